@@ -1,0 +1,16 @@
+//! Where the four colour sensors sit under the robot.
+use crate::robot::Pose;
+use glam::Vec2;
+
+/// Distance of each sensor from the robot's centre, m (3 cm diagonal).
+pub const SENSOR_RADIUS: f32 = 0.015;
+
+/// Arena positions of sensors n = 0..3 at robot-frame (0,-r), (r,0), (0,r), (-r,0): Y-, X+, Y+, X-.
+pub fn sensor_positions(pose: &Pose, r: f32) -> [Vec2; 4] {
+    [
+        pose.to_world(Vec2::new(0.0, -r)),
+        pose.to_world(Vec2::new(r, 0.0)),
+        pose.to_world(Vec2::new(0.0, r)),
+        pose.to_world(Vec2::new(-r, 0.0)),
+    ]
+}
