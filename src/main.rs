@@ -1,1 +1,96 @@
-fn main() {}
+//! The `colcos` command line.
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use colcos::run::{run, RunOptions};
+use colcos::sim::prelude::*;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "colcos", version, about = "Multi-pheromone swarm robotics simulator (ColCOSPhi)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scenario: writes trajectory.csv, screen.png, run.gif, fields/*.npy and summary.json.
+    Run {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+        /// Output directory [default: runs/<scenario name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override the scenario's seed.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Override the scenario's duration, s.
+        #[arg(long)]
+        duration: Option<f32>,
+        /// Worker threads (default: all cores). Results do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Check a scenario file and print what it sets up, without running it.
+    Check { scenario: PathBuf },
+    /// List the behaviours a scenario can name.
+    Behaviours,
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn real_main() -> Result<()> {
+    match Cli::parse().command {
+        Command::Run { scenario, out, seed, duration, threads, quiet } => {
+            if let Some(n) = threads {
+                rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting up the thread pool")?;
+            }
+            let sc = Scenario::from_file(&scenario)?.with_overrides(seed, duration)?;
+            let out = out.unwrap_or_else(|| PathBuf::from("runs").join(scenario.file_stem().unwrap_or_default()));
+            let report = run(&sc, &out, &RunOptions { progress: !quiet, no_gif: false })?;
+            println!(
+                "{} robots, {} steps ({} s simulated) in {:.2} s: {:.1}x real time",
+                report.robots,
+                report.steps,
+                report.sim_seconds,
+                report.wall_seconds,
+                report.real_time_factor()
+            );
+            for f in &report.files {
+                println!("  wrote {}", f.display());
+            }
+            Ok(())
+        }
+        Command::Check { scenario } => {
+            let sc = Scenario::from_file(&scenario)?;
+            let a = sc.arena_size();
+            println!("{}: ok", scenario.display());
+            println!("  arena {} x {} m, {} s at dt {} s ({} steps), seed {}", a.x, a.y, sc.spec.duration, sc.spec.dt, sc.steps(), sc.spec.seed);
+            for p in &sc.spec.pheromones {
+                println!("  pheromone {:?}: {:?} model, colour {:?}", p.name, p.model, p.colour);
+            }
+            for g in &sc.spec.robots {
+                println!("  {} robot(s), role {:?}, behaviour {:?}", g.count, g.role, g.behaviour);
+            }
+            Ok(())
+        }
+        Command::Behaviours => {
+            for (name, about) in colcos::sim::behaviour::registry::list() {
+                println!("{name:10} {about}");
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,4 +1,12 @@
 //! The overhead tracker: poses at its own rate, with latency, noise and dropouts.
+//!
+//! Frames are due at times `k / rate_hz` (k = 0, 1, ...); a frame is captured from the true poses of
+//! the first simulation step at or after its due time and stamped with that step's time (so stamp and
+//! pose agree; over a run the frame rate is exact, frame to frame it jitters by up to one step), and
+//! each frame is delivered `latency` s after its stamp. In a frame every robot gets Gaussian position
+//! and heading noise and is missing with probability `dropout`; a missing robot keeps its previous
+//! tracked pose. The very first call reports the true poses at once (`seen = true`) so the host has a
+//! place to inject from before the first frame arrives.
 use crate::rng::SimRng;
 use crate::robot::Pose;
 use serde::{Deserialize, Serialize};
@@ -34,17 +42,118 @@ pub struct TrackedPose {
     pub seen: bool,
 }
 
+/// Slack when comparing frame times with the simulation clock, s (absorbs f32 rounding of `t`).
+const TIME_EPS: f64 = 1e-5;
+
+/// One captured frame on its way to the host.
+struct Frame {
+    stamp: f64,
+    deliver_at: f64,
+    /// Per robot: the noisy pose, or `None` if it dropped out of this frame.
+    poses: Vec<Option<Pose>>,
+}
+
 pub struct Tracker {
     pub params: TrackerParams,
+    tracked: Vec<TrackedPose>,
+    /// Frames captured but not yet delivered, oldest first.
+    queue: std::collections::VecDeque<Frame>,
+    /// Buffers of delivered frames, reused.
+    spare: Vec<Vec<Option<Pose>>>,
+    /// Index of the next frame to capture.
+    next_frame: u64,
+    started: bool,
 }
 
 impl Tracker {
-    pub fn new(_params: TrackerParams, _robots: usize) -> Self {
-        todo!()
+    pub fn new(params: TrackerParams, robots: usize) -> Self {
+        Tracker {
+            params,
+            tracked: vec![TrackedPose::default(); robots],
+            queue: Default::default(),
+            spare: Vec::new(),
+            next_frame: 0,
+            started: false,
+        }
     }
+
+    /// The latest delivered tracked poses.
+    pub fn tracked(&self) -> &[TrackedPose] {
+        &self.tracked
+    }
+
+    /// Forgets everything: the next `update` reports the true poses again, as the first did.
+    pub fn reset(&mut self) {
+        while let Some(f) = self.queue.pop_front() {
+            self.spare.push(f.poses);
+        }
+        self.next_frame = 0;
+        self.started = false;
+        for p in &mut self.tracked {
+            *p = TrackedPose::default();
+        }
+    }
+
+    /// Capture time of frame `k`, s.
+    fn frame_time(&self, k: u64) -> f64 {
+        k as f64 / self.params.rate_hz as f64
+    }
+
     /// Records the true poses at time `t` and returns the latest delivered tracked poses (a robot that
     /// dropped out keeps its last tracked pose).
-    pub fn update(&mut self, _t: f32, _true_poses: &[Pose], _rng: &mut SimRng) -> &[TrackedPose] {
-        todo!()
+    pub fn update(&mut self, t: f32, true_poses: &[Pose], rng: &mut SimRng) -> &[TrackedPose] {
+        use rand::RngExt;
+        let n = true_poses.len();
+        self.tracked.resize(n, TrackedPose::default());
+        let now = t as f64;
+        let rate_ok = self.params.rate_hz.is_finite() && self.params.rate_hz > 0.0;
+        if !self.started {
+            self.started = true;
+            for (tp, p) in self.tracked.iter_mut().zip(true_poses) {
+                *tp = TrackedPose { pose: *p, stamp: t, seen: true };
+            }
+            // First frame: the first capture time at or after now.
+            self.next_frame =
+                if rate_ok { ((now - TIME_EPS) * self.params.rate_hz as f64).ceil().max(0.0) as u64 } else { 0 };
+        }
+        if rate_ok {
+            let latency = self.params.latency.max(0.0) as f64;
+            let (pos_sd, head_sd) = (self.params.position_noise.max(0.0), self.params.heading_noise.max(0.0));
+            let dropout = self.params.dropout;
+            while self.frame_time(self.next_frame) <= now + TIME_EPS {
+                // The frame shows the poses of this step, so it is stamped with this step's time.
+                let stamp = now;
+                self.next_frame += 1;
+                let mut poses = self.spare.pop().unwrap_or_default();
+                poses.clear();
+                for p in true_poses {
+                    let dropped = dropout > 0.0 && rng.random::<f32>() < dropout;
+                    if dropped {
+                        poses.push(None);
+                        continue;
+                    }
+                    let mut q = *p;
+                    if pos_sd > 0.0 {
+                        q.pos.x += pos_sd * crate::rng::normal(rng);
+                        q.pos.y += pos_sd * crate::rng::normal(rng);
+                    }
+                    if head_sd > 0.0 {
+                        q.heading += head_sd * crate::rng::normal(rng);
+                    }
+                    poses.push(Some(q));
+                }
+                self.queue.push_back(Frame { stamp, deliver_at: stamp + latency, poses });
+            }
+        }
+        while self.queue.front().is_some_and(|f| f.deliver_at <= now + TIME_EPS) {
+            let Some(frame) = self.queue.pop_front() else { break };
+            for (tp, p) in self.tracked.iter_mut().zip(&frame.poses) {
+                if let Some(p) = p {
+                    *tp = TrackedPose { pose: *p, stamp: frame.stamp as f32, seen: true };
+                }
+            }
+            self.spare.push(frame.poses);
+        }
+        &self.tracked
     }
 }

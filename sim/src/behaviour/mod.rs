@@ -3,10 +3,13 @@
 //! batched environments and on the real robot through the bridge.
 
 mod avoid;
+mod follow;
 mod observation;
+pub mod registry;
 mod wander;
 
 pub use avoid::Avoid;
+pub use follow::{channel_index, Follow, FollowParams};
 pub use observation::{Observation, WheelCommand, BUMPER_FRONT, BUMPER_FRONT_LEFT, BUMPER_FRONT_RIGHT};
 pub use wander::Wander;
 

@@ -21,8 +21,22 @@ pub struct GaussianSource {
 
 impl GaussianSource {
     /// Eq. (5) at `p` and absolute time `t`.
-    pub fn value_at(&self, _p: Vec2, _t: f32) -> f32 {
-        todo!()
+    ///
+    /// The clock `t - start` is the `t` of eq. (5); the value is 0 before `start`.
+    pub fn value_at(&self, p: Vec2, t: f32) -> f32 {
+        if !(t >= self.start) {
+            return 0.0;
+        }
+        let tau = (t - self.start) as f64;
+        let (sx, sy, rho) = (self.sigma_x as f64, self.sigma_y as f64, self.rho as f64);
+        let one_m_rho2 = 1.0 - rho * rho;
+        let dx = (p.x - self.centre.x) as f64;
+        let dy = (p.y - self.centre.y) as f64;
+        let e = self.evaporation as f64;
+        let decay = if e.is_infinite() { 1.0 } else { (-tau / e).exp() };
+        let q = dx * dx / (sx * sx) + dy * dy / (sy * sy) - 2.0 * rho * dx * dy / (sx * sy);
+        let norm = self.k as f64 / (2.0 * std::f64::consts::PI * sx * sy * one_m_rho2.sqrt());
+        (norm * decay * (-q / (2.0 * one_m_rho2)).exp()) as f32
     }
 }
 

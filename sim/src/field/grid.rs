@@ -1,5 +1,21 @@
 //! Grid model, eq. (2): dPhi/dt = -Phi/e + d lap(Phi) - u.grad(Phi) + J.
+//!
+//! One [`GridField::step`] is split into three parts, in this order:
+//!
+//! 1. evaporation and static injection, integrated exactly per cell:
+//!    `Phi <- a Phi + b J` with `a = exp(-dt/e)` and `b = e (1 - a)` (`b = dt` when `e` is infinite);
+//! 2. diffusion, by the [`DiffusionScheme`] of the field (conservative, no-flux walls, never negative);
+//! 3. wind advection, first-order upwind in conservative flux form with no-flux walls, sub-stepped to a
+//!    Courant number of at most 1/2 per direction (so it never goes negative and conserves mass).
+//!
+//! With the default [`DiffusionScheme::Auto`] and `d dt / h^2 <= 1/4`, parts 1 and 2 are one fused pass
+//! that reads every cell once and writes it once (into a second buffer, then swapped).
+//!
+//! Large grids are processed in parallel with rayon (bands of rows, or strips of columns for the
+//! vertical sweeps); small grids run on the calling thread. Every output cell is computed by the same
+//! arithmetic whatever the partition, so results are bit-identical for any number of threads.
 use glam::Vec2;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Geometry of a field grid: `nx * ny` square cells of side `cell` metres, cell `(i, j)` centred at
@@ -25,6 +41,21 @@ impl GridSpec {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+    /// Extent of the grid, m: `(nx cell, ny cell)`.
+    pub fn size(&self) -> Vec2 {
+        Vec2::new(self.nx as f32 * self.cell, self.ny as f32 * self.cell)
+    }
+    /// Centre of cell `(i, j)`, m.
+    pub fn cell_centre(&self, i: usize, j: usize) -> Vec2 {
+        Vec2::new((i as f32 + 0.5) * self.cell, (j as f32 + 0.5) * self.cell)
+    }
+    /// Index range `[lo, hi)` of the cells whose centres may lie within `[lo_m, hi_m]` along one axis of
+    /// `n` cells.
+    pub(crate) fn cell_range(&self, lo_m: f32, hi_m: f32, n: usize) -> (usize, usize) {
+        let lo = ((lo_m / self.cell - 0.5).floor().max(0.0) as usize).min(n);
+        let hi = (((hi_m / self.cell - 0.5).ceil() + 1.0).max(0.0) as usize).min(n);
+        (lo, hi.max(lo))
+    }
 }
 
 /// How diffusion is integrated.
@@ -39,6 +70,13 @@ pub enum DiffusionScheme {
     /// Backward-Euler, split by direction (unconditionally stable, positive, conservative).
     Implicit,
     /// The paper's one-sided scheme, eq. (4) (exchange with the left and lower neighbour only).
+    ///
+    /// Read conservatively, eq. (4) makes every cell send `s/2` of its content to its right neighbour and
+    /// `s/2` to its upper neighbour per unit of `s = d dt / h^2` (what a cell receives from its left and
+    /// lower neighbours leaves them). Mass is conserved, but it is transported: the scheme is a
+    /// first-order upwind advection toward `+x` and `+y` at `d / (2h)` m/s, so mass drifts toward
+    /// `+x`/`+y` and piles up against those walls. Offered for fidelity to the paper only. Sub-stepped to
+    /// `s <= 1/2` per sub-step.
     OneSided,
 }
 
@@ -60,17 +98,84 @@ impl Default for GridParams {
     }
 }
 
+/// Grids with fewer cells than this run on the calling thread (rayon's overhead is not worth it).
+pub const PARALLEL_MIN_CELLS: usize = 1 << 17;
+/// Rows per parallel task of the row-wise passes.
+const BAND_ROWS: usize = 16;
+/// Columns per strip of the column-wise sweeps (implicit y-solve, vertical wind).
+const STRIP_COLS: usize = 128;
+/// Rows solved together (interleaved) by the implicit x-solve.
+const XSOLVE_ROWS: usize = 8;
+/// Largest explicit diffusion number `d dt / h^2` per (sub-)step.
+const EXPLICIT_MAX_R: f32 = 0.25;
+/// Largest one-sided number `d dt / h^2` per sub-step.
+const ONE_SIDED_MAX_S: f32 = 0.5;
+/// Largest Courant number per wind sub-step, per direction.
+const WIND_MAX_CFL: f32 = 0.5;
+
+/// Precomputed Thomas-algorithm coefficients for the backward-Euler system of one direction:
+/// `(1 + 2r) u_i - r u_{i-1} - r u_{i+1} = f_i` with no-flux ends (`(1 + r) u_0 - r u_1 = f_0`).
+/// Forward: `d_i = (f_i + r d_{i-1}) m_i`; backward: `u_i = d_i + cp_i u_{i+1}`. All coefficients are
+/// positive, so the solve maps non-negative data to non-negative data.
+#[derive(Clone, Debug)]
+struct Thomas {
+    n: usize,
+    r: f32,
+    m: Vec<f32>,
+    cp: Vec<f32>,
+}
+
+impl Thomas {
+    fn new(n: usize, r: f32) -> Self {
+        let rr = r as f64;
+        let mut m = vec![0f32; n];
+        let mut cp = vec![0f32; n];
+        let mut prev_cp = 0f64;
+        for i in 0..n {
+            let diag = if n == 1 {
+                1.0
+            } else if i == 0 || i == n - 1 {
+                1.0 + rr
+            } else {
+                1.0 + 2.0 * rr
+            };
+            let mi = 1.0 / (diag - rr * prev_cp);
+            let cpi = if i + 1 < n { rr * mi } else { 0.0 };
+            m[i] = mi as f32;
+            cp[i] = cpi as f32;
+            prev_cp = cpi;
+        }
+        Thomas { n, r, m, cp }
+    }
+
+    fn matches(&self, n: usize, r: f32) -> bool {
+        self.n == n && self.r.to_bits() == r.to_bits()
+    }
+}
+
 /// One pheromone on a grid.
 pub struct GridField {
     spec: GridSpec,
     params: GridParams,
     values: Vec<f32>,
     injection: Option<Vec<f32>>,
+    /// Second buffer of the explicit passes (swapped with `values`).
+    scratch: Vec<f32>,
+    thomas_x: Option<Thomas>,
+    thomas_y: Option<Thomas>,
 }
 
 impl GridField {
     pub fn new(spec: GridSpec, params: GridParams) -> Self {
-        GridField { spec, params, values: vec![0.0; spec.len()], injection: None }
+        GridField {
+            spec,
+            params,
+            values: vec![0.0; spec.len()],
+            injection: None,
+            scratch: Vec::new(),
+            thomas_x: None,
+            thomas_y: None,
+        }
     }
     pub fn spec(&self) -> &GridSpec {
         &self.spec
@@ -78,31 +183,594 @@ impl GridField {
     pub fn params(&self) -> &GridParams {
         &self.params
     }
+    /// Replaces the parameters (the cached implicit coefficients are rebuilt when needed).
+    pub fn set_params(&mut self, params: GridParams) {
+        self.params = params;
+    }
     pub fn values(&self) -> &[f32] {
         &self.values
     }
     pub fn values_mut(&mut self) -> &mut [f32] {
         &mut self.values
     }
+    /// Sets every cell to zero.
+    pub fn clear(&mut self) {
+        self.values.fill(0.0);
+    }
     /// Sets a static injection map `J` (units per second per cell), applied every step.
     pub fn set_static_injection(&mut self, j: Vec<f32>) {
         assert_eq!(j.len(), self.spec.len());
         self.injection = Some(j);
     }
+    /// The static injection map, if any.
+    pub fn static_injection(&self) -> Option<&[f32]> {
+        self.injection.as_deref()
+    }
+    /// Removes the static injection map.
+    pub fn clear_static_injection(&mut self) {
+        self.injection = None;
+    }
+
     /// Bilinear value at `p` (m); clamped at the walls.
-    pub fn value_at(&self, _p: Vec2) -> f32 {
-        todo!()
+    pub fn value_at(&self, p: Vec2) -> f32 {
+        let GridSpec { nx, ny, cell } = self.spec;
+        if nx == 0 || ny == 0 {
+            return 0.0;
+        }
+        let (i0, i1, tx) = lerp_index(p.x / cell - 0.5, nx);
+        let (j0, j1, ty) = lerp_index(p.y / cell - 0.5, ny);
+        let v = &self.values;
+        let lo = v[j0 * nx + i0] + (v[j0 * nx + i1] - v[j0 * nx + i0]) * tx;
+        let hi = v[j1 * nx + i0] + (v[j1 * nx + i1] - v[j1 * nx + i0]) * tx;
+        lo + (hi - lo) * ty
     }
+
     /// Adds `amount * kernel.weight(distance to segment a-b)` to every cell near the segment.
-    pub fn deposit_segment(&mut self, _kernel: &crate::field::Kernel, _a: Vec2, _b: Vec2, _amount: f32) {
-        todo!()
+    /// Only the bounding box of the segment grown by the kernel's support is visited. `a == b` is a point
+    /// deposit. A kernel narrower than half a cell may touch no cell centre and deposit nothing.
+    pub fn deposit_segment(&mut self, kernel: &crate::field::Kernel, a: Vec2, b: Vec2, amount: f32) {
+        let GridSpec { nx, ny, cell } = self.spec;
+        let support = kernel.support();
+        if !(support >= 0.0) || !a.is_finite() || !b.is_finite() {
+            return;
+        }
+        let (i0, i1) = self.spec.cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
+        let (j0, j1) = self.spec.cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
+        let ab = b - a;
+        let len2 = ab.length_squared();
+        for j in j0..j1 {
+            let y = (j as f32 + 0.5) * cell;
+            let row = &mut self.values[j * nx..(j + 1) * nx];
+            for (i, v) in row.iter_mut().enumerate().take(i1).skip(i0) {
+                let p = Vec2::new((i as f32 + 0.5) * cell, y);
+                let dist = segment_distance(p, a, ab, len2);
+                if dist <= support {
+                    let w = kernel.weight(dist);
+                    if w != 0.0 {
+                        *v += amount * w;
+                    }
+                }
+            }
+        }
     }
+
+    /// Adds `amount * kernel.weight(distance to p)` to every cell near `p`.
+    pub fn deposit_point(&mut self, kernel: &crate::field::Kernel, p: Vec2, amount: f32) {
+        self.deposit_segment(kernel, p, p, amount);
+    }
+
     /// Advances by `dt` seconds: exact evaporation and static injection, then diffusion and wind.
-    pub fn step(&mut self, _dt: f32) {
-        todo!()
+    pub fn step(&mut self, dt: f32) {
+        if !(dt > 0.0) || self.spec.is_empty() {
+            return;
+        }
+        let GridSpec { nx, ny, cell } = self.spec;
+        let e = self.params.evaporation as f64;
+        let dtd = dt as f64;
+        let (a, b) = if e.is_finite() && e > 0.0 {
+            let a = (-dtd / e).exp();
+            // e (1 - a), accurate for small dt / e.
+            (a as f32, (-e * (-dtd / e).exp_m1()) as f32)
+        } else if e.is_finite() {
+            // e <= 0: the pheromone vanishes at once; the injection of this step is not kept either.
+            (0.0, 0.0)
+        } else {
+            (1.0, dt)
+        };
+        let d = self.params.diffusion.max(0.0);
+        let r = if d.is_finite() { d * dt / (cell * cell) } else { f32::INFINITY };
+        let parallel = self.spec.len() >= PARALLEL_MIN_CELLS;
+        let has_diffusion = r > 0.0 && (nx > 1 || ny > 1);
+
+        if !has_diffusion {
+            self.evaporate_inject(a, b, parallel);
+        } else {
+            match self.params.scheme {
+                DiffusionScheme::Auto if r <= EXPLICIT_MAX_R => self.explicit(a, b, r, 1, parallel),
+                DiffusionScheme::Auto | DiffusionScheme::Implicit => {
+                    if r.is_finite() {
+                        self.implicit(a, b, r, parallel)
+                    } else {
+                        // Infinite diffusion: uniform at the mean.
+                        self.evaporate_inject(a, b, parallel);
+                        let mean = (self.values.iter().map(|&v| v as f64).sum::<f64>() / self.values.len() as f64) as f32;
+                        self.values.fill(mean);
+                    }
+                }
+                DiffusionScheme::Explicit => {
+                    let n = substeps(r, EXPLICIT_MAX_R);
+                    self.explicit(a, b, r / n as f32, n, parallel)
+                }
+                DiffusionScheme::OneSided => {
+                    self.evaporate_inject(a, b, parallel);
+                    let n = substeps(r, ONE_SIDED_MAX_S);
+                    let s = r / n as f32;
+                    for _ in 0..n {
+                        self.one_sided_pass(s, parallel);
+                    }
+                }
+            }
+        }
+
+        let wind = self.params.wind;
+        if wind != Vec2::ZERO && wind.is_finite() {
+            let cx = wind.x * dt / cell;
+            let cy = wind.y * dt / cell;
+            let n = substeps(cx.abs().max(cy.abs()), WIND_MAX_CFL);
+            let (cx, cy) = (cx / n as f32, cy / n as f32);
+            for _ in 0..n {
+                if cx != 0.0 && nx > 1 {
+                    advect_x(&mut self.values, nx, cx, parallel);
+                }
+                if cy != 0.0 && ny > 1 {
+                    advect_y(&mut self.values, nx, ny, cy, parallel);
+                }
+            }
+        }
     }
+
     /// Integral of the field, sum of values times cell area.
     pub fn total_mass(&self) -> f64 {
-        todo!()
+        let h = self.spec.cell as f64;
+        self.values.iter().map(|&v| v as f64).sum::<f64>() * h * h
+    }
+
+    /// `Phi <- a Phi + b J`, in place.
+    fn evaporate_inject(&mut self, a: f32, b: f32, parallel: bool) {
+        let chunk = self.spec.nx.max(1) * BAND_ROWS;
+        match &self.injection {
+            Some(j) => {
+                let f = |(v, j): (&mut [f32], &[f32])| {
+                    for (v, &j) in v.iter_mut().zip(j) {
+                        *v = a * *v + b * j;
+                    }
+                };
+                if parallel {
+                    self.values.par_chunks_mut(chunk).zip(j.par_chunks(chunk)).for_each(f);
+                } else {
+                    self.values.chunks_mut(chunk).zip(j.chunks(chunk)).for_each(f);
+                }
+            }
+            None => {
+                if a == 1.0 {
+                    return;
+                }
+                let f = |v: &mut [f32]| v.iter_mut().for_each(|v| *v *= a);
+                if parallel {
+                    self.values.par_chunks_mut(chunk).for_each(f);
+                } else {
+                    self.values.chunks_mut(chunk).for_each(f);
+                }
+            }
+        }
+    }
+
+    /// `n` explicit sub-steps of diffusion number `r`; the first is fused with evaporation and injection.
+    fn explicit(&mut self, a: f32, b: f32, r: f32, n: usize, parallel: bool) {
+        let GridSpec { nx, ny, .. } = self.spec;
+        self.scratch.resize(self.values.len(), 0.0);
+        for k in 0..n {
+            let inj = if k == 0 { self.injection.as_deref() } else { None };
+            let (a, b) = if k == 0 { (a, b) } else { (1.0, 0.0) };
+            explicit_pass(&self.values, &mut self.scratch, inj, nx, ny, a, b, r, parallel);
+            std::mem::swap(&mut self.values, &mut self.scratch);
+        }
+    }
+
+    /// Backward Euler split by direction: x-solve (fused with evaporation and injection), then y-solve.
+    fn implicit(&mut self, a: f32, b: f32, r: f32, parallel: bool) {
+        let GridSpec { nx, ny, .. } = self.spec;
+        if !self.thomas_x.as_ref().is_some_and(|t| t.matches(nx, r)) {
+            self.thomas_x = Some(Thomas::new(nx, r));
+        }
+        if !self.thomas_y.as_ref().is_some_and(|t| t.matches(ny, r)) {
+            self.thomas_y = Some(Thomas::new(ny, r));
+        }
+        let tx = self.thomas_x.as_ref().expect("set above");
+        let ty = self.thomas_y.as_ref().expect("set above");
+        let inj = self.injection.as_deref();
+        let band = nx * XSOLVE_ROWS;
+        let xsolve = |(k, rows): (usize, &mut [f32])| {
+            let jrows = inj.map(|j| &j[k * band..k * band + rows.len()]);
+            xsolve_rows(rows, jrows, nx, a, b, tx);
+        };
+        if parallel {
+            self.values.par_chunks_mut(band).enumerate().for_each(xsolve);
+        } else {
+            self.values.chunks_mut(band).enumerate().for_each(xsolve);
+        }
+        if ny > 1 {
+            let grid = StripGrid::new(&mut self.values, nx, ny);
+            grid.for_each_strip(parallel, |s| ysolve_strip(s, ty));
+        }
+    }
+
+    /// One sub-step of the conservative reading of eq. (4) with number `s = d dt / h^2`.
+    fn one_sided_pass(&mut self, s: f32, parallel: bool) {
+        let GridSpec { nx, ny, .. } = self.spec;
+        self.scratch.resize(self.values.len(), 0.0);
+        let src = &self.values;
+        let half = 0.5 * s;
+        let f = |(band, out): (usize, &mut [f32])| {
+            for (k, orow) in out.chunks_mut(nx).enumerate() {
+                let j = band * BAND_ROWS + k;
+                let c = &src[j * nx..(j + 1) * nx];
+                let dn = if j > 0 { Some(&src[(j - 1) * nx..j * nx]) } else { None };
+                // Outflow to the upper neighbour, if any.
+                let keep_v = if j + 1 < ny { half } else { 0.0 };
+                for i in 0..nx {
+                    let keep_h = if i + 1 < nx { half } else { 0.0 };
+                    let mut v = c[i] * (1.0 - keep_h - keep_v);
+                    if i > 0 {
+                        v += half * c[i - 1];
+                    }
+                    if let Some(dn) = dn {
+                        v += half * dn[i];
+                    }
+                    orow[i] = v;
+                }
+            }
+        };
+        if parallel {
+            self.scratch.par_chunks_mut(nx * BAND_ROWS).enumerate().for_each(f);
+        } else {
+            self.scratch.chunks_mut(nx * BAND_ROWS).enumerate().for_each(f);
+        }
+        std::mem::swap(&mut self.values, &mut self.scratch);
+    }
+}
+
+/// Number of sub-steps that bring `x` down to at most `max` each.
+fn substeps(x: f32, max: f32) -> usize {
+    if x <= max {
+        1
+    } else {
+        ((x / max).ceil() as usize).max(1)
+    }
+}
+
+/// Index pair and weight for linear interpolation at fractional index `f` on `n` samples, clamped.
+pub(crate) fn lerp_index(f: f32, n: usize) -> (usize, usize, f32) {
+    if n <= 1 || !(f > 0.0) {
+        return (0, 0, 0.0);
+    }
+    let max = (n - 1) as f32;
+    if f >= max {
+        return (n - 1, n - 1, 0.0);
+    }
+    let i0 = f.floor() as usize;
+    let i0 = i0.min(n - 2);
+    (i0, i0 + 1, f - i0 as f32)
+}
+
+/// Distance from `p` to the segment starting at `a` with direction `ab` (`len2 = |ab|^2`).
+fn segment_distance(p: Vec2, a: Vec2, ab: Vec2, len2: f32) -> f32 {
+    let t = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (p - (a + ab * t)).length()
+}
+
+/// `out = scale * (w c + r (left + right + up + down))` with `w = 1 - 4r`; a missing neighbour (wall)
+/// counts as the cell itself, which is the no-flux condition. Every term is non-negative for
+/// non-negative data and `r <= 1/4`.
+#[inline(always)]
+fn stencil_row(c: &[f32], up: &[f32], dn: &[f32], out: &mut [f32], scale: f32, r: f32) {
+    let nx = c.len();
+    let w = 1.0 - 4.0 * r;
+    let (up, dn, out) = (&up[..nx], &dn[..nx], &mut out[..nx]);
+    if nx == 1 {
+        out[0] = scale * (w * c[0] + r * ((c[0] + c[0]) + (up[0] + dn[0])));
+        return;
+    }
+    out[0] = scale * (w * c[0] + r * ((c[0] + c[1]) + (up[0] + dn[0])));
+    let l = nx - 1;
+    out[l] = scale * (w * c[l] + r * ((c[l - 1] + c[l]) + (up[l] + dn[l])));
+    if nx > 2 {
+        let n = nx - 2;
+        let cl = &c[0..n];
+        let cm = &c[1..n + 1];
+        let cr = &c[2..n + 2];
+        let u = &up[1..n + 1];
+        let d = &dn[1..n + 1];
+        let o = &mut out[1..n + 1];
+        for k in 0..n {
+            o[k] = scale * (w * cm[k] + r * ((cl[k] + cr[k]) + (u[k] + d[k])));
+        }
+    }
+}
+
+/// One explicit pass `dst = (1 + r lap) (a src + b J)`.
+#[allow(clippy::too_many_arguments)]
+fn explicit_pass(
+    src: &[f32],
+    dst: &mut [f32],
+    inj: Option<&[f32]>,
+    nx: usize,
+    ny: usize,
+    a: f32,
+    b: f32,
+    r: f32,
+    parallel: bool,
+) {
+    let row = |j: usize| &src[j * nx..(j + 1) * nx];
+    let band = |(bi, out): (usize, &mut [f32])| {
+        let j0 = bi * BAND_ROWS;
+        let rows = out.len() / nx;
+        match inj {
+            None => {
+                for (k, o) in out.chunks_mut(nx).enumerate() {
+                    let j = j0 + k;
+                    let c = row(j);
+                    let dn = if j > 0 { row(j - 1) } else { c };
+                    let up = if j + 1 < ny { row(j + 1) } else { c };
+                    stencil_row(c, up, dn, o, a, r);
+                }
+            }
+            Some(jm) => {
+                // Rolling buffers of psi = a Phi + b J for rows j-1, j, j+1.
+                let psi = |j: usize, buf: &mut Vec<f32>| {
+                    buf.clear();
+                    let s = &src[j * nx..(j + 1) * nx];
+                    let q = &jm[j * nx..(j + 1) * nx];
+                    buf.extend(s.iter().zip(q).map(|(&v, &q)| a * v + b * q));
+                };
+                let mut prev = Vec::with_capacity(nx);
+                let mut cur = Vec::with_capacity(nx);
+                let mut next = Vec::with_capacity(nx);
+                psi(j0, &mut cur);
+                if j0 > 0 {
+                    psi(j0 - 1, &mut prev);
+                } else {
+                    prev.clone_from(&cur);
+                }
+                for (k, o) in out.chunks_mut(nx).enumerate().take(rows) {
+                    let j = j0 + k;
+                    if j + 1 < ny {
+                        psi(j + 1, &mut next);
+                    } else {
+                        next.clone_from(&cur);
+                    }
+                    stencil_row(&cur, &next, &prev, o, 1.0, r);
+                    std::mem::swap(&mut prev, &mut cur);
+                    std::mem::swap(&mut cur, &mut next);
+                }
+            }
+        }
+    };
+    if parallel {
+        dst.par_chunks_mut(nx * BAND_ROWS).enumerate().for_each(band);
+    } else {
+        dst.chunks_mut(nx * BAND_ROWS).enumerate().for_each(band);
+    }
+}
+
+/// Backward-Euler x-solve of up to `XSOLVE_ROWS` rows at once (their recurrences interleaved so the
+/// dependency chains overlap), with `f = a Phi + b J` formed on the fly.
+fn xsolve_rows(rows: &mut [f32], inj: Option<&[f32]>, nx: usize, a: f32, b: f32, t: &Thomas) {
+    let nrows = rows.len() / nx;
+    let r = t.r;
+    let (m, cp) = (&t.m[..nx], &t.cp[..nx]);
+    let mut prev = [0f32; XSOLVE_ROWS];
+    // Forward sweep.
+    for i in 0..nx {
+        let mi = m[i];
+        for k in 0..nrows {
+            let idx = k * nx + i;
+            let f = match inj {
+                Some(j) => a * rows[idx] + b * j[idx],
+                None => a * rows[idx],
+            };
+            let v = (f + r * prev[k]) * mi;
+            rows[idx] = v;
+            prev[k] = v;
+        }
+    }
+    // Backward sweep.
+    for i in (0..nx.saturating_sub(1)).rev() {
+        let ci = cp[i];
+        for k in 0..nrows {
+            let idx = k * nx + i;
+            rows[idx] += ci * rows[idx + 1];
+        }
+    }
+}
+
+/// Backward-Euler y-solve of one strip of columns, sweeping rows (contiguous within the strip).
+fn ysolve_strip(s: &mut Strip<'_>, t: &Thomas) {
+    let ny = s.ny;
+    let r = t.r;
+    let (m, cp) = (&t.m[..ny], &t.cp[..ny]);
+    for v in s.row(0) {
+        *v *= m[0];
+    }
+    for j in 1..ny {
+        let mj = m[j];
+        let (lo, cur) = s.rows2(j - 1, j);
+        for (c, &l) in cur.iter_mut().zip(lo.iter()) {
+            *c = (*c + r * l) * mj;
+        }
+    }
+    for j in (0..ny - 1).rev() {
+        let cj = cp[j];
+        let (hi, cur) = s.rows2(j + 1, j);
+        for (c, &h) in cur.iter_mut().zip(hi.iter()) {
+            *c += cj * h;
+        }
+    }
+}
+
+/// Upwind advection along x by Courant number `c` (|c| <= 1), in place, no-flux walls.
+fn advect_x(values: &mut [f32], nx: usize, c: f32, parallel: bool) {
+    let f = |row: &mut [f32]| {
+        if c > 0.0 {
+            // Face flux c * phi_i from i to i + 1; the last cell sends nothing.
+            let l = nx - 1;
+            row[l] += c * row[l - 1];
+            for i in (1..l).rev() {
+                row[i] = row[i] * (1.0 - c) + c * row[i - 1];
+            }
+            row[0] *= 1.0 - c;
+        } else {
+            let c = -c;
+            row[0] += c * row[1];
+            for i in 1..nx - 1 {
+                row[i] = row[i] * (1.0 - c) + c * row[i + 1];
+            }
+            row[nx - 1] *= 1.0 - c;
+        }
+    };
+    if parallel {
+        values.par_chunks_mut(nx).for_each(f);
+    } else {
+        values.chunks_mut(nx).for_each(f);
+    }
+}
+
+/// Upwind advection along y by Courant number `c` (|c| <= 1), in place, no-flux walls.
+fn advect_y(values: &mut [f32], nx: usize, ny: usize, c: f32, parallel: bool) {
+    let grid = StripGrid::new(values, nx, ny);
+    grid.for_each_strip(parallel, |s| {
+        let axpy = |dst: &mut [f32], src: &[f32], keep: f32| {
+            for (d, &s) in dst.iter_mut().zip(src) {
+                *d = *d * keep + c.abs() * s;
+            }
+        };
+        if c > 0.0 {
+            let (lo, top) = s.rows2(ny - 2, ny - 1);
+            axpy(top, lo, 1.0);
+            for j in (1..ny - 1).rev() {
+                let (lo, cur) = s.rows2(j - 1, j);
+                axpy(cur, lo, 1.0 - c);
+            }
+            s.row(0).iter_mut().for_each(|v| *v *= 1.0 - c);
+        } else {
+            let ca = -c;
+            let (hi, bot) = s.rows2(1, 0);
+            axpy(bot, hi, 1.0);
+            for j in 1..ny - 1 {
+                let (hi, cur) = s.rows2(j + 1, j);
+                axpy(cur, hi, 1.0 - ca);
+            }
+            s.row(ny - 1).iter_mut().for_each(|v| *v *= 1.0 - ca);
+        }
+    });
+}
+
+/// A row-major grid split into strips of columns that may be processed concurrently.
+struct StripGrid<'a> {
+    ptr: SyncPtr,
+    nx: usize,
+    ny: usize,
+    _borrow: std::marker::PhantomData<&'a mut [f32]>,
+}
+
+#[derive(Clone, Copy)]
+struct SyncPtr(*mut f32);
+// SAFETY: the pointer is only used to build slices of disjoint column strips (see `Strip`).
+unsafe impl Send for SyncPtr {}
+unsafe impl Sync for SyncPtr {}
+
+/// Columns `[i0, i0 + width)` of every row of a [`StripGrid`].
+struct Strip<'a> {
+    ptr: SyncPtr,
+    nx: usize,
+    ny: usize,
+    i0: usize,
+    width: usize,
+    _borrow: std::marker::PhantomData<&'a mut [f32]>,
+}
+
+impl<'a> StripGrid<'a> {
+    fn new(values: &'a mut [f32], nx: usize, ny: usize) -> Self {
+        assert_eq!(values.len(), nx * ny);
+        StripGrid { ptr: SyncPtr(values.as_mut_ptr()), nx, ny, _borrow: std::marker::PhantomData }
+    }
+
+    fn for_each_strip(self, parallel: bool, f: impl Fn(&mut Strip<'_>) + Sync + Send) {
+        let (nx, ny, ptr) = (self.nx, self.ny, self.ptr);
+        let nstrips = nx.div_ceil(STRIP_COLS);
+        let run = |k: usize| {
+            let i0 = k * STRIP_COLS;
+            let width = STRIP_COLS.min(nx - i0);
+            // Each strip owns its columns exclusively: no two strips alias.
+            let mut s = Strip { ptr, nx, ny, i0, width, _borrow: std::marker::PhantomData };
+            f(&mut s);
+        };
+        if parallel {
+            (0..nstrips).into_par_iter().for_each(run);
+        } else {
+            (0..nstrips).for_each(run);
+        }
+    }
+}
+
+impl Strip<'_> {
+    fn row(&mut self, j: usize) -> &mut [f32] {
+        assert!(j < self.ny);
+        // SAFETY: in bounds (j < ny, i0 + width <= nx); the strip holds its columns exclusively and the
+        // returned slice borrows `self` mutably.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.0.add(j * self.nx + self.i0), self.width) }
+    }
+
+    /// Row `other` (read) and row `j` (write) of the strip; `other != j`.
+    fn rows2(&mut self, other: usize, j: usize) -> (&[f32], &mut [f32]) {
+        assert!(other < self.ny && j < self.ny && other != j);
+        // SAFETY: distinct rows of the strip do not overlap; both in bounds; borrows of `self`.
+        unsafe {
+            let o = std::slice::from_raw_parts(self.ptr.0.add(other * self.nx + self.i0), self.width);
+            let c = std::slice::from_raw_parts_mut(self.ptr.0.add(j * self.nx + self.i0), self.width);
+            (o, c)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thomas_solves_the_system() {
+        let n = 7;
+        let r = 3.5f32;
+        let t = Thomas::new(n, r);
+        let f: Vec<f32> = (0..n).map(|i| (i * i) as f32 + 1.0).collect();
+        let mut u = f.clone();
+        xsolve_rows(&mut u, None, n, 1.0, 0.0, &t);
+        for i in 0..n {
+            let l = if i > 0 { u[i - 1] } else { u[i] };
+            let rr = if i + 1 < n { u[i + 1] } else { u[i] };
+            let lhs = u[i] - r * (l + rr - 2.0 * u[i]);
+            assert!((lhs - f[i]).abs() < 1e-4 * f[i].max(1.0), "{i}: {lhs} vs {}", f[i]);
+        }
+        let s: f32 = u.iter().sum();
+        let s0: f32 = f.iter().sum();
+        assert!((s - s0).abs() < 1e-4 * s0);
+    }
+
+    #[test]
+    fn lerp_index_clamps() {
+        assert_eq!(lerp_index(-3.0, 5), (0, 0, 0.0));
+        assert_eq!(lerp_index(10.0, 5), (4, 4, 0.0));
+        assert_eq!(lerp_index(1.25, 5), (1, 2, 0.25));
+        assert_eq!(lerp_index(0.7, 1), (0, 0, 0.0));
     }
 }

@@ -8,7 +8,8 @@ mod pheromone;
 mod static_map;
 
 pub use gaussian::{GaussianField, GaussianSource};
-pub use grid::{DiffusionScheme, GridField, GridParams, GridSpec};
+pub use grid::{DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS};
+pub(crate) use grid::lerp_index;
 pub use kernel::Kernel;
 pub use pheromone::{FieldModel, Pheromone};
 pub use static_map::{image_map, polyline_map};

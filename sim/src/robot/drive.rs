@@ -9,13 +9,28 @@ pub struct DriveState {
     pub right: f32,
 }
 
+/// A command component clamped to the wheel limit; NaN counts as 0.
+fn clamp_command(v: f32, max: f32) -> f32 {
+    if v.is_nan() { 0.0 } else { v.clamp(-max, max) }
+}
+
 impl DriveState {
     /// Moves the wheel speeds toward the clamped command over `dt` (exact first-order response).
-    pub fn update(&mut self, _cmd: WheelCommand, _params: &ColiasParams, _dt: f32) {
-        todo!()
+    ///
+    /// `v += (cmd - v) * (1 - exp(-dt / tau))` with `tau = params.motor_lag`; `tau <= 0` follows the
+    /// command at once. Commands are clamped to `+-max_wheel_speed`, NaN counts as 0.
+    pub fn update(&mut self, cmd: WheelCommand, params: &ColiasParams, dt: f32) {
+        let max = params.max_wheel_speed.abs();
+        let l = clamp_command(cmd.left, max);
+        let r = clamp_command(cmd.right, max);
+        let alpha = if params.motor_lag > 0.0 { -(-dt.max(0.0) / params.motor_lag).exp_m1() } else { 1.0 };
+        self.left += (l - self.left) * alpha;
+        self.right += (r - self.right) * alpha;
     }
     /// Body velocities: (forward speed m/s, yaw rate rad/s).
-    pub fn body_velocity(&self, _params: &ColiasParams) -> (f32, f32) {
-        todo!()
+    pub fn body_velocity(&self, params: &ColiasParams) -> (f32, f32) {
+        let forward = 0.5 * (self.left + self.right);
+        let yaw = if params.wheel_base > 0.0 { (self.right - self.left) / params.wheel_base } else { 0.0 };
+        (forward, yaw)
     }
 }

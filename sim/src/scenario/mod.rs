@@ -1,2 +1,93 @@
-//! scenario
-pub struct Scenario;
+//! Scenario files: TOML parsed into a [`ScenarioSpec`] (unknown keys rejected, errors with the key path),
+//! then validated before anything runs.
+
+mod spec;
+mod validate;
+
+pub use spec::*;
+
+use crate::error::{Result, SimError};
+use std::path::{Path, PathBuf};
+
+/// A checked scenario, ready to build a [`crate::world::World`].
+#[derive(Clone, Debug)]
+pub struct Scenario {
+    pub spec: ScenarioSpec,
+    /// Directory that relative paths in the file (images) are resolved against.
+    pub base_dir: PathBuf,
+}
+
+impl Scenario {
+    /// Reads, parses and validates a scenario file.
+    pub fn from_file(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| SimError::io(format!("reading scenario {}", path.display()), e))?;
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_toml_str(&text, base).map_err(|e| match e {
+            SimError::Parse { message, .. } => SimError::Parse { path: path.display().to_string(), message },
+            other => other,
+        })
+    }
+
+    /// Parses and validates scenario text; `base_dir` resolves relative paths.
+    pub fn from_toml_str(text: &str, base_dir: impl Into<PathBuf>) -> Result<Self> {
+        let spec = parse_spec(text)?;
+        Self::from_spec(spec, base_dir)
+    }
+
+    /// Validates an already parsed spec.
+    pub fn from_spec(spec: ScenarioSpec, base_dir: impl Into<PathBuf>) -> Result<Self> {
+        let scenario = Scenario { spec, base_dir: base_dir.into() };
+        validate::validate(&scenario)?;
+        Ok(scenario)
+    }
+
+    /// Arena size, m.
+    pub fn arena_size(&self) -> glam::Vec2 {
+        let s = self.spec.arena.size.unwrap_or(self.spec.screen.size);
+        glam::Vec2::new(s[0], s[1])
+    }
+
+    /// Number of ticks in a run.
+    pub fn steps(&self) -> u64 {
+        (self.spec.duration / self.spec.dt).round() as u64
+    }
+
+    /// Total number of robots.
+    pub fn robot_count(&self) -> usize {
+        self.spec.robots.iter().map(|g| g.count).sum()
+    }
+
+    /// Index of the pheromone called `name`.
+    pub fn pheromone_index(&self, name: &str) -> Option<usize> {
+        self.spec.pheromones.iter().position(|p| p.name == name)
+    }
+
+    /// Replaces the seed and/or duration and checks the result again.
+    pub fn with_overrides(mut self, seed: Option<u64>, duration: Option<f32>) -> Result<Self> {
+        if let Some(s) = seed {
+            self.spec.seed = s;
+        }
+        if let Some(d) = duration {
+            self.spec.duration = d;
+        }
+        validate::validate(&self)?;
+        Ok(self)
+    }
+
+    /// The scenario as TOML (what a run actually used).
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(&self.spec).unwrap_or_default()
+    }
+}
+
+/// TOML text to spec. Errors name the key path (`robots[0].count`) and what was wrong.
+pub fn parse_spec(text: &str) -> Result<ScenarioSpec> {
+    let de = toml::de::Deserializer::parse(text).map_err(|e| SimError::Parse { path: "<text>".into(), message: e.to_string() })?;
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner().to_string();
+        let message = if path == "." || path.is_empty() { inner } else { format!("at `{path}`: {inner}") };
+        SimError::Parse { path: "<text>".into(), message }
+    })
+}

@@ -1,4 +1,13 @@
 //! TCS34725-like colour sensor looking at the screen.
+//!
+//! Model: the screen emits `light_k = (level_k / 255)^gamma` in each primary; the sensor counts
+//! `dark + gain * integration_ms * sum_k crosstalk[c][k] * light_k + noise * N(0, 1)`, clamped to
+//! `0..=65535`. The calibrated inverse undoes all of it but the noise.
+//!
+//! Default gain: 1500 counts per unit light per ms. At the default 24 ms integration a full white
+//! screen gives at most `30 + 1500 * 24 * 1.16 = 41,790` counts (the green row of the crosstalk matrix
+//! sums to 1.16), well below saturation with room for noise; at 40 ms or more white saturates every
+//! channel (`1500 * 40 * 1.11 > 65,535`), as a real TCS34725 does with too long an integration time.
 use crate::field::Pheromone;
 use crate::rng::SimRng;
 use crate::screen::ScreenSpec;
@@ -30,7 +39,7 @@ impl Default for ColourSensorParams {
             footprint_radius: 0.0015,
             gamma: 2.2,
             crosstalk: [[1.0, 0.08, 0.03], [0.06, 1.0, 0.10], [0.02, 0.12, 1.0]],
-            gain: 20.0,
+            gain: 1500.0,
             integration_ms: 24.0,
             dark_counts: 30.0,
             noise: 8.0,
@@ -38,27 +47,119 @@ impl Default for ColourSensorParams {
     }
 }
 
+/// Number of screen points a sensor averages: the centre and a ring of [`RING_POINTS`].
+pub const RING_POINTS: usize = 8;
+/// Radius of the sample ring as a fraction of the footprint radius.
+pub const RING_FRACTION: f32 = 0.7;
+
 /// A colour sensor model with its calibrated inverse.
 #[derive(Clone, Debug)]
 pub struct ColourSensor {
     pub params: ColourSensorParams,
+    /// Inverse of `params.crosstalk` (identity if it is singular).
+    inverse: [[f32; 3]; 3],
+    /// Sample offsets of the footprint, m, relative to the sensor centre.
+    offsets: [Vec2; RING_POINTS + 1],
+}
+
+/// Inverse of a 3x3 matrix, computed in f64; `None` when (nearly) singular.
+pub fn invert3(m: &[[f32; 3]; 3]) -> Option<[[f32; 3]; 3]> {
+    let a = |r: usize, c: usize| m[r][c] as f64;
+    let cof = |r: usize, c: usize| {
+        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+        let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+        a(r1, c1) * a(r2, c2) - a(r1, c2) * a(r2, c1)
+    };
+    let det = a(0, 0) * cof(0, 0) + a(0, 1) * cof(0, 1) + a(0, 2) * cof(0, 2);
+    if !det.is_finite() || det.abs() < 1e-9 {
+        return None;
+    }
+    let mut inv = [[0.0f32; 3]; 3];
+    for (r, row) in inv.iter_mut().enumerate() {
+        for (c, v) in row.iter_mut().enumerate() {
+            // inverse = adjugate / det, adjugate = transpose of the cofactors.
+            *v = (cof(c, r) / det) as f32;
+        }
+    }
+    Some(inv)
 }
 
 impl ColourSensor {
-    pub fn new(_params: ColourSensorParams) -> Self {
-        todo!()
+    pub fn new(params: ColourSensorParams) -> Self {
+        const IDENTITY: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let inverse = invert3(&params.crosstalk).unwrap_or(IDENTITY);
+        let mut offsets = [Vec2::ZERO; RING_POINTS + 1];
+        let ring = RING_FRACTION * params.footprint_radius.max(0.0);
+        for (k, o) in offsets.iter_mut().skip(1).enumerate() {
+            *o = ring * Vec2::from_angle(std::f32::consts::TAU * k as f32 / RING_POINTS as f32);
+        }
+        ColourSensor { params, inverse, offsets }
     }
+
+    /// Where on the screen the sensor at `p` samples, arena coordinates: `p` and a ring around it.
+    pub fn sample_points(&self, p: Vec2) -> [Vec2; RING_POINTS + 1] {
+        self.offsets.map(|o| p + o)
+    }
+
     /// Mean 8-bit screen level (r, g, b) over the footprint around `p`, each in [0, 255].
-    pub fn screen_levels(&self, _pheromones: &[Pheromone], _screen: &ScreenSpec, _p: Vec2) -> [f32; 3] {
-        todo!()
+    pub fn screen_levels(&self, pheromones: &[Pheromone], screen: &ScreenSpec, p: Vec2) -> [f32; 3] {
+        let mut sum = [0u32; 3];
+        for q in self.sample_points(p) {
+            let px = crate::screen::pixel_at(pheromones, screen, q);
+            for c in 0..3 {
+                sum[c] += px[c] as u32;
+            }
+        }
+        sum.map(|s| s as f32 / (RING_POINTS + 1) as f32)
     }
+
+    /// Light emitted per primary, in [0, 1], for 8-bit levels.
+    pub fn light(&self, levels: [f32; 3]) -> [f32; 3] {
+        levels.map(|l| {
+            let x = if l.is_nan() { 0.0 } else { (l / 255.0).clamp(0.0, 1.0) };
+            x.powf(self.params.gamma)
+        })
+    }
+
     /// Counts for the given mean screen levels: transfer curve, crosstalk, gain, integration, noise,
     /// saturation at 65535.
-    pub fn counts(&self, _levels: [f32; 3], _rng: &mut SimRng) -> [u16; 3] {
-        todo!()
+    pub fn counts(&self, levels: [f32; 3], rng: &mut SimRng) -> [u16; 3] {
+        let p = &self.params;
+        let light = self.light(levels);
+        let scale = p.gain * p.integration_ms;
+        let mut out = [0u16; 3];
+        for (c, o) in out.iter_mut().enumerate() {
+            let signal: f32 = (0..3).map(|k| p.crosstalk[c][k] * light[k]).sum();
+            let mut raw = p.dark_counts + scale * signal;
+            if p.noise > 0.0 {
+                raw += p.noise * crate::rng::normal(rng);
+            }
+            // `as` saturates and maps NaN to 0.
+            *o = raw.clamp(0.0, 65535.0).round() as u16;
+        }
+        out
     }
+
     /// Calibrated inverse: counts back to screen intensity in [0, 1] per channel.
-    pub fn intensity(&self, _counts: [u16; 3]) -> [f32; 3] {
-        todo!()
+    ///
+    /// Subtracts the dark counts, divides by gain and integration time, undoes the crosstalk, clamps
+    /// the light to [0, 1] and inverts the transfer curve: `intensity = light^(1 / gamma)`, which is
+    /// `level / 255`. A saturated channel (65535) reads 1.
+    pub fn intensity(&self, counts: [u16; 3]) -> [f32; 3] {
+        let p = &self.params;
+        let scale = p.gain * p.integration_ms;
+        let signal = counts.map(|n| if scale > 0.0 { (n as f32 - p.dark_counts) / scale } else { 0.0 });
+        let inv_gamma = if p.gamma > 0.0 { 1.0 / p.gamma } else { 1.0 };
+        let mut out = [0.0f32; 3];
+        for (c, o) in out.iter_mut().enumerate() {
+            if counts[c] == u16::MAX {
+                *o = 1.0;
+                continue;
+            }
+            let light: f32 = (0..3).map(|k| self.inverse[c][k] * signal[k]).sum();
+            let light = if light.is_nan() { 0.0 } else { light.clamp(0.0, 1.0) };
+            *o = light.powf(inv_gamma);
+        }
+        out
     }
 }

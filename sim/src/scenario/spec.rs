@@ -1,0 +1,247 @@
+//! The scenario file format (TOML), as plain serde structs. Unknown keys are rejected everywhere.
+//! Checking the values happens in [`super::validate`].
+
+use crate::field::{DiffusionScheme, Kernel};
+use crate::robot::ColiasParams;
+use crate::screen::ScreenSpec;
+use crate::sensors::{BumperParams, ColourSensorParams};
+use crate::tracker::TrackerParams;
+use serde::{Deserialize, Serialize};
+
+/// A whole scenario: arena, screen, pheromones, robots, duration, time step, seed.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioSpec {
+    /// Human-readable name.
+    #[serde(default)]
+    pub name: String,
+    /// Length of a run, s.
+    pub duration: f32,
+    /// Time step, s (the paper's screen refresh: 0.02).
+    #[serde(default = "default_dt")]
+    pub dt: f32,
+    #[serde(default)]
+    pub seed: u64,
+    #[serde(default)]
+    pub arena: ArenaSpec,
+    #[serde(default)]
+    pub screen: ScreenSpec,
+    #[serde(default)]
+    pub field: FieldSpec,
+    #[serde(default)]
+    pub robot: ColiasParams,
+    #[serde(default)]
+    pub sensor: ColourSensorParams,
+    #[serde(default)]
+    pub bumper: BumperParams,
+    #[serde(default)]
+    pub tracker: TrackerParams,
+    #[serde(default)]
+    pub output: OutputSpec,
+    #[serde(default)]
+    pub pheromones: Vec<PheromoneSpec>,
+    #[serde(default)]
+    pub robots: Vec<RobotGroupSpec>,
+}
+
+fn default_dt() -> f32 {
+    0.02
+}
+
+/// The walled arena. By default it is the screen.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArenaSpec {
+    /// Width and height, m (default: the screen's size).
+    pub size: Option<[f32; 2]>,
+}
+
+/// Where pheromone is injected: at the tracker's poses (as in the real rig) or the true ones.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InjectAt {
+    #[default]
+    Tracked,
+    True,
+}
+
+/// The grid shared by all grid pheromones.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FieldSpec {
+    /// Grid cell side, m.
+    pub cell: f32,
+    pub inject_at: InjectAt,
+}
+
+impl Default for FieldSpec {
+    fn default() -> Self {
+        FieldSpec { cell: 0.005, inject_at: InjectAt::Tracked }
+    }
+}
+
+/// What a run writes besides the trajectory log.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Seconds between GIF frames (0: no GIF).
+    pub gif_interval: f32,
+    /// GIF width in pixels (height follows the screen's aspect ratio).
+    pub gif_width: u32,
+    /// Log every n-th tick.
+    pub log_every: u32,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { gif_interval: 0.2, gif_width: 480, log_every: 1 }
+    }
+}
+
+/// Field model of one pheromone.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    /// Eq. (2) on the grid.
+    #[default]
+    Grid,
+    /// Eq. (5): Gaussian sources.
+    Gaussian,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PheromoneSpec {
+    pub name: String,
+    /// k_j of eq. (1): screen levels (0-255 scale) per unit of pheromone, for r, g, b.
+    pub colour: [f32; 3],
+    #[serde(default)]
+    pub model: ModelKind,
+    /// Evaporation time e, s (grid: absent = no evaporation).
+    pub evaporation: Option<f32>,
+    /// Diffusion coefficient d, m^2/s (grid only).
+    #[serde(default)]
+    pub diffusion: f32,
+    #[serde(default)]
+    pub scheme: DiffusionScheme,
+    /// Constant wind, m/s (grid only).
+    #[serde(default)]
+    pub wind: [f32; 2],
+    /// Static injection maps (grid only).
+    #[serde(default)]
+    pub maps: Vec<MapSpec>,
+    /// Fixed Gaussian sources (gaussian only).
+    #[serde(default)]
+    pub sources: Vec<SourceSpec>,
+}
+
+/// A static injection map: a polyline with a width, or an image.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapSpec {
+    /// Points of a polyline, m.
+    pub polyline: Option<Vec<[f32; 2]>>,
+    /// Trail width, m.
+    pub width: Option<f32>,
+    /// PNG path, relative to the scenario file.
+    pub image: Option<String>,
+    /// Image channel to read: "r", "g", "b" or "luma".
+    pub channel: Option<String>,
+    /// Injection rate J, units per second (at full image level).
+    pub rate: f32,
+}
+
+/// A Gaussian source of eq. (5).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SourceSpec {
+    pub k: f32,
+    /// (sigma_x, sigma_y), m.
+    pub sigma: [f32; 2],
+    #[serde(default)]
+    pub rho: f32,
+    /// Evaporation time e, s.
+    pub evaporation: f32,
+    /// (mu_x, mu_y), m (fixed sources only).
+    #[serde(default)]
+    pub centre: [f32; 2],
+    /// Start time, s.
+    #[serde(default)]
+    pub start: f32,
+}
+
+/// How a group of robots is placed at the start.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Placement {
+    /// Uniformly at random, without overlap, headings random.
+    #[default]
+    Random,
+    /// On a regular grid over the region, headings random.
+    Grid,
+    /// At the poses given in `poses`.
+    Explicit,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RobotGroupSpec {
+    pub count: usize,
+    /// A free label (`leader`, `predator`, ...): behaviours never see it; emitters can refer to it.
+    #[serde(default)]
+    pub role: String,
+    /// Behaviour name from the registry (`wander`, `avoid`, `follow`, ...).
+    pub behaviour: String,
+    /// Parameters of the behaviour (checked by the behaviour's own spec).
+    #[serde(default)]
+    pub params: toml::Table,
+    #[serde(default)]
+    pub placement: Placement,
+    /// Region to place robots in, [x0, y0, x1, y1], m (default: the whole arena).
+    pub region: Option<[f32; 4]>,
+    /// Poses [x m, y m, heading degrees] for `placement = "explicit"`.
+    #[serde(default)]
+    pub poses: Vec<[f32; 3]>,
+    /// Trails this group lays on grid pheromones.
+    #[serde(default)]
+    pub deposits: Vec<DepositSpec>,
+    /// Gaussian sources this group emits.
+    #[serde(default)]
+    pub emits: Vec<EmitSpec>,
+}
+
+/// Trail injection along each robot's path.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DepositSpec {
+    pub pheromone: String,
+    pub kernel: Kernel,
+    /// Units per second at the kernel's peak.
+    pub rate: f32,
+}
+
+/// A Gaussian source attached to each robot of a group.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EmitSpec {
+    pub pheromone: String,
+    pub k: f32,
+    pub sigma: [f32; 2],
+    #[serde(default)]
+    pub rho: f32,
+    pub evaporation: f32,
+    /// When to (re)start the source's clock at the robot's position.
+    #[serde(default)]
+    pub when: EmitWhen,
+}
+
+/// `follow`: the source sits at the robot and is refreshed every step (AGP follows the leader).
+/// `near`: while the robot is within `distance` of a robot of role `role`, the source is moved to it and
+/// its clock restarts (refreshed); away from it, the source stays and evaporates (ALP).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum EmitWhen {
+    #[default]
+    Follow,
+    Near { role: String, distance: f32 },
+}

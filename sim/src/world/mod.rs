@@ -1,0 +1,140 @@
+//! A world: one arena with its pheromones, screen, robots, tracker and behaviours, stepped together
+//! (design.md, "Data flow of one step").
+
+mod build;
+mod inject;
+mod placement;
+mod step;
+
+use crate::behaviour::{Behaviour, Observation, WheelCommand};
+use crate::field::{Kernel, Pheromone};
+use crate::rng::SimRng;
+use crate::robot::{ArenaPhysics, ColiasParams, DriveState, Pose};
+use crate::scenario::{InjectAt, Scenario};
+use crate::screen::ScreenSpec;
+use crate::sensors::{BumperParams, ColourSensor, NeighbourIndex};
+use crate::tracker::{TrackedPose, Tracker};
+use glam::Vec2;
+
+/// Per-robot state that the world keeps apart from physics.
+pub struct RobotSlot {
+    /// Index of the scenario's robot group this robot comes from.
+    pub group: usize,
+    pub behaviour: Box<dyn Behaviour>,
+    /// This robot's own random stream (sensor noise, behaviour choices).
+    pub rng: SimRng,
+    pub drive: DriveState,
+    /// Command applied in the last step.
+    pub command: WheelCommand,
+}
+
+/// A trail deposit rule of one robot.
+struct Deposit {
+    robot: usize,
+    pheromone: usize,
+    kernel: Kernel,
+    /// Units per second at the kernel's peak.
+    rate: f32,
+}
+
+/// A Gaussian source attached to one robot.
+struct Emitter {
+    robot: usize,
+    pheromone: usize,
+    /// Index of the source in the pheromone's [`crate::field::GaussianField`].
+    source: usize,
+    /// `None`: follow always; `Some((targets, distance))`: refresh when near one of `targets`.
+    near: Option<(Vec<usize>, f32)>,
+}
+
+pub struct World {
+    scenario: Scenario,
+    time: f32,
+    tick: u64,
+    dt: f32,
+    arena: Vec2,
+    robot_params: ColiasParams,
+    bumper_params: BumperParams,
+    screen: ScreenSpec,
+    inject_at: InjectAt,
+    pheromones: Vec<Pheromone>,
+    physics: ArenaPhysics,
+    robots: Vec<RobotSlot>,
+    observations: Vec<Observation>,
+    tracker: Tracker,
+    tracker_rng: SimRng,
+    tracked: Vec<TrackedPose>,
+    /// Where each robot injected last (None before its first tracked pose).
+    last_injection: Vec<Option<Vec2>>,
+    neighbours: NeighbourIndex,
+    sensor: ColourSensor,
+    deposits: Vec<Deposit>,
+    emitters: Vec<Emitter>,
+    // Scratch buffers reused every step (no per-step allocation).
+    command_buffer: Vec<WheelCommand>,
+    velocities: Vec<(f32, f32)>,
+    positions: Vec<Vec2>,
+}
+
+impl World {
+    /// Simulation time, s.
+    pub fn time(&self) -> f32 {
+        self.time
+    }
+    /// Number of steps taken.
+    pub fn tick(&self) -> u64 {
+        self.tick
+    }
+    pub fn dt(&self) -> f32 {
+        self.dt
+    }
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+    /// Arena size, m.
+    pub fn arena(&self) -> Vec2 {
+        self.arena
+    }
+    pub fn screen(&self) -> &ScreenSpec {
+        &self.screen
+    }
+    pub fn pheromones(&self) -> &[Pheromone] {
+        &self.pheromones
+    }
+    pub fn pheromones_mut(&mut self) -> &mut [Pheromone] {
+        &mut self.pheromones
+    }
+    pub fn robot_count(&self) -> usize {
+        self.robots.len()
+    }
+    pub fn robots(&self) -> &[RobotSlot] {
+        &self.robots
+    }
+    pub fn robot_params(&self) -> &ColiasParams {
+        &self.robot_params
+    }
+    /// True poses.
+    pub fn poses(&self) -> &[Pose] {
+        self.physics.poses()
+    }
+    /// Poses as the tracker last delivered them.
+    pub fn tracked(&self) -> &[TrackedPose] {
+        &self.tracked
+    }
+    /// What each robot senses now.
+    pub fn observations(&self) -> &[Observation] {
+        &self.observations
+    }
+    /// Role of robot `i` (its group's `role`).
+    pub fn role(&self, i: usize) -> &str {
+        &self.scenario.spec.robots[self.robots[i].group].role
+    }
+    /// The colour sensor model shared by all robots.
+    pub fn sensor(&self) -> &ColourSensor {
+        &self.sensor
+    }
+    /// Steps until the scenario's duration is reached.
+    pub fn is_finished(&self) -> bool {
+        self.tick >= self.scenario.steps()
+    }
+}

@@ -1,0 +1,6 @@
+//! colcos: a simulator, RL environment and hardware bridge for multi-pheromone swarm robotics, after
+//! the ColCOSPhi system. This facade re-exports the library crates; the `colcos` binary is the CLI.
+
+pub use colcos_sim as sim;
+
+pub mod run;
