@@ -116,8 +116,8 @@ pub fn render(pheromones: &[Pheromone], screen: &ScreenSpec, width: u32, height:
                 }
             }
             for (a, &v) in acc.iter_mut().zip(&vals) {
-                for c in 0..3 {
-                    a[c] += ph.colour[c] * v;
+                for (a, k) in a.iter_mut().zip(ph.colour) {
+                    *a += k * v;
                 }
             }
         }

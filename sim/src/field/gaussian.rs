@@ -1,4 +1,5 @@
 //! Gaussian-source model, eq. (5).
+#![allow(clippy::neg_cmp_op_on_partial_ord)] // NaN-aware test
 use glam::Vec2;
 
 #[derive(Clone, Copy, Debug, PartialEq)]

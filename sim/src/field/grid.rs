@@ -14,6 +14,7 @@
 //! Large grids are processed in parallel with rayon (bands of rows, or strips of columns for the
 //! vertical sweeps); small grids run on the calling thread. Every output cell is computed by the same
 //! arithmetic whatever the partition, so results are bit-identical for any number of threads.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)] // NaN-aware tests; index loops over several equal-length slices
 use glam::Vec2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -161,8 +162,11 @@ pub struct GridField {
     injection: Option<Vec<f32>>,
     /// Second buffer of the explicit passes (swapped with `values`).
     scratch: Vec<f32>,
-    thomas_x: Option<Thomas>,
-    thomas_y: Option<Thomas>,
+    thomas_x: Option<Box<Thomas>>,
+    thomas_y: Option<Box<Thomas>>,
+    /// Log of (exact cumulative decay / applied cumulative decay): error feedback that keeps the product
+    /// of the f32 decay factors within one rounding of `exp(-t/e)` over any number of steps.
+    decay_carry: f64,
 }
 
 impl GridField {
@@ -175,6 +179,7 @@ impl GridField {
             scratch: Vec::new(),
             thomas_x: None,
             thomas_y: None,
+            decay_carry: 0.0,
         }
     }
     pub fn spec(&self) -> &GridSpec {
@@ -268,9 +273,12 @@ impl GridField {
         let e = self.params.evaporation as f64;
         let dtd = dt as f64;
         let (a, b) = if e.is_finite() && e > 0.0 {
-            let a = (-dtd / e).exp();
-            // e (1 - a), accurate for small dt / e.
-            (a as f32, (-e * (-dtd / e).exp_m1()) as f32)
+            // The f32 factor actually applied is chosen so that the running product tracks exp(-t/e), and
+            // b = e (1 - a) is the exact injection for that factor (so the steady state is e J).
+            let ln_a = -dtd / e + self.decay_carry;
+            let a = ln_a.exp() as f32;
+            self.decay_carry = ln_a - (a as f64).ln();
+            (a, (e * (1.0 - a as f64)) as f32)
         } else if e.is_finite() {
             // e <= 0: the pheromone vanishes at once; the injection of this step is not kept either.
             (0.0, 0.0)
@@ -381,10 +389,10 @@ impl GridField {
     fn implicit(&mut self, a: f32, b: f32, r: f32, parallel: bool) {
         let GridSpec { nx, ny, .. } = self.spec;
         if !self.thomas_x.as_ref().is_some_and(|t| t.matches(nx, r)) {
-            self.thomas_x = Some(Thomas::new(nx, r));
+            self.thomas_x = Some(Box::new(Thomas::new(nx, r)));
         }
         if !self.thomas_y.as_ref().is_some_and(|t| t.matches(ny, r)) {
-            self.thomas_y = Some(Thomas::new(ny, r));
+            self.thomas_y = Some(Box::new(Thomas::new(ny, r)));
         }
         let tx = self.thomas_x.as_ref().expect("set above");
         let ty = self.thomas_y.as_ref().expect("set above");

@@ -56,14 +56,14 @@ mod tests {
         let h = npy_header_f32(&[2, 3]);
         let dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }";
         let mut expected = b"\x93NUMPY\x01\x00".to_vec();
-        let pad = 64 - 10 - dict.len() - 1;
+        let pad = 128 - 10 - dict.len() - 1;
         expected.extend_from_slice(&((dict.len() + pad + 1) as u16).to_le_bytes());
         expected.extend_from_slice(dict.as_bytes());
         expected.extend(std::iter::repeat_n(b' ', pad));
         expected.push(b'\n');
-        assert_eq!(h.len(), 64);
+        assert_eq!(h.len(), 128);
         assert_eq!(h, expected);
-        assert_eq!(&h[8..10], &[54, 0]);
+        assert_eq!(&h[8..10], &[118, 0]);
         assert_eq!(npy_header_f32(&[5]).len() % 64, 0);
         assert!(String::from_utf8_lossy(&npy_header_f32(&[5])).contains("'shape': (5,), "));
         assert!(String::from_utf8_lossy(&npy_header_f32(&[])).contains("'shape': (), "));
@@ -75,9 +75,9 @@ mod tests {
         let p = dir.path().join("a.npy");
         write_npy_f32(&p, &[2, 2], &[1.0, 2.0, 3.0, -0.5]).unwrap();
         let bytes = std::fs::read(&p).unwrap();
-        assert_eq!(bytes.len(), 64 + 16);
-        assert_eq!(&bytes[64..68], &1.0f32.to_le_bytes());
-        assert_eq!(&bytes[76..80], &(-0.5f32).to_le_bytes());
+        assert_eq!(bytes.len(), 128 + 16);
+        assert_eq!(&bytes[128..132], &1.0f32.to_le_bytes());
+        assert_eq!(&bytes[140..144], &(-0.5f32).to_le_bytes());
         assert!(write_npy_f32(&p, &[3], &[1.0]).is_err());
     }
 }

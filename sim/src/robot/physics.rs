@@ -11,16 +11,23 @@
 use super::{ColiasParams, Pose};
 use glam::Vec2;
 use rapier2d::prelude::{
-    ColliderBuilder, IntegrationParameters, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, Rotation, Vector,
+    ColliderBuilder, IntegrationParameters, SpringCoefficients, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, Rotation, Vector,
 };
 
 /// Half-thickness of the wall boxes, m: thick enough that nothing can tunnel through.
 const WALL_HALF_THICKNESS: f32 = 0.5;
 /// Friction coefficient of robots and walls (low: plastic shells sliding past each other).
 const FRICTION: f32 = 0.05;
-/// rapier's length unit, m: scales its slop (0.005 units = 1 mm), prediction distance (4 mm) and
-/// corrective velocity (0.6 m/s) to the 2 cm robots.
+/// rapier's length unit, m: scales its slop (0.005 units = 1 mm) and corrective velocity (0.6 m/s)
+/// to the 2 cm robots.
 const LENGTH_UNIT: f32 = 0.2;
+/// Distance at which rapier starts predictive contacts, m. It must exceed the distance two robots
+/// close in one step (2 x 0.35 m/s x 20 ms = 14 mm), or robots meeting head-on overlap by up to that.
+const PREDICTION_DISTANCE: f32 = 0.02;
+/// Natural frequency of the contact springs, Hz (rapier's default is 30 Hz for dynamic pairs and
+/// 60 Hz against fixed bodies). With 20 ms steps those let a line of robots pushed into a wall
+/// compress by centimetres; 300 Hz keeps overlaps under half a millimetre.
+const CONTACT_FREQUENCY: f32 = 300.0;
 
 pub struct ArenaPhysics {
     world: PhysicsWorld,
@@ -38,6 +45,9 @@ impl ArenaPhysics {
         world.integration_parameters = IntegrationParameters {
             length_unit: LENGTH_UNIT,
             num_solver_iterations: 4,
+            normalized_prediction_distance: PREDICTION_DISTANCE / LENGTH_UNIT,
+            contact_softness: SpringCoefficients::new(CONTACT_FREQUENCY, 10.0),
+            static_contact_softness: SpringCoefficients::new(CONTACT_FREQUENCY, 10.0),
             ..IntegrationParameters::default()
         };
         let (w, h) = (size.x.max(0.0), size.y.max(0.0));
@@ -154,3 +164,4 @@ impl ArenaPhysics {
         if p.is_finite() { p.clamp(lo, hi) } else { 0.5 * (lo + hi) }
     }
 }
+

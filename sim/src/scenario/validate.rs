@@ -32,8 +32,8 @@ pub(super) fn validate(sc: &Scenario) -> Result<()> {
     positive("arena.size[0]", arena.x)?;
     positive("arena.size[1]", arena.y)?;
     for (i, r) in s.screen.resolution.iter().enumerate() {
-        if *r == 0 || *r > 16384 {
-            return Err(SimError::invalid(format!("screen.resolution[{i}]"), r, "must be 1..=16384 pixels"));
+        if *r == 0 || *r > 65536 {
+            return Err(SimError::invalid(format!("screen.resolution[{i}]"), r, "must be 1..=65536 pixels"));
         }
     }
     positive("screen.size[0]", s.screen.size[0])?;

@@ -1,0 +1,113 @@
+//! Whole-world steps: 10,000 Colias robots (colour sensors, bumpers, trail injection) on a 1 cm
+//! three-pheromone grid in a 14.4 m x 8.1 m arena (the density of 100 robots on the 65-inch screen),
+//! and 100 robots on the 65-inch screen with a 5 mm grid. Prints the median step time, the real-time
+//! factor at dt = 20 ms, and the ratio to ARGoS's headline (10,000 simple robots at 1.4x real time).
+//!
+//! cargo bench --bench swarm_step
+use colcos::sim::prelude::*;
+use criterion::{criterion_group, criterion_main, Criterion};
+use std::time::{Duration, Instant};
+
+const ARGOS_10K_REAL_TIME_FACTOR: f64 = 1.4;
+
+fn scenario(robots: usize, size: [f32; 2], resolution: [u32; 2], cell: f32) -> Scenario {
+    let per_group = robots / 3;
+    let group = |lay: &str, follow: &str, count: usize| {
+        format!(
+            r#"
+[[robots]]
+count = {count}
+behaviour = "follow"
+params = {{ channel = "{follow}", speed = 0.1 }}
+deposits = [{{ pheromone = "{lay}", kernel = {{ shape = "disc", radius = 0.01 }}, rate = 3.0 }}]
+"#
+        )
+    };
+    let text = format!(
+        r#"
+duration = 10.0
+[screen]
+resolution = [{rx}, {ry}]
+size = [{w}, {h}]
+[field]
+cell = {cell}
+[output]
+gif_interval = 0
+[[pheromones]]
+name = "red"
+colour = [255, 0, 0]
+evaporation = 20.0
+diffusion = 1e-6
+[[pheromones]]
+name = "green"
+colour = [0, 255, 0]
+evaporation = 20.0
+diffusion = 1e-6
+[[pheromones]]
+name = "blue"
+colour = [0, 0, 255]
+evaporation = 20.0
+diffusion = 1e-6
+{a}{b}{c}"#,
+        rx = resolution[0],
+        ry = resolution[1],
+        w = size[0],
+        h = size[1],
+        a = group("red", "b", per_group),
+        b = group("green", "r", per_group),
+        c = group("blue", "g", robots - 2 * per_group),
+    );
+    Scenario::from_toml_str(&text, ".").expect("bench scenario is valid")
+}
+
+fn median(mut xs: Vec<f64>) -> f64 {
+    xs.sort_by(f64::total_cmp);
+    xs[xs.len() / 2]
+}
+
+/// Median wall time of one step over `n` steps after `warm` warm-up steps.
+fn time_steps(world: &mut World, warm: usize, n: usize) -> f64 {
+    for _ in 0..warm {
+        world.step();
+    }
+    median(
+        (0..n)
+            .map(|_| {
+                let t = Instant::now();
+                world.step();
+                t.elapsed().as_secs_f64()
+            })
+            .collect(),
+    )
+}
+
+fn report(label: &str, step_s: f64, dt: f64, target: f64, peer: Option<(&str, f64)>) {
+    let rtf = dt / step_s;
+    print!("{label}: median step {:.3} ms, {rtf:.1}x real time (target >= {target}x: {})", step_s * 1e3, if rtf >= target { "met" } else { "NOT met" });
+    if let Some((name, peer_rtf)) = peer {
+        print!(", {:.1}x {name}", rtf / peer_rtf);
+    }
+    println!();
+}
+
+fn bench(c: &mut Criterion) {
+    let big = scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01);
+    let small = scenario(100, [1.439, 0.809], [3840, 2160], 0.005);
+    let mut w_big = World::new(&big).unwrap();
+    let mut w_small = World::new(&small).unwrap();
+
+    let mut g = c.benchmark_group("swarm_step");
+    g.sample_size(20).measurement_time(Duration::from_secs(8)).warm_up_time(Duration::from_secs(2));
+    g.bench_function("10k_robots_1cm_grid", |b| b.iter(|| w_big.step()));
+    g.bench_function("100_robots_5mm_grid", |b| b.iter(|| w_small.step()));
+    g.finish();
+
+    println!("\n== swarm_step summary (dt = 20 ms, {} threads) ==", rayon::current_num_threads());
+    let big_s = time_steps(&mut w_big, 10, 100);
+    report("10,000 robots, 14.4 x 8.1 m, 1 cm grid x3", big_s, 0.02, 2.0, Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)));
+    let small_s = time_steps(&mut w_small, 50, 2000);
+    report("100 robots, 65-inch screen, 5 mm grid x3", small_s, 0.02, 100.0, None);
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
