@@ -3,4 +3,7 @@
 
 pub use colcos_sim as sim;
 
+pub mod backend;
+pub mod display;
+pub mod experiment;
 pub mod run;

@@ -34,7 +34,15 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Field backend: cpu, gpu or auto (overrides the scenario's `field.backend`).
+        #[arg(long)]
+        backend: Option<colcos::sim::field::BackendChoice>,
     },
+    /// Show a scenario's screen image in a window (full screen on a chosen monitor, or windowed), or
+    /// render it headless to PNG.
+    Display(colcos::display::DisplayArgs),
+    /// Reproduce the paper's case studies (all trials in parallel): figures, CSVs, summary.json/.md.
+    Experiment(colcos::experiment::ExperimentArgs),
     /// Check a scenario file and print what it sets up, without running it.
     Check { scenario: PathBuf },
     /// List the behaviours a scenario can name.
@@ -53,13 +61,19 @@ fn main() -> ExitCode {
 
 fn real_main() -> Result<()> {
     match Cli::parse().command {
-        Command::Run { scenario, out, seed, duration, threads, quiet } => {
+        Command::Display(args) => colcos::display::main(args),
+        Command::Experiment(args) => colcos::experiment::main(args),
+        Command::Run { scenario, out, seed, duration, threads, quiet, backend } => {
             if let Some(n) = threads {
                 rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting up the thread pool")?;
             }
-            let sc = Scenario::from_file(&scenario)?.with_overrides(seed, duration)?;
+            let mut sc = Scenario::from_file(&scenario)?.with_overrides(seed, duration)?;
+            if let Some(b) = backend {
+                sc.spec.field.backend = b;
+            }
             let out = out.unwrap_or_else(|| PathBuf::from("runs").join(scenario.file_stem().unwrap_or_default()));
             let report = run(&sc, &out, &RunOptions { progress: !quiet, no_gif: false })?;
+            println!("field backend: {}", report.backend);
             println!(
                 "{} robots, {} steps ({} s simulated) in {:.2} s: {:.1}x real time",
                 report.robots,

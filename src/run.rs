@@ -17,6 +17,8 @@ pub struct RunReport {
     pub sim_seconds: f32,
     pub wall_seconds: f64,
     pub files: Vec<PathBuf>,
+    /// The field backend that stepped the grids (`cpu (...)` or `gpu: <adapter>`).
+    pub backend: String,
 }
 
 impl RunReport {
@@ -44,6 +46,7 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
     files.push(scenario_copy);
 
     let mut world = World::new(scenario)?;
+    let backend = crate::backend::install(&mut world, scenario.spec.field.backend)?;
     let log_path = out_dir.join("trajectory.csv");
     let mut log = TrajectoryLog::create(&log_path)?;
     files.push(log_path);
@@ -86,10 +89,10 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
     files.push(png);
     files.extend(write_fields(&world, scenario, out_dir)?);
 
-    let report = RunReport { out_dir: out_dir.to_path_buf(), steps, robots: world.robot_count(), sim_seconds: world.time(), wall_seconds: stepping, files };
+    let report = RunReport { out_dir: out_dir.to_path_buf(), steps, robots: world.robot_count(), sim_seconds: world.time(), wall_seconds: stepping, files, backend };
     let summary = out_dir.join("summary.json");
     let json = format!(
-        "{{\n  \"scenario\": {:?},\n  \"seed\": {},\n  \"steps\": {},\n  \"robots\": {},\n  \"sim_seconds\": {},\n  \"step_wall_seconds\": {:.4},\n  \"real_time_factor\": {:.2},\n  \"total_wall_seconds\": {:.3}\n}}\n",
+        "{{\n  \"scenario\": {:?},\n  \"seed\": {},\n  \"steps\": {},\n  \"robots\": {},\n  \"sim_seconds\": {},\n  \"step_wall_seconds\": {:.4},\n  \"real_time_factor\": {:.2},\n  \"total_wall_seconds\": {:.3},\n  \"backend\": {:?}\n}}\n",
         scenario.spec.name,
         scenario.spec.seed,
         steps,
@@ -97,7 +100,8 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
         report.sim_seconds,
         report.wall_seconds,
         report.real_time_factor(),
-        started.elapsed().as_secs_f64()
+        started.elapsed().as_secs_f64(),
+        report.backend
     );
     std::fs::write(&summary, json).with_context(|| format!("writing {}", summary.display()))?;
     let mut report = report;

@@ -11,6 +11,7 @@
 pub mod behaviour;
 pub mod error;
 pub mod field;
+pub mod metrics;
 pub mod output;
 pub mod robot;
 pub mod rng;

@@ -1,8 +1,8 @@
 //! The screen, eq. (1): I(x, y, c) = clip(sum_j k_j Phi_j(x, y)) as 8-bit RGB at the panel's resolution.
 use crate::error::{Result, SimError};
 use crate::field::{FieldModel, Pheromone};
-use rayon::prelude::*;
 use glam::Vec2;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The display panel: resolution in pixels and physical size in metres. Pixel row 0 is at the top
@@ -18,14 +18,20 @@ pub struct ScreenSpec {
 impl Default for ScreenSpec {
     /// The paper's 65-inch 4K panel.
     fn default() -> Self {
-        ScreenSpec { resolution: [3840, 2160], size: [1.439, 0.809] }
+        ScreenSpec {
+            resolution: [3840, 2160],
+            size: [1.439, 0.809],
+        }
     }
 }
 
 impl ScreenSpec {
     /// Size of one pixel, m: `(size.x / resolution.x, size.y / resolution.y)`.
     pub fn pixel_size(&self) -> Vec2 {
-        Vec2::new(self.size[0] / self.resolution[0].max(1) as f32, self.size[1] / self.resolution[1].max(1) as f32)
+        Vec2::new(
+            self.size[0] / self.resolution[0].max(1) as f32,
+            self.size[1] / self.resolution[1].max(1) as f32,
+        )
     }
 
     /// Centre of the pixel that shows point `p` (the screen is pixelated: a sensor sees pixels).
@@ -34,10 +40,17 @@ impl ScreenSpec {
         let ps = self.pixel_size();
         let k = |v: f32, size: f32, n: u32| -> f32 {
             let n = n.max(1);
-            let idx = if v.is_nan() { 0.0 } else { (v / size).floor().clamp(0.0, (n - 1) as f32) };
+            let idx = if v.is_nan() {
+                0.0
+            } else {
+                (v / size).floor().clamp(0.0, (n - 1) as f32)
+            };
             (idx + 0.5) * size
         };
-        Vec2::new(k(p.x, ps.x, self.resolution[0]), k(p.y, ps.y, self.resolution[1]))
+        Vec2::new(
+            k(p.x, ps.x, self.resolution[0]),
+            k(p.y, ps.y, self.resolution[1]),
+        )
     }
 }
 
@@ -67,7 +80,12 @@ pub fn pixel_at(pheromones: &[Pheromone], screen: &ScreenSpec, p: Vec2) -> [u8; 
 /// Pixel `(px, row)` samples the fields at the centre of that pixel of a `width x height` grid stretched
 /// over the panel; row 0 is the top (`y = height`). Grid fields are resampled bilinearly (the same as
 /// [`crate::field::GridField::value_at`], with the horizontal weights computed once per image).
-pub fn render(pheromones: &[Pheromone], screen: &ScreenSpec, width: u32, height: u32) -> image::RgbImage {
+pub fn render(
+    pheromones: &[Pheromone],
+    screen: &ScreenSpec,
+    width: u32,
+    height: u32,
+) -> image::RgbImage {
     let (w, h) = (width as usize, height as usize);
     let mut img = image::RgbImage::new(width, height);
     if w == 0 || h == 0 {
@@ -82,10 +100,14 @@ pub fn render(pheromones: &[Pheromone], screen: &ScreenSpec, width: u32, height:
         .map(|ph| match &ph.model {
             FieldModel::Grid(g) => {
                 let s = g.spec();
-                Some(xs.iter().map(|&x| {
-                    let (i0, i1, t) = crate::field::lerp_index(x / s.cell - 0.5, s.nx);
-                    (i0 as u32, i1 as u32, t)
-                }).collect())
+                Some(
+                    xs.iter()
+                        .map(|&x| {
+                            let (i0, i1, t) = crate::field::lerp_index(x / s.cell - 0.5, s.nx);
+                            (i0 as u32, i1 as u32, t)
+                        })
+                        .collect(),
+                )
             }
             FieldModel::Gaussian(_) => None,
         })
@@ -139,5 +161,8 @@ pub fn render(pheromones: &[Pheromone], screen: &ScreenSpec, width: u32, height:
 /// Writes an image as PNG.
 pub fn save_png(img: &image::RgbImage, path: &std::path::Path) -> Result<()> {
     img.save_with_format(path, image::ImageFormat::Png)
-        .map_err(|e| SimError::Image { path: path.display().to_string(), message: e.to_string() })
+        .map_err(|e| SimError::Image {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
 }

@@ -28,7 +28,13 @@ pub struct TrackerParams {
 
 impl Default for TrackerParams {
     fn default() -> Self {
-        TrackerParams { rate_hz: 30.0, latency: 0.04, position_noise: 0.001, heading_noise: 0.02, dropout: 0.01 }
+        TrackerParams {
+            rate_hz: 30.0,
+            latency: 0.04,
+            position_noise: 0.001,
+            heading_noise: 0.02,
+            dropout: 0.01,
+        }
     }
 }
 
@@ -110,15 +116,27 @@ impl Tracker {
         if !self.started {
             self.started = true;
             for (tp, p) in self.tracked.iter_mut().zip(true_poses) {
-                *tp = TrackedPose { pose: *p, stamp: t, seen: true };
+                *tp = TrackedPose {
+                    pose: *p,
+                    stamp: t,
+                    seen: true,
+                };
             }
             // First frame: the first capture time at or after now.
-            self.next_frame =
-                if rate_ok { ((now - TIME_EPS) * self.params.rate_hz as f64).ceil().max(0.0) as u64 } else { 0 };
+            self.next_frame = if rate_ok {
+                ((now - TIME_EPS) * self.params.rate_hz as f64)
+                    .ceil()
+                    .max(0.0) as u64
+            } else {
+                0
+            };
         }
         if rate_ok {
             let latency = self.params.latency.max(0.0) as f64;
-            let (pos_sd, head_sd) = (self.params.position_noise.max(0.0), self.params.heading_noise.max(0.0));
+            let (pos_sd, head_sd) = (
+                self.params.position_noise.max(0.0),
+                self.params.heading_noise.max(0.0),
+            );
             let dropout = self.params.dropout;
             while self.frame_time(self.next_frame) <= now + TIME_EPS {
                 // The frame shows the poses of this step, so it is stamped with this step's time.
@@ -142,14 +160,28 @@ impl Tracker {
                     }
                     poses.push(Some(q));
                 }
-                self.queue.push_back(Frame { stamp, deliver_at: stamp + latency, poses });
+                self.queue.push_back(Frame {
+                    stamp,
+                    deliver_at: stamp + latency,
+                    poses,
+                });
             }
         }
-        while self.queue.front().is_some_and(|f| f.deliver_at <= now + TIME_EPS) {
-            let Some(frame) = self.queue.pop_front() else { break };
+        while self
+            .queue
+            .front()
+            .is_some_and(|f| f.deliver_at <= now + TIME_EPS)
+        {
+            let Some(frame) = self.queue.pop_front() else {
+                break;
+            };
             for (tp, p) in self.tracked.iter_mut().zip(&frame.poses) {
                 if let Some(p) = p {
-                    *tp = TrackedPose { pose: *p, stamp: frame.stamp as f32, seen: true };
+                    *tp = TrackedPose {
+                        pose: *p,
+                        stamp: frame.stamp as f32,
+                        seen: true,
+                    };
                 }
             }
             self.spare.push(frame.poses);

@@ -7,7 +7,12 @@ fn field(nx: usize, ny: usize, cell: f32, params: GridParams) -> GridField {
 }
 
 fn params(e: f32, d: f32, scheme: DiffusionScheme) -> GridParams {
-    GridParams { evaporation: e, diffusion: d, scheme, wind: Vec2::ZERO }
+    GridParams {
+        evaporation: e,
+        diffusion: d,
+        scheme,
+        wind: Vec2::ZERO,
+    }
 }
 
 /// Centre of mass (m) and per-axis variance (m^2).
@@ -33,16 +38,28 @@ fn moments(f: &GridField) -> (Vec2, Vec2) {
             vy += v * (c.y as f64 - cy).powi(2);
         }
     }
-    (Vec2::new(cx as f32, cy as f32), Vec2::new((vx / m) as f32, (vy / m) as f32))
+    (
+        Vec2::new(cx as f32, cy as f32),
+        Vec2::new((vx / m) as f32, (vy / m) as f32),
+    )
 }
 
 fn blobs(f: &mut GridField) {
     let s = *f.spec();
     let size = s.size();
-    let k = Kernel::Cone { radius: 0.12 * size.x.min(size.y) };
+    let k = Kernel::Cone {
+        radius: 0.12 * size.x.min(size.y),
+    };
     f.deposit_point(&k, size * Vec2::new(0.3, 0.4), 5.0);
     f.deposit_point(&k, size * Vec2::new(0.05, 0.9), 2.0);
-    f.deposit_segment(&Kernel::Disc { radius: 2.0 * s.cell }, size * 0.6, size * Vec2::new(0.97, 0.1), 1.0);
+    f.deposit_segment(
+        &Kernel::Disc {
+            radius: 2.0 * s.cell,
+        },
+        size * 0.6,
+        size * Vec2::new(0.97, 0.1),
+        1.0,
+    );
 }
 
 #[test]
@@ -74,7 +91,11 @@ fn steady_state_is_e_times_j() {
             f.step(0.1);
         }
         for (v, j) in f.values().iter().zip(&j) {
-            assert!((v - 5.0 * j).abs() <= 1e-5 * (5.0 * j).max(1.0), "{v} vs {}", 5.0 * j);
+            assert!(
+                (v - 5.0 * j).abs() <= 1e-5 * (5.0 * j).max(1.0),
+                "{v} vs {}",
+                5.0 * j
+            );
         }
     }
 }
@@ -103,7 +124,10 @@ fn diffusion_conserves_mass_and_stays_positive() {
         }
         let rel = (f.total_mass() / m0 - 1.0).abs();
         assert!(rel < 1e-4, "{scheme:?} r={r}: mass rel err {rel}");
-        assert!(f.values().iter().all(|&v| v >= 0.0 && v.is_finite()), "{scheme:?} r={r}: negative");
+        assert!(
+            f.values().iter().all(|&v| v >= 0.0 && v.is_finite()),
+            "{scheme:?} r={r}: negative"
+        );
     }
 }
 
@@ -111,7 +135,12 @@ fn diffusion_conserves_mass_and_stays_positive() {
 fn diffusion_conserves_mass_with_injection_fused() {
     // Auto explicit with a static map: mass grows by exactly sum(J) h^2 per second (e infinite).
     let h = 0.01;
-    let mut f = field(50, 30, h, params(f32::INFINITY, 0.2 * h * h / 0.02, DiffusionScheme::Auto));
+    let mut f = field(
+        50,
+        30,
+        h,
+        params(f32::INFINITY, 0.2 * h * h / 0.02, DiffusionScheme::Auto),
+    );
     let mut j = vec![0.0; 1500];
     j[15 * 50 + 20] = 100.0;
     j[29 * 50 + 49] = 50.0;
@@ -120,7 +149,11 @@ fn diffusion_conserves_mass_with_injection_fused() {
         f.step(0.02);
     }
     let expect = 150.0 * 4.0 * (h as f64).powi(2);
-    assert!((f.total_mass() / expect - 1.0).abs() < 1e-4, "{} vs {expect}", f.total_mass());
+    assert!(
+        (f.total_mass() / expect - 1.0).abs() < 1e-4,
+        "{} vs {expect}",
+        f.total_mass()
+    );
 }
 
 #[test]
@@ -134,9 +167,15 @@ fn huge_dt_is_bounded_and_positive() {
             f.step(100.0);
         }
         let v = f.values();
-        assert!(v.iter().all(|&v| v >= 0.0 && v.is_finite() && v <= max0), "{scheme:?}");
+        assert!(
+            v.iter().all(|&v| v >= 0.0 && v.is_finite() && v <= max0),
+            "{scheme:?}"
+        );
         let mean = v.iter().map(|&v| v as f64).sum::<f64>() / v.len() as f64;
-        assert!(v.iter().all(|&v| ((v as f64) - mean).abs() < 1e-3 * mean), "{scheme:?}: not uniform");
+        assert!(
+            v.iter().all(|&v| ((v as f64) - mean).abs() < 1e-3 * mean),
+            "{scheme:?}: not uniform"
+        );
         assert!((f.total_mass() / m0 - 1.0).abs() < 1e-4);
     }
 }
@@ -159,7 +198,10 @@ fn point_mass_spreads_as_analytic_gaussian() {
         let (c, var) = moments(&f);
         let expect = 2.0 * d * t;
         for v in [var.x, var.y] {
-            assert!((v / expect - 1.0).abs() < 0.03, "{scheme:?}: var {v} vs {expect}");
+            assert!(
+                (v / expect - 1.0).abs() < 0.03,
+                "{scheme:?}: var {v} vs {expect}"
+            );
         }
         assert!((c - Vec2::splat(100.5 * 0.005)).abs().max_element() < 1e-5);
         // The profile along x through the centre follows exp(-x^2 / (4 d t)).
@@ -168,7 +210,10 @@ fn point_mass_spreads_as_analytic_gaussian() {
         let x = 10.0 * 0.005;
         let ratio = at / peak;
         let expect_ratio = (-x * x / (4.0 * d * t)).exp();
-        assert!((ratio / expect_ratio - 1.0).abs() < 0.05, "{scheme:?}: {ratio} vs {expect_ratio}");
+        assert!(
+            (ratio / expect_ratio - 1.0).abs() < 0.05,
+            "{scheme:?}: {ratio} vs {expect_ratio}"
+        );
     }
 }
 
@@ -190,14 +235,27 @@ fn one_sided_drifts_toward_plus_x_plus_y_symmetric_does_not() {
     let one = run(DiffusionScheme::OneSided);
     // Upwind transport at d / (2h) per axis: 100 steps * 0.1 cell.
     assert!(one.x > 5.0 * h && one.y > 5.0 * h, "one-sided moved {one}");
-    assert!((one.x - 10.0 * h).abs() < 0.5 * h && (one.y - 10.0 * h).abs() < 0.5 * h, "{one}");
+    assert!(
+        (one.x - 10.0 * h).abs() < 0.5 * h && (one.y - 10.0 * h).abs() < 0.5 * h,
+        "{one}"
+    );
 }
 
 #[test]
 fn wind_moves_centre_of_mass_and_conserves_mass() {
     let h = 0.005;
     for wind in [Vec2::new(0.05, -0.03), Vec2::new(-0.2, 0.11)] {
-        let mut f = field(200, 200, h, GridParams { evaporation: f32::INFINITY, diffusion: 0.0, scheme: DiffusionScheme::Auto, wind });
+        let mut f = field(
+            200,
+            200,
+            h,
+            GridParams {
+                evaporation: f32::INFINITY,
+                diffusion: 0.0,
+                scheme: DiffusionScheme::Auto,
+                wind,
+            },
+        );
         f.deposit_point(&Kernel::Cone { radius: 0.05 }, Vec2::new(0.5, 0.5), 1.0);
         let (c0, _) = moments(&f);
         let m0 = f.total_mass();
@@ -207,7 +265,11 @@ fn wind_moves_centre_of_mass_and_conserves_mass() {
         }
         let (c, _) = moments(&f);
         let moved = c - c0;
-        assert!((moved - wind * t).abs().max_element() < h, "moved {moved} vs {}", wind * t);
+        assert!(
+            (moved - wind * t).abs().max_element() < h,
+            "moved {moved} vs {}",
+            wind * t
+        );
         assert!((f.total_mass() / m0 - 1.0).abs() < 1e-5);
         assert!(f.values().iter().all(|&v| v >= 0.0));
     }
@@ -256,11 +318,18 @@ fn value_at_is_bilinear_and_clamped() {
         }
     }
     let lin = |p: Vec2| 2.0 * p.x + 3.0 * p.y;
-    for p in [Vec2::new(0.33, 0.41), Vec2::new(0.05, 0.05), Vec2::new(0.95, 0.75), Vec2::new(0.5, 0.2)] {
+    for p in [
+        Vec2::new(0.33, 0.41),
+        Vec2::new(0.05, 0.05),
+        Vec2::new(0.95, 0.75),
+        Vec2::new(0.5, 0.2),
+    ] {
         assert!((f.value_at(p) - lin(p)).abs() < 1e-5, "{p}");
     }
     // Clamped beyond the outer cell centres and outside the arena.
     assert!((f.value_at(Vec2::new(0.0, 0.0)) - lin(Vec2::new(0.05, 0.05))).abs() < 1e-5);
     assert!((f.value_at(Vec2::new(5.0, -3.0)) - lin(Vec2::new(0.95, 0.05))).abs() < 1e-5);
-    assert!((f.total_mass() - f.values().iter().map(|&v| v as f64).sum::<f64>() * 0.01).abs() < 1e-6);
+    assert!(
+        (f.total_mass() - f.values().iter().map(|&v| v as f64).sum::<f64>() * 0.01).abs() < 1e-6
+    );
 }

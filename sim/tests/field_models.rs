@@ -1,8 +1,8 @@
 //! Gaussian model eq. (5), static maps, the screen eq. (1), and thread-count determinism.
 use colcos_sim::Vec2;
 use colcos_sim::field::{
-    DiffusionScheme, FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec, Kernel, Pheromone,
-    image_map, polyline_map,
+    DiffusionScheme, FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec,
+    Kernel, Pheromone, image_map, polyline_map,
 };
 use colcos_sim::screen::{ScreenSpec, pixel_at, render, save_png};
 
@@ -33,10 +33,18 @@ fn gaussian_source_matches_eq5() {
             start: 2.0,
         };
         for t in [2.0f32, 2.5, 5.0, 20.0] {
-            for p in [Vec2::new(0.7, 0.4), Vec2::new(0.75, 0.45), Vec2::new(0.62, 0.5), Vec2::new(0.9, 0.2)] {
+            for p in [
+                Vec2::new(0.7, 0.4),
+                Vec2::new(0.75, 0.45),
+                Vec2::new(0.62, 0.5),
+                Vec2::new(0.9, 0.2),
+            ] {
                 let got = s.value_at(p, t) as f64;
                 let want = eq5(&s, p, t as f64);
-                assert!((got - want).abs() <= 1e-5 * want.abs() + 1e-30, "rho {rho} t {t} p {p}: {got} vs {want}");
+                assert!(
+                    (got - want).abs() <= 1e-5 * want.abs() + 1e-30,
+                    "rho {rho} t {t} p {p}: {got} vs {want}"
+                );
             }
         }
         assert_eq!(s.value_at(s.centre, 1.9), 0.0);
@@ -53,21 +61,35 @@ fn gaussian_source_matches_eq5() {
     };
     let peak = 1.0 / (2.0 * std::f32::consts::PI * 0.01);
     assert!((s.value_at(Vec2::ZERO, 100.0) / peak - 1.0).abs() < 1e-6);
-    let mut g = GaussianField { sources: vec![s, s], time: 0.0 };
+    let mut g = GaussianField {
+        sources: vec![s, s],
+        time: 0.0,
+    };
     g.step(0.5);
     assert!((g.value_at(Vec2::ZERO) / (2.0 * peak) - 1.0).abs() < 1e-6);
 }
 
 #[test]
 fn polyline_map_has_the_given_width() {
-    let spec = GridSpec { nx: 200, ny: 100, cell: 0.005 };
-    let pts = [Vec2::new(0.1, 0.25), Vec2::new(0.9, 0.25), Vec2::new(0.9, 0.05)];
+    let spec = GridSpec {
+        nx: 200,
+        ny: 100,
+        cell: 0.005,
+    };
+    let pts = [
+        Vec2::new(0.1, 0.25),
+        Vec2::new(0.9, 0.25),
+        Vec2::new(0.9, 0.05),
+    ];
     let width = 0.04;
     let m = polyline_map(&spec, &pts, width, 3.0);
     // Column x = 0.5025 (i = 100) crosses the horizontal segment: cells within 0.02 of y = 0.25.
     let col: Vec<f32> = (0..spec.ny).map(|j| m[j * spec.nx + 100]).collect();
     let covered: Vec<usize> = (0..spec.ny).filter(|&j| col[j] > 0.0).collect();
-    let ys: Vec<f32> = covered.iter().map(|&j| (j as f32 + 0.5) * spec.cell).collect();
+    let ys: Vec<f32> = covered
+        .iter()
+        .map(|&j| (j as f32 + 0.5) * spec.cell)
+        .collect();
     assert_eq!(covered.len(), 8, "{ys:?}");
     assert!(ys.iter().all(|&y| (y - 0.25).abs() <= 0.02));
     // Max, not sum, at the corner; 0 elsewhere.
@@ -85,10 +107,18 @@ fn image_map_reads_png_top_row_at_height() {
     let mut img = image::RgbImage::new(4, 2);
     for (x, y, p) in img.enumerate_pixels_mut() {
         let _ = x;
-        *p = if y == 0 { image::Rgb([255, 0, 102]) } else { image::Rgb([0, 255, 102]) };
+        *p = if y == 0 {
+            image::Rgb([255, 0, 102])
+        } else {
+            image::Rgb([0, 255, 102])
+        };
     }
     img.save(&path).unwrap();
-    let spec = GridSpec { nx: 8, ny: 4, cell: 0.1 };
+    let spec = GridSpec {
+        nx: 8,
+        ny: 4,
+        cell: 0.1,
+    };
     let red = image_map(&spec, &path, Some(0), 2.0).unwrap();
     // Top grid row (j = 3) is the image's top row: full red; bottom row none.
     assert!((0..8).all(|i| (red[3 * 8 + i] - 2.0).abs() < 1e-6));
@@ -116,7 +146,11 @@ fn grid_pheromone(colour: [f32; 3], spec: GridSpec) -> Pheromone {
 
 #[test]
 fn pixel_at_rounds_and_clips() {
-    let spec = GridSpec { nx: 4, ny: 4, cell: 0.25 };
+    let spec = GridSpec {
+        nx: 4,
+        ny: 4,
+        cell: 0.25,
+    };
     let mut a = grid_pheromone([100.0, 0.0, -50.0], spec);
     let mut b = grid_pheromone([0.0, 1.0, 0.0], spec);
     if let FieldModel::Grid(g) = &mut a.model {
@@ -125,8 +159,14 @@ fn pixel_at_rounds_and_clips() {
     if let FieldModel::Grid(g) = &mut b.model {
         g.values_mut().fill(254.5); // g rounds half away from zero -> 255
     }
-    let screen = ScreenSpec { resolution: [8, 8], size: [1.0, 1.0] };
-    assert_eq!(pixel_at(&[a, b], &screen, Vec2::new(0.3, 0.6)), [100, 255, 0]);
+    let screen = ScreenSpec {
+        resolution: [8, 8],
+        size: [1.0, 1.0],
+    };
+    assert_eq!(
+        pixel_at(&[a, b], &screen, Vec2::new(0.3, 0.6)),
+        [100, 255, 0]
+    );
     let mut c = grid_pheromone([3.0, 2.6, 0.0], spec);
     if let FieldModel::Grid(g) = &mut c.model {
         g.values_mut().fill(1000.0);
@@ -134,13 +174,23 @@ fn pixel_at_rounds_and_clips() {
     assert_eq!(pixel_at(&[c], &screen, Vec2::new(0.3, 0.6)), [255, 255, 0]);
     // Pixel centres.
     assert_eq!(screen.pixel_size(), Vec2::splat(0.125));
-    assert_eq!(screen.pixel_centre(Vec2::new(0.3, 0.01)), Vec2::new(0.3125, 0.0625));
-    assert_eq!(screen.pixel_centre(Vec2::new(-1.0, 2.0)), Vec2::new(0.0625, 0.9375));
+    assert_eq!(
+        screen.pixel_centre(Vec2::new(0.3, 0.01)),
+        Vec2::new(0.3125, 0.0625)
+    );
+    assert_eq!(
+        screen.pixel_centre(Vec2::new(-1.0, 2.0)),
+        Vec2::new(0.0625, 0.9375)
+    );
 }
 
 #[test]
 fn render_puts_high_y_at_the_top() {
-    let spec = GridSpec { nx: 144, ny: 81, cell: 0.01 };
+    let spec = GridSpec {
+        nx: 144,
+        ny: 81,
+        cell: 0.01,
+    };
     let mut p = grid_pheromone([0.0, 0.0, 255.0], spec);
     if let FieldModel::Grid(g) = &mut p.model {
         g.deposit_point(&Kernel::Disc { radius: 0.05 }, Vec2::new(0.3, 0.7), 1.0);
@@ -161,7 +211,10 @@ fn render_puts_high_y_at_the_top() {
             time: 0.0,
         }),
     };
-    let screen = ScreenSpec { resolution: [1440, 810], size: [1.44, 0.81] };
+    let screen = ScreenSpec {
+        resolution: [1440, 810],
+        size: [1.44, 0.81],
+    };
     let img = render(&[p, gauss], &screen, 144, 81);
     assert_eq!(img.dimensions(), (144, 81));
     // Blue blob at y = 0.7 m: image row (0.81 - 0.7) / 0.01 = 11 from the top, column 30.
@@ -171,7 +224,12 @@ fn render_puts_high_y_at_the_top() {
     assert!(img.get_pixel(120, 71).0[0] > 200);
     assert_eq!(img.get_pixel(120, 5).0[0], 0);
     // Same values as pixel_at at the panel's own resolution.
-    let full = render(std::slice::from_ref(&grid_pheromone([1.0; 3], spec)), &screen, 1440, 810);
+    let full = render(
+        std::slice::from_ref(&grid_pheromone([1.0; 3], spec)),
+        &screen,
+        1440,
+        810,
+    );
     assert_eq!(full.dimensions(), (1440, 810));
     let dir = tempfile::tempdir().unwrap();
     save_png(&img, &dir.path().join("s.png")).unwrap();
@@ -179,39 +237,83 @@ fn render_puts_high_y_at_the_top() {
 
 #[test]
 fn render_matches_pixel_at() {
-    let spec = GridSpec { nx: 50, ny: 30, cell: 0.02 };
+    let spec = GridSpec {
+        nx: 50,
+        ny: 30,
+        cell: 0.02,
+    };
     let mut p = grid_pheromone([40.0, 10.0, 0.0], spec);
     if let FieldModel::Grid(g) = &mut p.model {
         for (k, v) in g.values_mut().iter_mut().enumerate() {
             *v = (k % 13) as f32 * 0.37;
         }
     }
-    let screen = ScreenSpec { resolution: [160, 90], size: [1.0, 0.6] };
+    let screen = ScreenSpec {
+        resolution: [160, 90],
+        size: [1.0, 0.6],
+    };
     let ps = [p];
     let img = render(&ps, &screen, 160, 90);
     for (x, row) in [(0u32, 0u32), (17, 33), (159, 89), (80, 45)] {
-        let c = Vec2::new((x as f32 + 0.5) * 1.0 / 160.0, 0.6 - (row as f32 + 0.5) * 0.6 / 90.0);
-        assert_eq!(img.get_pixel(x, row).0, pixel_at(&ps, &screen, c), "{x},{row}");
+        let c = Vec2::new(
+            (x as f32 + 0.5) * 1.0 / 160.0,
+            0.6 - (row as f32 + 0.5) * 0.6 / 90.0,
+        );
+        assert_eq!(
+            img.get_pixel(x, row).0,
+            pixel_at(&ps, &screen, c),
+            "{x},{row}"
+        );
     }
 }
 
 #[test]
 fn stepping_is_bit_identical_across_thread_counts() {
-    let spec = GridSpec { nx: 3840, ny: 2160, cell: 1.439 / 3840.0 };
+    let spec = GridSpec {
+        nx: 3840,
+        ny: 2160,
+        cell: 1.439 / 3840.0,
+    };
     let h = spec.cell;
     let run = |threads: usize| -> Vec<Vec<f32>> {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let cases = [
                 (DiffusionScheme::Auto, 0.2 * h * h / 0.02, Vec2::ZERO, true),
-                (DiffusionScheme::Implicit, 3.0 * h * h / 0.02, Vec2::new(0.01, -0.02), false),
-                (DiffusionScheme::OneSided, 0.3 * h * h / 0.02, Vec2::ZERO, false),
+                (
+                    DiffusionScheme::Implicit,
+                    3.0 * h * h / 0.02,
+                    Vec2::new(0.01, -0.02),
+                    false,
+                ),
+                (
+                    DiffusionScheme::OneSided,
+                    0.3 * h * h / 0.02,
+                    Vec2::ZERO,
+                    false,
+                ),
             ];
             cases
                 .iter()
                 .map(|&(scheme, d, wind, inj)| {
-                    let mut f = GridField::new(spec, GridParams { evaporation: 8.0, diffusion: d, scheme, wind });
-                    f.deposit_segment(&Kernel::Disc { radius: 0.01 }, Vec2::new(0.2, 0.2), Vec2::new(1.2, 0.6), 3.0);
+                    let mut f = GridField::new(
+                        spec,
+                        GridParams {
+                            evaporation: 8.0,
+                            diffusion: d,
+                            scheme,
+                            wind,
+                        },
+                    );
+                    f.deposit_segment(
+                        &Kernel::Disc { radius: 0.01 },
+                        Vec2::new(0.2, 0.2),
+                        Vec2::new(1.2, 0.6),
+                        3.0,
+                    );
                     f.deposit_point(&Kernel::Cone { radius: 0.02 }, Vec2::new(1.43, 0.8), 5.0);
                     if inj {
                         let mut j = vec![0.0; spec.len()];
@@ -220,11 +322,9 @@ fn stepping_is_bit_identical_across_thread_counts() {
                         }
                         f.set_static_injection(j);
                     }
-                    let t0 = std::time::Instant::now();
                     for _ in 0..2 {
                         f.step(0.02);
                     }
-                    eprintln!("TIMING {threads} {scheme:?} {:?}", t0.elapsed());
                     f.values().to_vec()
                 })
                 .collect()
@@ -234,7 +334,10 @@ fn stepping_is_bit_identical_across_thread_counts() {
     for n in [2, 4] {
         let other = run(n);
         for (a, b) in one.iter().zip(&other) {
-            assert!(a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()), "differs with {n} threads");
+            assert!(
+                a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "differs with {n} threads"
+            );
         }
     }
 }

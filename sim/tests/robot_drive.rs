@@ -14,7 +14,12 @@ fn lag_follows_the_analytic_first_order_response() {
         d.update(cmd, &p, DT);
         let t = k as f32 * DT;
         let f = 1.0 - (-t / p.motor_lag).exp();
-        assert!((d.left - 0.2 * f).abs() < 1e-5, "left at {t}: {} vs {}", d.left, 0.2 * f);
+        assert!(
+            (d.left - 0.2 * f).abs() < 1e-5,
+            "left at {t}: {} vs {}",
+            d.left,
+            0.2 * f
+        );
         assert!((d.right + 0.1 * f).abs() < 1e-5, "right at {t}");
     }
 }
@@ -34,7 +39,10 @@ fn lag_is_exact_for_any_step() {
 
 #[test]
 fn zero_lag_is_immediate_and_commands_are_clamped() {
-    let p = ColiasParams { motor_lag: 0.0, ..ColiasParams::default() };
+    let p = ColiasParams {
+        motor_lag: 0.0,
+        ..ColiasParams::default()
+    };
     let mut d = DriveState::default();
     d.update(WheelCommand::new(0.1, -0.2), &p, DT);
     assert_eq!((d.left, d.right), (0.1, -0.2));
@@ -47,7 +55,10 @@ fn zero_lag_is_immediate_and_commands_are_clamped() {
 #[test]
 fn body_velocity_of_a_differential_drive() {
     let p = ColiasParams::default();
-    let d = DriveState { left: 0.1, right: 0.3 };
+    let d = DriveState {
+        left: 0.1,
+        right: 0.3,
+    };
     let (v, w) = d.body_velocity(&p);
     assert!((v - 0.2).abs() < 1e-6);
     assert!((w - 0.2 / p.wheel_base).abs() < 1e-4);
@@ -74,9 +85,15 @@ fn straight_drive_covers_speed_times_time() {
     // Distance with the lag: v (t - tau (1 - e^{-t/tau})); the speed is applied after its update, so
     // the discrete lag leads by one step: sum_k v (1 - e^{-k dt / tau}) dt.
     let tau = p.motor_lag;
-    let expected: f32 = (1..=50).map(|k| 0.2 * (1.0 - (-(k as f32) * DT / tau).exp()) * DT).sum();
+    let expected: f32 = (1..=50)
+        .map(|k| 0.2 * (1.0 - (-(k as f32) * DT / tau).exp()) * DT)
+        .sum();
     let moved = end.pos - start.pos;
-    assert!((moved.length() - expected).abs() < 0.02 * expected, "moved {} expected {expected}", moved.length());
+    assert!(
+        (moved.length() - expected).abs() < 0.02 * expected,
+        "moved {} expected {expected}",
+        moved.length()
+    );
     // The no-lag figure is 0.2 m; the lag costs about v * tau.
     assert!((moved.length() + 0.2 * tau - 0.2).abs() < 0.02 * 0.2);
     // Along the heading.
@@ -89,11 +106,20 @@ fn spinning_in_place_turns_at_the_yaw_rate() {
     let (start, end, p) = drive(WheelCommand::new(-0.05, 0.05), 0.0, 1.0);
     let tau = p.motor_lag;
     let rate = 0.1 / p.wheel_base;
-    let expected: f32 = (1..=50).map(|k| rate * (1.0 - (-(k as f32) * DT / tau).exp()) * DT).sum();
+    let expected: f32 = (1..=50)
+        .map(|k| rate * (1.0 - (-(k as f32) * DT / tau).exp()) * DT)
+        .sum();
     // Unwrap: the turn is less than 2 pi... compare via the wrapped difference.
     let turned = end.heading - start.heading;
     let diff = (turned - expected).rem_euclid(std::f32::consts::TAU);
     let diff = diff.min(std::f32::consts::TAU - diff);
-    assert!(diff < 0.02 * expected, "turned {turned} expected {expected}");
-    assert!((end.pos - start.pos).length() < 1e-4, "moved {}", (end.pos - start.pos).length());
+    assert!(
+        diff < 0.02 * expected,
+        "turned {turned} expected {expected}"
+    );
+    assert!(
+        (end.pos - start.pos).length() < 1e-4,
+        "moved {}",
+        (end.pos - start.pos).length()
+    );
 }

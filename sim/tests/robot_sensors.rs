@@ -28,7 +28,11 @@ fn wall_ahead_at_one_centimetre_reads_a_half() {
     let far = readings(&[Pose::new(0.5, 0.5, 0.0)], arena, 0);
     assert_eq!(far, [0.0; 3]);
     // Facing away from the near wall: nothing.
-    let away = readings(&[Pose::new(1.0 - 0.01 - R, 0.5, std::f32::consts::PI)], arena, 0);
+    let away = readings(
+        &[Pose::new(1.0 - 0.01 - R, 0.5, std::f32::consts::PI)],
+        arena,
+        0,
+    );
     assert_eq!(away, [0.0; 3]);
 }
 
@@ -37,12 +41,18 @@ fn robot_ahead_left_triggers_front_left_more() {
     let arena = Vec2::new(1.0, 1.0);
     let me = Pose::new(0.5, 0.5, 0.3);
     let other = Pose::new(0.0, 0.0, 0.0);
-    let other = Pose { pos: me.to_world(Vec2::new(0.045, 0.03)), ..other };
+    let other = Pose {
+        pos: me.to_world(Vec2::new(0.045, 0.03)),
+        ..other
+    };
     let r = readings(&[me, other], arena, 0);
     assert!(r[0] > 0.0, "{r:?}");
     assert!(r[0] > r[2], "{r:?}");
     // Mirror: ahead-right.
-    let other = Pose { pos: me.to_world(Vec2::new(0.045, -0.03)), ..other };
+    let other = Pose {
+        pos: me.to_world(Vec2::new(0.045, -0.03)),
+        ..other
+    };
     let r = readings(&[me, other], arena, 0);
     assert!(r[2] > r[0], "{r:?}");
 }
@@ -54,7 +64,10 @@ fn robot_straight_ahead_reads_by_distance() {
     // The other robot's rim 5 mm in front of my rim.
     let other = Pose::new(0.3, 0.3 + 2.0 * R + 0.005, 0.0);
     let r = readings(&[me, other], arena, 0);
-    assert!((r[1] - reading_for_distance(0.005, 0.02)).abs() < 1e-3, "{r:?}");
+    assert!(
+        (r[1] - reading_for_distance(0.005, 0.02)).abs() < 1e-3,
+        "{r:?}"
+    );
     assert!((r[1] - 0.75).abs() < 1e-3);
     // Overlapping robots: the sensor inside the other disc reads 1.
     let other = Pose::new(0.3, 0.3 + 2.0 * R - 0.004, 0.0);
@@ -73,19 +86,31 @@ fn index_finds_the_same_as_brute_force() {
         (s >> 8) as f32 / (1u32 << 24) as f32
     };
     let poses: Vec<Pose> = (0..400)
-        .map(|_| Pose::new(R + next() * (arena.x - 2.0 * R), R + next() * (arena.y - 2.0 * R), next() * 6.283))
+        .map(|_| {
+            Pose::new(
+                R + next() * (arena.x - 2.0 * R),
+                R + next() * (arena.y - 2.0 * R),
+                next() * 6.0,
+            )
+        })
         .collect();
     let params = BumperParams::default();
     let pos: Vec<Vec2> = poses.iter().map(|p| p.pos).collect();
     let mut index = NeighbourIndex::default();
     // A whole-arena cell is brute force.
     index.rebuild(arena, 10.0, &pos);
-    let brute: Vec<[f32; 3]> = (0..poses.len()).map(|i| index.bumpers(i, &poses, R, arena, &params)).collect();
+    let brute: Vec<[f32; 3]> = (0..poses.len())
+        .map(|i| index.bumpers(i, &poses, R, arena, &params))
+        .collect();
     let mut hits = 0;
     for cell in [NeighbourIndex::cell_for(R, &params), 0.03, 0.2] {
         index.rebuild(arena, cell, &pos);
         for (i, b) in brute.iter().enumerate() {
-            assert_eq!(index.bumpers(i, &poses, R, arena, &params), *b, "robot {i} cell {cell}");
+            assert_eq!(
+                index.bumpers(i, &poses, R, arena, &params),
+                *b,
+                "robot {i} cell {cell}"
+            );
             hits += b.iter().filter(|&&v| v > 0.0).count();
         }
     }
@@ -98,7 +123,10 @@ fn ray_disc_geometry() {
     assert!((ray_disc(Vec2::ZERO, d, Vec2::new(0.05, 0.0), 0.02).unwrap() - 0.03).abs() < 1e-6);
     assert_eq!(ray_disc(Vec2::ZERO, d, Vec2::new(-0.05, 0.0), 0.02), None);
     assert_eq!(ray_disc(Vec2::ZERO, d, Vec2::new(0.05, 0.03), 0.02), None);
-    assert_eq!(ray_disc(Vec2::ZERO, d, Vec2::new(0.01, 0.0), 0.02), Some(0.0));
+    assert_eq!(
+        ray_disc(Vec2::ZERO, d, Vec2::new(0.01, 0.0), 0.02),
+        Some(0.0)
+    );
     assert_eq!(reading_for_distance(0.03, 0.02), 0.0);
     assert_eq!(reading_for_distance(0.0, 0.02), 1.0);
 }

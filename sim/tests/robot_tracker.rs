@@ -6,7 +6,13 @@ use colcos_sim::tracker::{Tracker, TrackerParams};
 const DT: f32 = 0.02;
 
 fn quiet(rate_hz: f32, latency: f32) -> TrackerParams {
-    TrackerParams { rate_hz, latency, position_noise: 0.0, heading_noise: 0.0, dropout: 0.0 }
+    TrackerParams {
+        rate_hz,
+        latency,
+        position_noise: 0.0,
+        heading_noise: 0.0,
+        dropout: 0.0,
+    }
 }
 
 #[test]
@@ -34,7 +40,10 @@ fn a_moving_robot_is_tracked_latency_behind() {
             // Delivered `latency` after capture; the newest delivered frame is at most one frame
             // period (plus one step for the capture at the step after the frame time) older.
             assert!(lag >= latency - 1e-4, "lag {lag} at {time}");
-            assert!(lag <= latency + 1.0 / rate + DT + 1e-4, "lag {lag} at {time}");
+            assert!(
+                lag <= latency + 1.0 / rate + DT + 1e-4,
+                "lag {lag} at {time}"
+            );
             // The pose is the true pose at the stamp.
             assert!((v * out.stamp - out.pose.pos.x).abs() < 1e-5);
             if stamps.last() != Some(&out.stamp) {
@@ -49,7 +58,10 @@ fn a_moving_robot_is_tracked_latency_behind() {
     }
     let span = stamps.last().unwrap() - stamps[0];
     let frames = (stamps.len() - 1) as f32;
-    assert!((frames - span * rate).abs() <= 1.0, "{frames} frames in {span} s");
+    assert!(
+        (frames - span * rate).abs() <= 1.0,
+        "{frames} frames in {span} s"
+    );
 }
 
 #[test]
@@ -66,15 +78,27 @@ fn zero_latency_at_the_step_rate_is_the_truth() {
 
 #[test]
 fn noise_and_dropout_statistics() {
-    let params = TrackerParams { rate_hz: 50.0, latency: 0.0, position_noise: 0.002, heading_noise: 0.03, dropout: 0.1 };
+    let params = TrackerParams {
+        rate_hz: 50.0,
+        latency: 0.0,
+        position_noise: 0.002,
+        heading_noise: 0.03,
+        dropout: 0.1,
+    };
     let n = 200;
     let mut t = Tracker::new(params, n);
     let mut r = rng::stream(5, 0, 0);
-    let truth: Vec<Pose> = (0..n).map(|i| Pose::new(i as f32 * 0.01, 0.5, 0.0)).collect();
+    let truth: Vec<Pose> = (0..n)
+        .map(|i| Pose::new(i as f32 * 0.01, 0.5, 0.0))
+        .collect();
     t.update(0.0, &truth, &mut r);
     let (mut dx, mut dh, mut count) = (0.0f64, 0.0f64, 0usize);
     let (mut same, mut total) = (0usize, 0usize);
-    let mut prev: Vec<Pose> = t.update(0.0, &truth, &mut r).iter().map(|p| p.pose).collect();
+    let mut prev: Vec<Pose> = t
+        .update(0.0, &truth, &mut r)
+        .iter()
+        .map(|p| p.pose)
+        .collect();
     for k in 1..500 {
         let out = t.update(k as f32 * DT, &truth, &mut r);
         for (i, p) in out.iter().enumerate() {
@@ -103,8 +127,14 @@ fn tracker_is_deterministic() {
     let run = || {
         let mut t = Tracker::new(TrackerParams::default(), 3);
         let mut r = rng::stream(2, 0, 0);
-        let truth = [Pose::new(0.1, 0.2, 0.3), Pose::new(0.4, 0.5, 0.6), Pose::new(0.7, 0.1, 0.0)];
-        (0..200).map(|k| t.update(k as f32 * DT, &truth, &mut r).to_vec()).collect::<Vec<_>>()
+        let truth = [
+            Pose::new(0.1, 0.2, 0.3),
+            Pose::new(0.4, 0.5, 0.6),
+            Pose::new(0.7, 0.1, 0.0),
+        ];
+        (0..200)
+            .map(|k| t.update(k as f32 * DT, &truth, &mut r).to_vec())
+            .collect::<Vec<_>>()
     };
     assert_eq!(run(), run());
 }

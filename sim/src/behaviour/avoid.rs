@@ -1,5 +1,5 @@
 //! Sharp turn away from a bumper hit, then carry on with an inner behaviour.
-use super::{Behaviour, Observation, WheelCommand, BUMPER_FRONT_LEFT, BUMPER_FRONT_RIGHT};
+use super::{BUMPER_FRONT_LEFT, BUMPER_FRONT_RIGHT, Behaviour, Observation, WheelCommand};
 use crate::rng::SimRng;
 
 pub struct Avoid<B> {
@@ -20,7 +20,14 @@ impl<B> Avoid<B> {
     /// Threshold 0.1, a 0.4 s pivot at 0.06 m/s per wheel: about 4.6 rad/s with the Colias wheel
     /// base, so roughly a quarter turn once the motor lag is through.
     pub fn new(inner: B) -> Self {
-        Avoid { inner, threshold: 0.1, turn_duration: 0.4, turn_speed: 0.06, turn_until: None, turn_sign: 1.0 }
+        Avoid {
+            inner,
+            threshold: 0.1,
+            turn_duration: 0.4,
+            turn_speed: 0.06,
+            turn_until: None,
+            turn_sign: 1.0,
+        }
     }
 
     /// True while a turn is in progress at `time`.

@@ -5,6 +5,7 @@
 mod avoid;
 mod follow;
 mod observation;
+pub mod paper;
 pub mod registry;
 mod wander;
 

@@ -13,6 +13,9 @@ const REGISTRY: &[(&str, &str, Builder)] = &[
     ("wander", "correlated random walk (bumps into things)", build_wander),
     ("avoid", "random walk with a sharp turn on a bumper hit", build_avoid),
     ("follow", "follow a colour trail (left/right sensor difference), wander off it, avoid on a bump", build_follow),
+    ("forage", "paper Algorithm 1: follow LAP/SAP trails by eq. (7), cyan 70 % at bifurcations, avoid SRP", build_forage),
+    ("aggregation_leader", "paper Algorithm 2: flee down the ALP gradient by eq. (8), else wander", build_aggregation_leader),
+    ("aggregation_follower", "paper Algorithm 3: flee the ALP, else climb the AGP gradient by eq. (8), else wander", build_aggregation_follower),
 ];
 
 /// Names and descriptions of all behaviours.
@@ -84,4 +87,20 @@ fn build_follow(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
         return Err(SimError::invalid(format!("{key}.params.threshold"), p.threshold, "must be >= 0"));
     }
     Ok(Box::new(Avoid::new(Follow::new(channel, speed, p.sensitivity, p.threshold))))
+}
+
+fn build_forage(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+    let p: super::paper::ForagingParams = parse_params(params, key)?;
+    p.validate(key)?;
+    Ok(Box::new(super::paper::Foraging::new(p)))
+}
+
+fn build_aggregation_leader(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+    let p: super::paper::LeaderParams = parse_params(params, key)?;
+    Ok(Box::new(super::paper::Leader::new(p.validate(key)?)))
+}
+
+fn build_aggregation_follower(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+    let p: super::paper::FollowerParams = parse_params(params, key)?;
+    Ok(Box::new(super::paper::Follower::new(p.validate(key)?)))
 }

@@ -23,7 +23,13 @@ impl Wander {
     /// Default turn std 0.1 (with the Colias 26 mm wheel base a turn radius of about 13 cm at one
     /// std), correlation time 1 s.
     pub fn new(speed: f32) -> Self {
-        Wander { speed, turn: 0.0, turn_std: 0.1, turn_time: 1.0, last_time: None }
+        Wander {
+            speed,
+            turn: 0.0,
+            turn_std: 0.1,
+            turn_time: 1.0,
+            last_time: None,
+        }
     }
 }
 
@@ -39,7 +45,11 @@ impl Behaviour for Wander {
             None => self.turn = std * z,
             Some(t0) => {
                 let dt = (obs.time - t0).max(0.0);
-                let a = if self.turn_time > 0.0 { (-dt / self.turn_time).exp() } else { 0.0 };
+                let a = if self.turn_time > 0.0 {
+                    (-dt / self.turn_time).exp()
+                } else {
+                    0.0
+                };
                 self.turn = a * self.turn + std * (1.0 - a * a).max(0.0).sqrt() * z;
             }
         }
@@ -48,6 +58,9 @@ impl Behaviour for Wander {
         }
         self.turn = self.turn.clamp(-1.0, 1.0);
         self.last_time = Some(obs.time);
-        WheelCommand::new(self.speed * (1.0 - self.turn), self.speed * (1.0 + self.turn))
+        WheelCommand::new(
+            self.speed * (1.0 - self.turn),
+            self.speed * (1.0 + self.turn),
+        )
     }
 }

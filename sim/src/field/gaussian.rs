@@ -34,7 +34,11 @@ impl GaussianSource {
         let dx = (p.x - self.centre.x) as f64;
         let dy = (p.y - self.centre.y) as f64;
         let e = self.evaporation as f64;
-        let decay = if e.is_infinite() { 1.0 } else { (-tau / e).exp() };
+        let decay = if e.is_infinite() {
+            1.0
+        } else {
+            (-tau / e).exp()
+        };
         let q = dx * dx / (sx * sx) + dy * dy / (sy * sy) - 2.0 * rho * dx * dy / (sx * sy);
         let norm = self.k as f64 / (2.0 * std::f64::consts::PI * sx * sy * one_m_rho2.sqrt());
         (norm * decay * (-q / (2.0 * one_m_rho2)).exp()) as f32

@@ -58,7 +58,10 @@ mod tests {
     #[test]
     fn shapes() {
         let d = Kernel::Disc { radius: 0.1 };
-        assert_eq!((d.weight(0.0), d.weight(0.1), d.weight(0.1001)), (1.0, 1.0, 0.0));
+        assert_eq!(
+            (d.weight(0.0), d.weight(0.1), d.weight(0.1001)),
+            (1.0, 1.0, 0.0)
+        );
         assert_eq!(d.support(), 0.1);
         let c = Kernel::Cone { radius: 0.2 };
         assert_eq!(c.weight(0.0), 1.0);

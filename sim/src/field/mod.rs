@@ -1,15 +1,17 @@
 //! Pheromone fields: the grid model of eq. (2), the Gaussian-source model of eq. (5), injection kernels
 //! and static injection maps. A [`Pheromone`] is one named field with its drawing colour.
 
+mod backend;
 mod gaussian;
 mod grid;
 mod kernel;
 mod pheromone;
 mod static_map;
 
+pub use backend::{BackendChoice, FieldBackend};
 pub use gaussian::{GaussianField, GaussianSource};
-pub use grid::{DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS};
 pub(crate) use grid::lerp_index;
+pub use grid::{DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS};
 pub use kernel::Kernel;
 pub use pheromone::{FieldModel, Pheromone};
 pub use static_map::{image_map, polyline_map};

@@ -21,7 +21,11 @@ pub fn polyline_map(spec: &GridSpec, points: &[Vec2], width: f32, value: f32) ->
         for j in j0..j1 {
             for i in i0..i1 {
                 let p = spec.cell_centre(i, j);
-                let t = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                let t = if len2 > 0.0 {
+                    ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
                 if (p - (a + ab * t)).length() <= half {
                     let v = &mut map[j * spec.nx + i];
                     *v = v.max(value);
@@ -37,8 +41,16 @@ pub fn polyline_map(spec: &GridSpec, points: &[Vec2], width: f32, value: f32) ->
 ///
 /// Resampling is bilinear between pixel centres (clamped at the edges); luma is Rec. 601
 /// (`0.299 r + 0.587 g + 0.114 b`).
-pub fn image_map(spec: &GridSpec, path: &std::path::Path, channel: Option<usize>, scale: f32) -> Result<Vec<f32>> {
-    let err = |message: String| SimError::Image { path: path.display().to_string(), message };
+pub fn image_map(
+    spec: &GridSpec,
+    path: &std::path::Path,
+    channel: Option<usize>,
+    scale: f32,
+) -> Result<Vec<f32>> {
+    let err = |message: String| SimError::Image {
+        path: path.display().to_string(),
+        message,
+    };
     if let Some(c) = channel.filter(|&c| c > 2) {
         return Err(err(format!("channel {c} does not exist (0 r, 1 g, 2 b)")));
     }

@@ -7,7 +7,14 @@ use std::io::Write;
 pub fn npy_header_f32(shape: &[usize]) -> Vec<u8> {
     let dims = match shape {
         [n] => format!("({n},)"),
-        _ => format!("({})", shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
     };
     let mut dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {dims}, }}");
     // 6 magic + 2 version + 2 length + dict + '\n'.
@@ -35,7 +42,8 @@ pub fn write_npy_f32(path: &std::path::Path, shape: &[usize], data: &[f32]) -> R
     let ctx = || format!("writing {}", path.display());
     let file = std::fs::File::create(path).map_err(|e| SimError::io(ctx(), e))?;
     let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
-    w.write_all(&npy_header_f32(shape)).map_err(|e| SimError::io(ctx(), e))?;
+    w.write_all(&npy_header_f32(shape))
+        .map_err(|e| SimError::io(ctx(), e))?;
     let mut buf = Vec::with_capacity(4 * 16384);
     for chunk in data.chunks(16384) {
         buf.clear();

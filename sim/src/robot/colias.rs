@@ -18,6 +18,12 @@ pub struct ColiasParams {
 
 impl Default for ColiasParams {
     fn default() -> Self {
-        ColiasParams { radius: 0.02, mass: 0.05, wheel_base: 0.026, max_wheel_speed: 0.35, motor_lag: 0.05 }
+        ColiasParams {
+            radius: 0.02,
+            mass: 0.05,
+            wheel_base: 0.026,
+            max_wheel_speed: 0.35,
+            motor_lag: 0.05,
+        }
     }
 }

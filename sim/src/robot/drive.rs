@@ -23,14 +23,22 @@ impl DriveState {
         let max = params.max_wheel_speed.abs();
         let l = clamp_command(cmd.left, max);
         let r = clamp_command(cmd.right, max);
-        let alpha = if params.motor_lag > 0.0 { -(-dt.max(0.0) / params.motor_lag).exp_m1() } else { 1.0 };
+        let alpha = if params.motor_lag > 0.0 {
+            -(-dt.max(0.0) / params.motor_lag).exp_m1()
+        } else {
+            1.0
+        };
         self.left += (l - self.left) * alpha;
         self.right += (r - self.right) * alpha;
     }
     /// Body velocities: (forward speed m/s, yaw rate rad/s).
     pub fn body_velocity(&self, params: &ColiasParams) -> (f32, f32) {
         let forward = 0.5 * (self.left + self.right);
-        let yaw = if params.wheel_base > 0.0 { (self.right - self.left) / params.wheel_base } else { 0.0 };
+        let yaw = if params.wheel_base > 0.0 {
+            (self.right - self.left) / params.wheel_base
+        } else {
+            0.0
+        };
         (forward, yaw)
     }
 }

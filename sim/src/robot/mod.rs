@@ -6,7 +6,7 @@ mod physics;
 
 pub use colias::ColiasParams;
 pub use drive::DriveState;
-pub use physics::ArenaPhysics;
+pub use physics::{ArenaPhysics, PhysicsBackend};
 
 use glam::Vec2;
 
@@ -19,7 +19,10 @@ pub struct Pose {
 
 impl Pose {
     pub fn new(x: f32, y: f32, heading: f32) -> Self {
-        Pose { pos: Vec2::new(x, y), heading }
+        Pose {
+            pos: Vec2::new(x, y),
+            heading,
+        }
     }
     /// Unit vector along the heading.
     pub fn forward(&self) -> Vec2 {

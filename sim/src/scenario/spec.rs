@@ -1,7 +1,7 @@
 //! The scenario file format (TOML), as plain serde structs. Unknown keys are rejected everywhere.
 //! Checking the values happens in [`super::validate`].
 
-use crate::field::{DiffusionScheme, Kernel};
+use crate::field::{BackendChoice, DiffusionScheme, Kernel};
 use crate::robot::ColiasParams;
 use crate::screen::ScreenSpec;
 use crate::sensors::{BumperParams, ColourSensorParams};
@@ -72,11 +72,13 @@ pub struct FieldSpec {
     /// Grid cell side, m.
     pub cell: f32,
     pub inject_at: InjectAt,
+    /// Which backend steps the grid fields: `cpu` (default), `gpu` or `auto` (see `colcos-gpu`).
+    pub backend: BackendChoice,
 }
 
 impl Default for FieldSpec {
     fn default() -> Self {
-        FieldSpec { cell: 0.005, inject_at: InjectAt::Tracked }
+        FieldSpec { cell: 0.005, inject_at: InjectAt::Tracked, backend: BackendChoice::Cpu }
     }
 }
 

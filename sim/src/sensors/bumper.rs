@@ -14,14 +14,22 @@ pub struct BumperParams {
 
 impl Default for BumperParams {
     fn default() -> Self {
-        BumperParams { range: 0.02, angles: [std::f32::consts::FRAC_PI_4, 0.0, -std::f32::consts::FRAC_PI_4] }
+        BumperParams {
+            range: 0.02,
+            angles: [
+                std::f32::consts::FRAC_PI_4,
+                0.0,
+                -std::f32::consts::FRAC_PI_4,
+            ],
+        }
     }
 }
 
 /// Reading of an IR bumper whose first obstacle is `distance` m from the robot's rim: `1 - d / range`
 /// inside the range, 0 beyond it (and for a non-positive range).
 pub fn reading_for_distance(distance: f32, range: f32) -> f32 {
-    if !(range > 0.0) || !(distance < range) {
+    let inside = range > 0.0 && distance < range;
+    if !inside {
         return 0.0;
     }
     (1.0 - distance.max(0.0) / range).clamp(0.0, 1.0)
@@ -91,10 +99,16 @@ impl NeighbourIndex {
     }
 
     pub fn rebuild(&mut self, arena: Vec2, cell: f32, positions: &[Vec2]) {
-        let cell = if cell.is_finite() && cell > 0.0 { cell } else { arena.x.max(arena.y).max(1e-3) };
+        let cell = if cell.is_finite() && cell > 0.0 {
+            cell
+        } else {
+            arena.x.max(arena.y).max(1e-3)
+        };
         // Bound the grid so a tiny cell cannot make a huge table.
         let max_cells_per_axis = 4096.0;
-        let cell = cell.max(arena.x / max_cells_per_axis).max(arena.y / max_cells_per_axis);
+        let cell = cell
+            .max(arena.x / max_cells_per_axis)
+            .max(arena.y / max_cells_per_axis);
         self.cell = cell;
         let nx = ((arena.x / cell).ceil() as usize).max(1);
         let ny = ((arena.y / cell).ceil() as usize).max(1);
@@ -126,23 +140,57 @@ impl NeighbourIndex {
 
     /// Robots whose cell lies within `reach` of `p` (a superset of those within `reach`).
     pub fn near(&self, p: Vec2, reach: f32) -> impl Iterator<Item = usize> + '_ {
-        let [nx, ny] = self.dims;
-        let (x0, x1, y0, y1) = if nx == 0 || self.cell <= 0.0 {
-            (1, 0, 1, 0)
-        } else {
-            let c = |v: f32, n: usize| ((v / self.cell).floor().max(0.0) as usize).min(n - 1);
-            (c(p.x - reach, nx), c(p.x + reach, nx), c(p.y - reach, ny), c(p.y + reach, ny))
-        };
-        (y0..=y1).flat_map(move |y| {
+        let (x0, x1, y0, y1) = self.cell_range(p, reach);
+        let nx = self.dims[0];
+        (y0..y1).flat_map(move |y| {
             let a = self.starts[y * nx + x0] as usize;
-            let b = self.starts[y * nx + x1 + 1] as usize;
+            let b = self.starts[y * nx + x1] as usize;
             self.items[a..b].iter().map(|&i| i as usize)
         })
     }
 
+    /// Calls `f` for every robot whose cell lies within `reach` of `p`, in a fixed order (the same
+    /// robots as [`Self::near`], without the iterator overhead).
+    #[inline]
+    pub fn for_each_near(&self, p: Vec2, reach: f32, mut f: impl FnMut(usize)) {
+        let (x0, x1, y0, y1) = self.cell_range(p, reach);
+        let nx = self.dims[0];
+        for y in y0..y1 {
+            let a = self.starts[y * nx + x0] as usize;
+            let b = self.starts[y * nx + x1] as usize;
+            for &i in &self.items[a..b] {
+                f(i as usize);
+            }
+        }
+    }
+
+    /// Half-open cell ranges (x0..x1, y0..y1) covering the square of half-side `reach` around `p`.
+    #[inline]
+    fn cell_range(&self, p: Vec2, reach: f32) -> (usize, usize, usize, usize) {
+        let [nx, ny] = self.dims;
+        if nx == 0 || ny == 0 || !(p.is_finite() && reach.is_finite()) {
+            return (0, 0, 0, 0);
+        }
+        let inv = 1.0 / self.cell;
+        // `as usize` saturates negatives to 0 (and truncation is floor for non-negatives).
+        let c = |v: f32, n: usize| ((v * inv) as usize).min(n - 1);
+        (
+            c(p.x - reach, nx),
+            c(p.x + reach, nx) + 1,
+            c(p.y - reach, ny),
+            c(p.y + reach, ny) + 1,
+        )
+    }
+
     fn cell_index(&self, p: Vec2) -> usize {
         let [nx, ny] = self.dims;
-        let c = |v: f32, n: usize| if v.is_finite() { ((v / self.cell).floor().max(0.0) as usize).min(n - 1) } else { 0 };
+        let c = |v: f32, n: usize| {
+            if v.is_finite() {
+                ((v / self.cell).floor().max(0.0) as usize).min(n - 1)
+            } else {
+                0
+            }
+        };
         c(p.y, ny) * nx + c(p.x, nx)
     }
 
@@ -153,11 +201,20 @@ impl NeighbourIndex {
     /// `1 - d / range` for the first wall or robot disc at distance `d < range`, 0 if none; a sensor
     /// whose rim point is already inside another robot (or beyond a wall) reads 1. Uses the index as
     /// last rebuilt: rebuild it with the current positions first.
-    pub fn bumpers(&self, index: usize, poses: &[Pose], radius: f32, arena: Vec2, params: &BumperParams) -> [f32; 3] {
-        let Some(me) = poses.get(index) else { return [0.0; 3] };
+    pub fn bumpers(
+        &self,
+        index: usize,
+        poses: &[Pose],
+        radius: f32,
+        arena: Vec2,
+        params: &BumperParams,
+    ) -> [f32; 3] {
+        let Some(me) = poses.get(index) else {
+            return [0.0; 3];
+        };
         let range = params.range;
         let mut readings = [0.0f32; 3];
-        if !(range > 0.0) {
+        if range.is_nan() || range <= 0.0 {
             return readings;
         }
         let mut dists = [range; 3];
@@ -171,20 +228,20 @@ impl NeighbourIndex {
         }
         let reach = 2.0 * radius + range;
         let reach2 = reach * reach;
-        for j in self.near(me.pos, reach) {
+        self.for_each_near(me.pos, reach, |j| {
             if j == index {
-                continue;
+                return;
             }
-            let Some(other) = poses.get(j) else { continue };
+            let Some(other) = poses.get(j) else { return };
             if (other.pos - me.pos).length_squared() > reach2 {
-                continue;
+                return;
             }
             for s in 0..3 {
                 if let Some(t) = ray_disc(origins[s], dirs[s], other.pos, radius) {
                     dists[s] = dists[s].min(t);
                 }
             }
-        }
+        });
         for s in 0..3 {
             readings[s] = reading_for_distance(dists[s], range);
         }

@@ -93,7 +93,11 @@ impl ColourSensor {
         for (k, o) in offsets.iter_mut().skip(1).enumerate() {
             *o = ring * Vec2::from_angle(std::f32::consts::TAU * k as f32 / RING_POINTS as f32);
         }
-        ColourSensor { params, inverse, offsets }
+        ColourSensor {
+            params,
+            inverse,
+            offsets,
+        }
     }
 
     /// Where on the screen the sensor at `p` samples, arena coordinates: `p` and a ring around it.
@@ -102,7 +106,12 @@ impl ColourSensor {
     }
 
     /// Mean 8-bit screen level (r, g, b) over the footprint around `p`, each in [0, 255].
-    pub fn screen_levels(&self, pheromones: &[Pheromone], screen: &ScreenSpec, p: Vec2) -> [f32; 3] {
+    pub fn screen_levels(
+        &self,
+        pheromones: &[Pheromone],
+        screen: &ScreenSpec,
+        p: Vec2,
+    ) -> [f32; 3] {
         let mut sum = [0u32; 3];
         for q in self.sample_points(p) {
             let px = crate::screen::pixel_at(pheromones, screen, q);
@@ -116,7 +125,11 @@ impl ColourSensor {
     /// Light emitted per primary, in [0, 1], for 8-bit levels.
     pub fn light(&self, levels: [f32; 3]) -> [f32; 3] {
         levels.map(|l| {
-            let x = if l.is_nan() { 0.0 } else { (l / 255.0).clamp(0.0, 1.0) };
+            let x = if l.is_nan() {
+                0.0
+            } else {
+                (l / 255.0).clamp(0.0, 1.0)
+            };
             x.powf(self.params.gamma)
         })
     }
@@ -148,7 +161,13 @@ impl ColourSensor {
     pub fn intensity(&self, counts: [u16; 3]) -> [f32; 3] {
         let p = &self.params;
         let scale = p.gain * p.integration_ms;
-        let signal = counts.map(|n| if scale > 0.0 { (n as f32 - p.dark_counts) / scale } else { 0.0 });
+        let signal = counts.map(|n| {
+            if scale > 0.0 {
+                (n as f32 - p.dark_counts) / scale
+            } else {
+                0.0
+            }
+        });
         let inv_gamma = if p.gamma > 0.0 { 1.0 / p.gamma } else { 1.0 };
         let mut out = [0.0f32; 3];
         for (c, o) in out.iter_mut().enumerate() {
@@ -157,7 +176,11 @@ impl ColourSensor {
                 continue;
             }
             let light: f32 = (0..3).map(|k| self.inverse[c][k] * signal[k]).sum();
-            let light = if light.is_nan() { 0.0 } else { light.clamp(0.0, 1.0) };
+            let light = if light.is_nan() {
+                0.0
+            } else {
+                light.clamp(0.0, 1.0)
+            };
             *o = light.powf(inv_gamma);
         }
         out

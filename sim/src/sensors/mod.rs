@@ -6,4 +6,4 @@ mod layout;
 
 pub use bumper::{BumperParams, NeighbourIndex, ray_disc, ray_walls, reading_for_distance};
 pub use colour::{ColourSensor, ColourSensorParams, RING_FRACTION, RING_POINTS, invert3};
-pub use layout::{sensor_positions, SENSOR_RADIUS};
+pub use layout::{SENSOR_RADIUS, sensor_positions};

@@ -92,6 +92,7 @@ impl World {
             command_buffer: Vec::new(),
             velocities: Vec::new(),
             positions: Vec::new(),
+            field_backend: None,
         };
         world.inject();
         world.observe();

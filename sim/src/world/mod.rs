@@ -74,6 +74,8 @@ pub struct World {
     command_buffer: Vec<WheelCommand>,
     velocities: Vec<(f32, f32)>,
     positions: Vec<Vec2>,
+    /// Steps the pheromones instead of the CPU when set (e.g. the GPU backend of `colcos-gpu`).
+    field_backend: Option<Box<dyn crate::field::FieldBackend>>,
 }
 
 impl World {
@@ -132,6 +134,14 @@ impl World {
     /// The colour sensor model shared by all robots.
     pub fn sensor(&self) -> &ColourSensor {
         &self.sensor
+    }
+    /// Installs a field backend that steps the pheromones from now on (`None`: the CPU).
+    pub fn set_field_backend(&mut self, backend: Option<Box<dyn crate::field::FieldBackend>>) {
+        self.field_backend = backend;
+    }
+    /// The installed field backend's description, or `None` for the CPU.
+    pub fn field_backend(&self) -> Option<String> {
+        self.field_backend.as_ref().map(|b| b.describe())
     }
     /// Steps until the scenario's duration is reached.
     pub fn is_finished(&self) -> bool {

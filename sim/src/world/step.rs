@@ -47,8 +47,9 @@ impl World {
         self.time = self.tick as f32 * dt;
         let tracked = self.tracker.update(self.time, self.physics.poses(), &mut self.tracker_rng);
         self.tracked.copy_from_slice(tracked);
-        for p in &mut self.pheromones {
-            p.step(dt);
+        match self.field_backend.as_mut() {
+            Some(backend) => backend.step(&mut self.pheromones, dt),
+            None => self.pheromones.iter_mut().for_each(|p| p.step(dt)),
         }
         self.inject();
         self.observe();

@@ -1,0 +1,166 @@
+"""colcos against its peers, side by side in one run: agent-steps per second with random actions.
+
+    python benches/python_throughput.py            # everything (needs vmas, mpe2, torch)
+    python benches/python_throughput.py --quick    # fewer steps
+
+Rows: colcos batched core (aggregation: 3 learning followers + leader + predator per world) at 1 /
+32 / 1,024 worlds; colcos parallel_env through the PettingZoo dict API; VMAS navigation and
+dispersion (4 agents, CPU torch) at 1 / 32 / 1,024 worlds; mpe2 simple_spread_v3 at 3 and 50 agents.
+Random actions are drawn before timing from a small pool, identically for every library, so the
+figures measure the environments. Each figure is the median of 3 repetitions.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+REPS = 3
+
+
+def median_rate(run: Callable[[], tuple[int, float]]) -> float:
+    rates = []
+    for _ in range(REPS):
+        agent_steps, secs = run()
+        rates.append(agent_steps / secs)
+    return statistics.median(rates)
+
+
+def colcos_batched(num_envs: int, steps: int, threads: int | None) -> float:
+    from colcos.vector import VecEnv
+
+    v = VecEnv("aggregation", num_envs=num_envs, num_threads=threads, max_cycles=500)
+    rng = np.random.default_rng(0)
+    pool = [rng.uniform(-1, 1, (num_envs, v.num_agents, 2)).astype(np.float32) for _ in range(8)]
+    v.reset(seed=0)
+    for a in pool:  # warm-up
+        v.step(a)
+
+    def run() -> tuple[int, float]:
+        t = time.perf_counter()
+        for k in range(steps):
+            v.step(pool[k % 8])
+        return steps * num_envs * v.num_agents, time.perf_counter() - t
+
+    return median_rate(run)
+
+
+def pettingzoo_dict(make: Callable[[], object], steps: int) -> float:
+    env = make()
+    env.reset(seed=0)
+    agents = list(env.possible_agents)
+    rng = np.random.default_rng(0)
+    pool = []
+    for _ in range(16):
+        acts = {}
+        for a in agents:
+            space = env.action_space(a)
+            space.seed(int(rng.integers(1 << 30)))
+            acts[a] = space.sample()
+        pool.append(acts)
+
+    def run() -> tuple[int, float]:
+        env.reset(seed=0)
+        n = 0
+        t = time.perf_counter()
+        for k in range(steps):
+            live = env.agents
+            if not live:
+                env.reset()
+                live = env.agents
+            acts = pool[k % 16]
+            env.step({a: acts[a] for a in live})
+            n += len(live)
+        return n, time.perf_counter() - t
+
+    return median_rate(run)
+
+
+def vmas_rate(scenario: str, num_envs: int, steps: int) -> float:
+    import torch
+    import vmas
+
+    env = vmas.make_env(scenario=scenario, num_envs=num_envs, device="cpu", continuous_actions=True, n_agents=4, seed=0)
+    env.reset()
+    g = torch.Generator().manual_seed(0)
+    pool = [[torch.rand(num_envs, env.get_agent_action_size(a), generator=g) * 2 - 1 for a in env.agents] for _ in range(8)]
+
+    def run() -> tuple[int, float]:
+        t = time.perf_counter()
+        for k in range(steps):
+            env.step(pool[k % 8])
+        return steps * num_envs * len(env.agents), time.perf_counter() - t
+
+    return median_rate(run)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--quick", action="store_true")
+    p.add_argument("--threads", type=int, default=None, help="colcos worker threads (default: all cores)")
+    args = p.parse_args()
+    scale = 0.25 if args.quick else 1.0
+    s = lambda n: max(10, int(n * scale))  # noqa: E731
+    rows: list[tuple[str, str, float | None]] = []
+
+    def add(lib: str, setup: str, fn: Callable[[], float]) -> None:
+        try:
+            rate = fn()
+        except Exception as e:  # a peer that is not installed is reported, not fatal
+            print(f"  {lib} {setup}: skipped ({type(e).__name__}: {e})", file=sys.stderr)
+            rate = None
+        rows.append((lib, setup, rate))
+        print(f"  {lib:<28} {setup:<34} {rate if rate is None else f'{rate:>14,.0f}'}", flush=True)
+
+    print(f"cores: {os.cpu_count()}, python {sys.version.split()[0]}")
+    import colcos
+
+    for e, n in [(1, 4000), (32, 1000), (1024, 100)]:
+        add("colcos VecEnv (batched)", f"aggregation, 3 agents, {e} worlds", lambda e=e, n=n: colcos_batched(e, s(n), args.threads))
+    add(
+        "colcos parallel_env (dict)",
+        "aggregation, 3 agents",
+        lambda: pettingzoo_dict(lambda: colcos.parallel_env(task="aggregation", max_cycles=500), s(4000)),
+    )
+    for scen in ("navigation", "dispersion"):
+        for e, n in [(1, 300), (32, 300), (1024, 100)]:
+            add(f"VMAS {scen}", f"4 agents, {e} worlds", lambda scen=scen, e=e, n=n: vmas_rate(scen, e, s(n)))
+    for agents, n in [(3, 2000), (50, 100)]:
+
+        def mpe(agents: int = agents, n: int = n) -> float:
+            from mpe2 import simple_spread_v3
+
+            return pettingzoo_dict(lambda: simple_spread_v3.parallel_env(N=agents, max_cycles=25), s(n))
+
+        add("mpe2 simple_spread_v3", f"{agents} agents (parallel dict API)", mpe)
+
+    def rate(lib: str, setup: str) -> float | None:
+        return next((r for l_, s_, r in rows if l_ == lib and s_ == setup), None)
+
+    print("\n| library | setup | agent-steps/s |")
+    print("| --- | --- | ---: |")
+    for lib, setup, r in rows:
+        print(f"| {lib} | {setup} | {'n/a' if r is None else f'{r:,.0f}'} |")
+    ours_1024 = rate("colcos VecEnv (batched)", "aggregation, 3 agents, 1024 worlds")
+    ours_dict = rate("colcos parallel_env (dict)", "aggregation, 3 agents")
+    print("\nratios (colcos / peer):")
+    for lib, setup, r in rows:
+        if r is None or lib.startswith("colcos"):
+            continue
+        ours = ours_1024 if lib.startswith("VMAS") and "1024" in setup else ours_dict if lib.startswith("mpe2") else None
+        if lib.startswith("VMAS") and " 1 worlds" in setup:
+            ours = rate("colcos VecEnv (batched)", "aggregation, 3 agents, 1 worlds")
+        if lib.startswith("VMAS") and "32 worlds" in setup:
+            ours = rate("colcos VecEnv (batched)", "aggregation, 3 agents, 32 worlds")
+        if ours:
+            print(f"  vs {lib}, {setup}: {ours / r:6.2f}x")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,27 @@
+//! colcos-env: reinforcement-learning tasks over `colcos-sim` worlds, and a batched vector environment.
+//!
+//! A [`Task`] turns a scenario into an RL problem: which robots are agents, how an agent's own sensor
+//! reading becomes its observation vector ([`encoding`]), how its action becomes a wheel command, its
+//! reward and its termination. Tasks live one per file under [`task`] and are built by name through
+//! [`task::registry`]. [`VecEnv`] steps `E` worlds of `N` agents each with rayon into flat buffers
+//! allocated once (`[E, N, ...]`, row-major), with per-world random streams derived from
+//! `(seed, world index, episode)`, so results never depend on the number of threads.
+//!
+//! Robots that are not agents (a leader, a predator) keep the behaviour their scenario gives them, with
+//! their own random streams.
+
+pub mod baseline;
+pub mod config;
+pub mod encoding;
+pub mod error;
+pub mod patch;
+pub mod spaces;
+pub mod task;
+mod vec_env;
+mod world_slot;
+
+pub use config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource};
+pub use error::{EnvError, Result};
+pub use spaces::{EnvSpec, Space};
+pub use task::Task;
+pub use vec_env::{Actions, VecEnv};

@@ -1,0 +1,91 @@
+//! RL tasks: one per file, built by name through [`registry`].
+//!
+//! A task is the experiment's loop function: unlike a behaviour it sees the whole world (true poses,
+//! fields) to hand out rewards and end episodes. Agents still observe only their own sensors.
+
+pub mod aggregation;
+pub mod foraging;
+pub mod registry;
+pub mod trail;
+
+use crate::error::{EnvError, Result};
+use colcos_sim::scenario::Scenario;
+use colcos_sim::world::World;
+use serde::de::DeserializeOwned;
+
+/// An RL problem over a scenario.
+pub trait Task: Send + Sync {
+    /// Registry name (`"aggregation"`).
+    fn name(&self) -> &'static str;
+    /// World robot indices of the agents, in agent order. Fixed for the task's lifetime.
+    fn agents(&self) -> &[usize];
+    /// Prepares a freshly built world for a new episode (e.g. brings static maps to steady state).
+    /// Returns true if it changed the fields, so the environment takes one settling step to let the
+    /// sensors see the change.
+    fn on_reset(&self, _world: &mut World) -> bool {
+        false
+    }
+    /// Rewards after a step, one per agent, and which agents have reached a terminal state. Entries of
+    /// `terminated` are only ever set to true here, never cleared.
+    fn evaluate(&self, world: &World, rewards: &mut [f32], terminated: &mut [bool]);
+}
+
+/// Deserialises a task's parameter object, naming the key at fault; unknown keys are refused.
+pub fn parse_params<T: DeserializeOwned>(task: &str, params: &serde_json::Value) -> Result<T> {
+    let value = if params.is_null() { serde_json::Value::Object(Default::default()) } else { params.clone() };
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        let key = if path == "." || path.is_empty() { task.to_string() } else { format!("{task}.{path}") };
+        EnvError::param(key, e.into_inner().to_string())
+    })
+}
+
+/// World indices of the robots whose group has role `role`.
+pub fn robots_with_role(scenario: &Scenario, role: &str) -> Vec<usize> {
+    let mut first = 0;
+    let mut out = Vec::new();
+    for g in &scenario.spec.robots {
+        if g.role == role {
+            out.extend(first..first + g.count);
+        }
+        first += g.count;
+    }
+    out
+}
+
+/// The robots of role `role`, or an error naming the parameter `key` if there are none.
+pub fn require_role(scenario: &Scenario, role: &str, key: &str) -> Result<Vec<usize>> {
+    let robots = robots_with_role(scenario, role);
+    if robots.is_empty() {
+        let roles: Vec<&str> = scenario.spec.robots.iter().map(|g| g.role.as_str()).collect();
+        return Err(EnvError::param(key, format!("no robot group has role {role:?} in this scenario (roles: {roles:?})")));
+    }
+    Ok(robots)
+}
+
+/// A finite, non-negative parameter.
+pub fn check_non_negative(key: &str, v: f32) -> Result<f32> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(EnvError::param(key, format!("{v} must be finite and >= 0")))
+    }
+}
+
+/// Brings every grid pheromone with a static injection map and finite evaporation `e` to its steady
+/// state `e J` (exact without diffusion). Returns true if any field changed.
+pub fn prefill_static_maps(world: &mut World) -> bool {
+    let mut changed = false;
+    for p in world.pheromones_mut() {
+        if let colcos_sim::field::FieldModel::Grid(g) = &mut p.model {
+            let e = g.params().evaporation;
+            if !(e.is_finite() && e > 0.0) {
+                continue;
+            }
+            let Some(j) = g.static_injection().map(|j| j.to_vec()) else { continue };
+            g.values_mut().iter_mut().zip(&j).for_each(|(v, j)| *v = e * j);
+            changed = true;
+        }
+    }
+    changed
+}

@@ -1,0 +1,42 @@
+//! Tasks by name.
+use super::{aggregation, foraging, trail, Task};
+use crate::config::ScenarioSource;
+use crate::error::{EnvError, Result};
+use colcos_sim::scenario::Scenario;
+
+type Builder = fn(&Scenario, &serde_json::Value) -> Result<Box<dyn Task>>;
+
+/// Every task: name, description, default scenario (TOML), builder.
+const REGISTRY: &[(&str, &str, &str, Builder)] = &[
+    ("aggregation", aggregation::DESCRIPTION, aggregation::DEFAULT_SCENARIO, aggregation::build),
+    ("foraging", foraging::DESCRIPTION, foraging::DEFAULT_SCENARIO, foraging::build),
+    ("trail", trail::DESCRIPTION, trail::DEFAULT_SCENARIO, trail::build),
+];
+
+/// Names and one-line descriptions of all tasks.
+pub fn list() -> impl Iterator<Item = (&'static str, &'static str)> {
+    REGISTRY.iter().map(|(n, d, _, _)| (*n, *d))
+}
+
+/// The built-in scenario text of task `name`.
+pub fn default_scenario(name: &str) -> Result<&'static str> {
+    find(name).map(|(_, _, s, _)| *s)
+}
+
+/// Builds task `name` over the scenario from `source`, with `params` (a JSON object).
+pub fn build(name: &str, source: &ScenarioSource, params: &serde_json::Value) -> Result<(Box<dyn Task>, Scenario)> {
+    let (_, _, default, builder) = find(name)?;
+    let scenario = source.load(default)?;
+    let task = builder(&scenario, params)?;
+    if task.agents().is_empty() {
+        return Err(EnvError::param(name, "the scenario has no agent robots"));
+    }
+    Ok((task, scenario))
+}
+
+fn find(name: &str) -> Result<&'static (&'static str, &'static str, &'static str, Builder)> {
+    REGISTRY.iter().find(|(n, _, _, _)| *n == name).ok_or_else(|| EnvError::UnknownTask {
+        name: name.to_string(),
+        known: REGISTRY.iter().map(|(n, _, _, _)| *n).collect::<Vec<_>>().join(", "),
+    })
+}

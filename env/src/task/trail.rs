@@ -1,0 +1,70 @@
+//! Follow and lay a trail: agents are rewarded for driving forward along a colour trail (a static loop
+//! in the built-in scenario), while laying trails of their own that others can follow.
+//!
+//! Reward per agent and step: `forward speed / max speed * strength of channel` (its own sensors'
+//! mean intensity), minus `bump_penalty * strongest bumper`. No termination.
+use super::{check_non_negative, parse_params, require_role, Task};
+use crate::error::{EnvError, Result};
+use colcos_sim::behaviour::channel_index;
+use colcos_sim::scenario::Scenario;
+use colcos_sim::world::World;
+use serde::Deserialize;
+
+pub const DESCRIPTION: &str = "follow a colour trail forward while laying one (static loop plus the robots' own trails)";
+pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/trail.toml");
+
+#[derive(Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct Params {
+    agent_role: String,
+    /// Channel of the trail to follow: "r", "g" or "b".
+    channel: String,
+    bump_penalty: f32,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params { agent_role: "agent".into(), channel: "b".into(), bump_penalty: 0.1 }
+    }
+}
+
+pub struct Trail {
+    agents: Vec<usize>,
+    channel: usize,
+    bump_penalty: f32,
+    inv_max_speed: f32,
+}
+
+pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn Task>> {
+    let p: Params = parse_params("trail", params)?;
+    let agents = require_role(scenario, &p.agent_role, "trail.agent_role")?;
+    let channel = channel_index(&p.channel).ok_or_else(|| EnvError::param("trail.channel", format!("{:?} is not \"r\", \"g\" or \"b\"", p.channel)))?;
+    let max = scenario.spec.robot.max_wheel_speed;
+    Ok(Box::new(Trail {
+        agents,
+        channel,
+        bump_penalty: check_non_negative("trail.bump_penalty", p.bump_penalty)?,
+        inv_max_speed: if max > 0.0 { 1.0 / max } else { 0.0 },
+    }))
+}
+
+impl Task for Trail {
+    fn name(&self) -> &'static str {
+        "trail"
+    }
+    fn agents(&self) -> &[usize] {
+        &self.agents
+    }
+    fn on_reset(&self, world: &mut World) -> bool {
+        super::prefill_static_maps(world)
+    }
+    fn evaluate(&self, world: &World, rewards: &mut [f32], _terminated: &mut [bool]) {
+        let obs = world.observations();
+        let params = world.robot_params();
+        for (r, &i) in rewards.iter_mut().zip(&self.agents) {
+            let (forward, _) = world.robots()[i].drive.body_velocity(params);
+            let o = &obs[i];
+            *r = forward * self.inv_max_speed * o.strength(self.channel) - self.bump_penalty * o.max_bumper();
+        }
+    }
+}

@@ -1,0 +1,484 @@
+//! The batched core: `E` worlds of `N` agents stepped with rayon into flat buffers allocated once.
+//!
+//! Ownership model: the environment owns every output buffer (`[E, N, OBS_DIM]` observations,
+//! `[E, N]` rewards and flags, ...); they are allocated at construction and never reallocated, so a
+//! binding may hand out views of them that stay valid for the environment's lifetime. Each `step` and
+//! `reset` overwrites them in place.
+use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
+use crate::encoding::{self, OBS_DIM};
+use crate::error::{EnvError, Result};
+use crate::spaces::{EnvSpec, Space};
+use crate::task::{registry, Task};
+use crate::world_slot::WorldSlot;
+use colcos_sim::scenario::Scenario;
+use colcos_sim::world::World;
+use rayon::prelude::*;
+
+/// Actions for every agent of every world, row-major `[E, N, 2]` or `[E, N]`.
+#[derive(Clone, Copy, Debug)]
+pub enum Actions<'a> {
+    /// Wheel speeds as fractions of the largest, `[E, N, 2]`; clipped to `[-1, 1]`, NaN refused.
+    Continuous(&'a [f32]),
+    /// Indices into [`encoding::DISCRETE_ACTIONS`], `[E, N]`.
+    Discrete(&'a [i64]),
+}
+
+/// Per-world output slices.
+struct Out<'a> {
+    obs: &'a mut [f32],
+    rewards: &'a mut [f32],
+    terminated: &'a mut [bool],
+    truncated: &'a mut [bool],
+    state: &'a mut [f32],
+    patch: &'a mut [u8],
+    final_obs: &'a mut [f32],
+    final_mask: &'a mut bool,
+}
+
+/// Everything a world's step needs besides its own slot and buffers.
+struct Ctx<'a> {
+    task: &'a dyn Task,
+    scenario: &'a Scenario,
+    mode: AutoresetMode,
+    max_cycles: u64,
+    max_speed: f32,
+    state_dim: usize,
+    patch: Option<PatchConfig>,
+}
+
+pub struct VecEnv {
+    spec: EnvSpec,
+    task: Box<dyn Task>,
+    /// The scenario with the current seed.
+    scenario: Scenario,
+    mode: AutoresetMode,
+    patch_cfg: Option<PatchConfig>,
+    pool: rayon::ThreadPool,
+    slots: Vec<WorldSlot>,
+    obs: Vec<f32>,
+    rewards: Vec<f32>,
+    terminated: Vec<bool>,
+    truncated: Vec<bool>,
+    state: Vec<f32>,
+    patch: Vec<u8>,
+    final_obs: Vec<f32>,
+    final_mask: Vec<bool>,
+    /// Scratch: decoded wheel commands of the agents `[E, N]`.
+    commands: Vec<colcos_sim::behaviour::WheelCommand>,
+    state_dim: usize,
+    patch_len: usize,
+    needs_reset: bool,
+}
+
+impl VecEnv {
+    pub fn new(cfg: &EnvConfig) -> Result<Self> {
+        if cfg.num_envs == 0 {
+            return Err(EnvError::param("num_envs", "must be at least 1"));
+        }
+        let (task, mut scenario) = registry::build(&cfg.task, &cfg.scenario, &cfg.params)?;
+        scenario.spec.seed = cfg.seed;
+        let max_cycles = if cfg.max_cycles > 0 { cfg.max_cycles } else { scenario.steps().max(1) };
+        let n = task.agents().len();
+        let robots = scenario.robot_count();
+        let e = cfg.num_envs;
+        if let Some(p) = cfg.patch {
+            if p.pixels == 0 || p.pixels > 256 {
+                return Err(EnvError::param("patch_pixels", format!("{} must be in 1..=256", p.pixels)));
+            }
+            if !(p.side.is_finite() && p.side > 0.0) {
+                return Err(EnvError::param("patch_side", format!("{} must be a positive length in m", p.side)));
+            }
+        }
+        let state_dim = if cfg.global_state { 4 * robots + 1 } else { 0 };
+        let patch_len = cfg.patch.map_or(0, |p| p.pixels * p.pixels * 3);
+        let threads = cfg.num_threads.unwrap_or(0);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|i| format!("colcos-env-{i}"))
+            .build()
+            .map_err(|err| EnvError::param("num_threads", err.to_string()))?;
+        let spec = EnvSpec {
+            task: cfg.task.clone(),
+            env_name: format!("colcos_{}_v0", cfg.task),
+            num_envs: e,
+            num_agents: n,
+            num_robots: robots,
+            agent_names: (0..n).map(|i| format!("robot_{i}")).collect(),
+            agent_robots: task.agents().to_vec(),
+            observation: Space::Box { low: -1.0, high: 1.0, shape: vec![OBS_DIM], dtype: "float32" },
+            action: match cfg.action {
+                ActionKind::Continuous => Space::Box { low: -1.0, high: 1.0, shape: vec![2], dtype: "float32" },
+                ActionKind::Discrete => Space::Discrete { n: encoding::DISCRETE_ACTIONS.len() },
+            },
+            state: cfg.global_state.then(|| Space::Box { low: -1.0, high: 1.0, shape: vec![state_dim], dtype: "float32" }),
+            patch: cfg.patch.map(|p| Space::Box { low: 0.0, high: 255.0, shape: vec![p.pixels, p.pixels, 3], dtype: "uint8" }),
+            max_cycles,
+            dt: scenario.spec.dt,
+        };
+        let slots = pool.install(|| (0..e).into_par_iter().map(|w| WorldSlot::build(&scenario, task.as_ref(), w, 0)).collect::<Result<Vec<_>>>())?;
+        let mut env = VecEnv {
+            spec,
+            task,
+            scenario,
+            mode: cfg.autoreset,
+            patch_cfg: cfg.patch,
+            pool,
+            slots,
+            obs: vec![0.0; e * n * OBS_DIM],
+            rewards: vec![0.0; e * n],
+            terminated: vec![false; e * n],
+            truncated: vec![false; e * n],
+            // At least one element per world so that every buffer splits into E chunks.
+            state: vec![0.0; e * state_dim.max(1)],
+            patch: vec![0; e * n * patch_len.max(1)],
+            final_obs: vec![0.0; e * n * OBS_DIM],
+            final_mask: vec![false; e],
+            commands: vec![Default::default(); e * n],
+            state_dim,
+            patch_len,
+            needs_reset: true,
+        };
+        env.write_all_outputs();
+        Ok(env)
+    }
+
+    pub fn spec(&self) -> &EnvSpec {
+        &self.spec
+    }
+    pub fn task(&self) -> &dyn Task {
+        self.task.as_ref()
+    }
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+    pub fn autoreset_mode(&self) -> AutoresetMode {
+        self.mode
+    }
+    /// Current base seed.
+    pub fn seed(&self) -> u64 {
+        self.scenario.spec.seed
+    }
+    /// The sim world of batch world `e`.
+    pub fn world(&self, e: usize) -> Option<&World> {
+        self.slots.get(e).map(|s| &s.world)
+    }
+    /// Steps taken in the current episode of each world.
+    pub fn episode_steps(&self, e: usize) -> u64 {
+        self.slots[e].steps
+    }
+    /// Number of the current episode of world `e` since the seed was last set.
+    pub fn episode(&self, e: usize) -> u64 {
+        self.slots[e].episode
+    }
+    /// Whether world `e` has finished its episode (and awaits a reset).
+    pub fn is_done(&self, e: usize) -> bool {
+        self.slots[e].done
+    }
+
+    /// Observations `[E, N, OBS_DIM]`.
+    pub fn obs(&self) -> &[f32] {
+        &self.obs
+    }
+    pub fn rewards(&self) -> &[f32] {
+        &self.rewards
+    }
+    pub fn terminated(&self) -> &[bool] {
+        &self.terminated
+    }
+    pub fn truncated(&self) -> &[bool] {
+        &self.truncated
+    }
+    /// Global state `[E, S]` (empty if disabled).
+    pub fn state(&self) -> &[f32] {
+        if self.state_dim == 0 { &[] } else { &self.state }
+    }
+    /// Screen patches `[E, N, P, P, 3]` (empty if disabled).
+    pub fn patch(&self) -> &[u8] {
+        if self.patch_len == 0 { &[] } else { &self.patch }
+    }
+    /// Final observations of worlds that ended in the last step (same-step autoreset) `[E, N, OBS_DIM]`.
+    pub fn final_obs(&self) -> &[f32] {
+        &self.final_obs
+    }
+    /// Which worlds ended (and were reset) in the last step, same-step autoreset.
+    pub fn final_mask(&self) -> &[bool] {
+        &self.final_mask
+    }
+
+    /// Raw pointers to the buffers, for bindings that hand out views. They stay valid and fixed for
+    /// the life of `self` (the buffers are never reallocated).
+    pub fn buffer_ptrs(&mut self) -> BufferPtrs {
+        BufferPtrs {
+            obs: self.obs.as_mut_ptr(),
+            rewards: self.rewards.as_mut_ptr(),
+            terminated: self.terminated.as_mut_ptr(),
+            truncated: self.truncated.as_mut_ptr(),
+            state: self.state.as_mut_ptr(),
+            patch: self.patch.as_mut_ptr(),
+            final_obs: self.final_obs.as_mut_ptr(),
+            final_mask: self.final_mask.as_mut_ptr(),
+        }
+    }
+
+    /// Resets the worlds selected by `mask` (all if `None`). A `seed` becomes the new base seed and
+    /// restarts the episode count of the reset worlds, so `reset(seed)` reproduces a run exactly.
+    pub fn reset(&mut self, seed: Option<u64>, mask: Option<&[bool]>) -> Result<()> {
+        let e = self.spec.num_envs;
+        if let Some(m) = mask.filter(|m| m.len() != e) {
+            return Err(EnvError::Action(format!("reset mask has {} entries, expected num_envs = {e}", m.len())));
+        }
+        if let Some(s) = seed {
+            self.scenario.spec.seed = s;
+        }
+        let (scenario, task) = (&self.scenario, self.task.as_ref());
+        // A seed restarts the episode count; the first reset after construction replays episode 0.
+        let restart = seed.is_some();
+        let first = self.needs_reset;
+        let slots = &mut self.slots;
+        self.pool.install(|| {
+            slots.par_iter_mut().enumerate().try_for_each(|(w, slot)| -> Result<()> {
+                if mask.is_none_or(|m| m[w]) {
+                    let episode = if restart { 0 } else if first { slot.episode } else { slot.episode + 1 };
+                    *slot = WorldSlot::build(scenario, task, w, episode)?;
+                }
+                Ok(())
+            })
+        })?;
+        if mask.is_none() {
+            self.needs_reset = false;
+        }
+        self.write_all_outputs();
+        Ok(())
+    }
+
+    /// One step of every world. Agents that have terminated are stopped and their actions ignored.
+    pub fn step(&mut self, actions: Actions) -> Result<()> {
+        if self.needs_reset {
+            return Err(EnvError::State("call reset() before step()".into()));
+        }
+        self.decode(actions)?;
+        if self.mode == AutoresetMode::Disabled {
+            if let Some(w) = self.slots.iter().position(|s| s.done) {
+                return Err(EnvError::State(format!("world {w} has finished its episode; reset it (autoreset mode is disabled)")));
+            }
+        }
+        let n = self.spec.num_agents;
+        let ctx = Ctx {
+            task: self.task.as_ref(),
+            scenario: &self.scenario,
+            mode: self.mode,
+            max_cycles: self.spec.max_cycles,
+            max_speed: self.scenario.spec.robot.max_wheel_speed,
+            state_dim: self.state_dim,
+            patch: self.patch_cfg,
+        };
+        let (sd, pl) = (self.state_dim.max(1), self.patch_len.max(1));
+        let slots = &mut self.slots;
+        let commands = &self.commands;
+        let outs = self
+            .obs
+            .par_chunks_mut(n * OBS_DIM)
+            .zip(self.rewards.par_chunks_mut(n))
+            .zip(self.terminated.par_chunks_mut(n))
+            .zip(self.truncated.par_chunks_mut(n))
+            .zip(self.state.par_chunks_mut(sd))
+            .zip(self.patch.par_chunks_mut(n * pl))
+            .zip(self.final_obs.par_chunks_mut(n * OBS_DIM))
+            .zip(self.final_mask.par_iter_mut())
+            .map(|(((((((obs, rewards), terminated), truncated), state), patch), final_obs), final_mask)| Out {
+                obs,
+                rewards,
+                terminated,
+                truncated,
+                state,
+                patch,
+                final_obs,
+                final_mask,
+            });
+        self.pool.install(|| {
+            slots.par_iter_mut().zip(commands.par_chunks(n)).zip(outs).enumerate().try_for_each(|(w, ((slot, cmds), mut out))| step_world(&ctx, w, slot, cmds, &mut out))
+        })
+    }
+
+    /// Checks and decodes the actions into wheel commands.
+    fn decode(&mut self, actions: Actions) -> Result<()> {
+        let (e, n) = (self.spec.num_envs, self.spec.num_agents);
+        let max = self.scenario.spec.robot.max_wheel_speed;
+        match (actions, &self.spec.action) {
+            (Actions::Continuous(a), Space::Box { .. }) => {
+                if a.len() != e * n * 2 {
+                    return Err(EnvError::Action(format!("expected {} values (num_envs {e} x agents {n} x 2 wheels), got {}", e * n * 2, a.len())));
+                }
+                if let Some(k) = a.iter().position(|v| !v.is_finite()) {
+                    let (w, i, c) = (k / (2 * n), (k / 2) % n, k % 2);
+                    return Err(EnvError::Action(format!("action of world {w}, agent robot_{i}, wheel {c} is {} (must be finite)", a[k])));
+                }
+                for (cmd, pair) in self.commands.iter_mut().zip(a.chunks_exact(2)) {
+                    *cmd = encoding::continuous_command(pair[0], pair[1], max);
+                }
+            }
+            (Actions::Discrete(a), Space::Discrete { n: count }) => {
+                if a.len() != e * n {
+                    return Err(EnvError::Action(format!("expected {} actions (num_envs {e} x agents {n}), got {}", e * n, a.len())));
+                }
+                for (k, (cmd, &v)) in self.commands.iter_mut().zip(a).enumerate() {
+                    *cmd = encoding::discrete_command(v, max)
+                        .ok_or_else(|| EnvError::Action(format!("action of world {}, agent robot_{} is {v}, not in 0..{count}", k / n, k % n)))?;
+                }
+            }
+            (Actions::Continuous(_), _) => return Err(EnvError::Action("this environment has discrete actions (integers), got continuous ones".into())),
+            (Actions::Discrete(_), _) => return Err(EnvError::Action("this environment has continuous actions (floats, [.., 2]), got discrete ones".into())),
+        }
+        Ok(())
+    }
+
+    /// Rewrites observations, state and patches of every world and clears rewards and flags.
+    fn write_all_outputs(&mut self) {
+        let n = self.spec.num_agents;
+        let ctx_max = self.scenario.spec.robot.max_wheel_speed;
+        let (sd, pl) = (self.state_dim, self.patch_len);
+        let agents = self.task.agents();
+        for (w, slot) in self.slots.iter().enumerate() {
+            write_obs(&slot.world, agents, ctx_max, &mut self.obs[w * n * OBS_DIM..(w + 1) * n * OBS_DIM]);
+            if sd > 0 {
+                write_state(&slot.world, slot.steps, self.spec.max_cycles, &mut self.state[w * sd..(w + 1) * sd]);
+            }
+            if let Some(p) = &self.patch_cfg {
+                write_patch(&slot.world, agents, p, &mut self.patch[w * n * pl..(w + 1) * n * pl]);
+            }
+        }
+        self.rewards.fill(0.0);
+        self.terminated.fill(false);
+        self.truncated.fill(false);
+        self.final_mask.fill(false);
+    }
+
+    /// The screen with the robots drawn on it, `width` pixels wide, of world `e`.
+    pub fn render(&self, e: usize, width: u32) -> Result<image::RgbImage> {
+        let slot = self.slots.get(e).ok_or_else(|| EnvError::param("world", format!("{e} is not below num_envs = {}", self.spec.num_envs)))?;
+        Ok(render_world(&slot.world, self.task.agents(), width))
+    }
+}
+
+/// Raw pointers to a [`VecEnv`]'s buffers (see [`VecEnv::buffer_ptrs`]).
+pub struct BufferPtrs {
+    pub obs: *mut f32,
+    pub rewards: *mut f32,
+    pub terminated: *mut bool,
+    pub truncated: *mut bool,
+    pub state: *mut f32,
+    pub patch: *mut u8,
+    pub final_obs: *mut f32,
+    pub final_mask: *mut bool,
+}
+
+fn step_world(ctx: &Ctx, w: usize, slot: &mut WorldSlot, cmds: &[colcos_sim::behaviour::WheelCommand], out: &mut Out) -> Result<()> {
+    let agents = ctx.task.agents();
+    *out.final_mask = false;
+    if slot.done {
+        // Next-step autoreset: this step only resets the world.
+        *slot = WorldSlot::build(ctx.scenario, ctx.task, w, slot.episode + 1)?;
+        out.rewards.fill(0.0);
+        out.terminated.fill(false);
+        out.truncated.fill(false);
+        write_world(ctx, slot, out);
+        return Ok(());
+    }
+    slot.decide_scripted();
+    for ((&i, cmd), &term) in agents.iter().zip(cmds).zip(&slot.terminated) {
+        slot.commands[i] = if term { colcos_sim::behaviour::WheelCommand::STOP } else { *cmd };
+    }
+    slot.world.step_with_commands(&slot.commands);
+    slot.steps += 1;
+    slot.prev_terminated.copy_from_slice(&slot.terminated);
+    ctx.task.evaluate(&slot.world, out.rewards, &mut slot.terminated);
+    for (r, &was) in out.rewards.iter_mut().zip(&slot.prev_terminated) {
+        if was {
+            *r = 0.0;
+        }
+    }
+    let truncate = slot.steps >= ctx.max_cycles;
+    let mut done = true;
+    for k in 0..agents.len() {
+        out.terminated[k] = slot.terminated[k];
+        out.truncated[k] = truncate && !slot.terminated[k];
+        done &= out.terminated[k] || out.truncated[k];
+    }
+    write_world(ctx, slot, out);
+    if done {
+        slot.done = true;
+        if ctx.mode == AutoresetMode::SameStep {
+            out.final_obs.copy_from_slice(out.obs);
+            *out.final_mask = true;
+            *slot = WorldSlot::build(ctx.scenario, ctx.task, w, slot.episode + 1)?;
+            write_world(ctx, slot, out);
+        }
+    }
+    Ok(())
+}
+
+fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut Out) {
+    let agents = ctx.task.agents();
+    write_obs(&slot.world, agents, ctx.max_speed, out.obs);
+    if ctx.state_dim > 0 {
+        write_state(&slot.world, slot.steps, ctx.max_cycles, out.state);
+    }
+    if let Some(p) = &ctx.patch {
+        write_patch(&slot.world, agents, p, out.patch);
+    }
+}
+
+fn write_obs(world: &World, agents: &[usize], max_speed: f32, out: &mut [f32]) {
+    let obs = world.observations();
+    for (&i, o) in agents.iter().zip(out.chunks_exact_mut(OBS_DIM)) {
+        encoding::encode(&obs[i], max_speed, o);
+    }
+}
+
+/// Global state: per robot `x / W * 2 - 1`, `y / H * 2 - 1`, `cos`, `sin` of the heading; then the
+/// episode's elapsed fraction.
+fn write_state(world: &World, steps: u64, max_cycles: u64, out: &mut [f32]) {
+    let arena = world.arena();
+    for (p, o) in world.poses().iter().zip(out.chunks_exact_mut(4)) {
+        o[0] = (2.0 * p.pos.x / arena.x - 1.0).clamp(-1.0, 1.0);
+        o[1] = (2.0 * p.pos.y / arena.y - 1.0).clamp(-1.0, 1.0);
+        o[2] = p.heading.cos();
+        o[3] = p.heading.sin();
+    }
+    if let Some(last) = out.last_mut() {
+        *last = (steps as f32 / max_cycles.max(1) as f32).min(1.0);
+    }
+}
+
+fn write_patch(world: &World, agents: &[usize], cfg: &PatchConfig, out: &mut [u8]) {
+    let len = cfg.pixels * cfg.pixels * 3;
+    let poses = world.poses();
+    for (&i, o) in agents.iter().zip(out.chunks_exact_mut(len)) {
+        crate::patch::sample(world.pheromones(), world.screen(), &poses[i], cfg, o);
+    }
+}
+
+/// Screen image with robots: agents white, scripted robots coloured by order of their role.
+pub fn render_world(world: &World, agents: &[usize], width: u32) -> image::RgbImage {
+    let screen = world.screen();
+    let width = width.max(16);
+    let height = ((width as f32 * screen.size[1] / screen.size[0]).round() as u32).max(1);
+    let mut img = colcos_sim::screen::render(world.pheromones(), screen, width, height);
+    const OTHERS: [[u8; 3]; 4] = [[255, 200, 0], [255, 0, 255], [0, 200, 255], [150, 150, 150]];
+    let mut roles: Vec<&str> = Vec::new();
+    let colours: Vec<image::Rgb<u8>> = (0..world.robot_count())
+        .map(|i| {
+            if agents.contains(&i) {
+                return image::Rgb([240, 240, 240]);
+            }
+            let role = world.role(i);
+            let k = roles.iter().position(|r| *r == role).unwrap_or_else(|| {
+                roles.push(role);
+                roles.len() - 1
+            });
+            image::Rgb(OTHERS[k % OTHERS.len()])
+        })
+        .collect();
+    colcos_sim::output::draw::robots(&mut img, screen, world.poses(), world.robot_params().radius, &colours);
+    img
+}

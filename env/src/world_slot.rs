@@ -1,0 +1,77 @@
+//! One world of a batch: the sim world, the behaviours of its scripted robots, and episode bookkeeping.
+use crate::error::Result;
+use crate::task::Task;
+use colcos_sim::behaviour::{registry, Behaviour, WheelCommand};
+use colcos_sim::rng::{self, SimRng};
+use colcos_sim::scenario::Scenario;
+use colcos_sim::world::World;
+
+/// Random stream of scripted robot `i` (above the streams the world itself uses).
+const STREAM_SCRIPTED0: u64 = 1 << 20;
+
+/// The world index passed to [`World::with_index`] for episode `episode` of batch world `w`: every
+/// (world, episode) pair has its own random streams, whatever the order worlds are reset in.
+pub fn world_index(w: usize, episode: u64) -> u64 {
+    (w as u64) | (episode << 32)
+}
+
+pub(crate) struct WorldSlot {
+    pub world: World,
+    /// Scripted (non-agent) robots: index, behaviour, random stream.
+    scripted: Vec<(usize, Box<dyn Behaviour>, SimRng)>,
+    /// Wheel commands of every robot for the next step.
+    pub commands: Vec<WheelCommand>,
+    /// Episodes started in this world since the seed was set.
+    pub episode: u64,
+    /// Steps taken in this episode.
+    pub steps: u64,
+    /// Agents that have terminated in this episode.
+    pub terminated: Vec<bool>,
+    /// Scratch: `terminated` before the last evaluation.
+    pub prev_terminated: Vec<bool>,
+    /// Every agent is terminated or truncated.
+    pub done: bool,
+}
+
+impl WorldSlot {
+    /// Builds episode `episode` of batch world `w`.
+    pub fn build(scenario: &Scenario, task: &dyn Task, w: usize, episode: u64) -> Result<Self> {
+        let index = world_index(w, episode);
+        let mut world = World::with_index(scenario, index)?;
+        let agents = task.agents();
+        let mut scripted = Vec::new();
+        let mut first = 0;
+        for (g, group) in scenario.spec.robots.iter().enumerate() {
+            for i in first..first + group.count {
+                if !agents.contains(&i) {
+                    let behaviour = registry::build(&group.behaviour, &group.params, &format!("robots[{g}]"))?;
+                    scripted.push((i, behaviour, rng::stream(scenario.spec.seed, index, STREAM_SCRIPTED0 + i as u64)));
+                }
+            }
+            first += group.count;
+        }
+        let robots = world.robot_count();
+        if task.on_reset(&mut world) {
+            // One still step so that the sensors see what the task changed.
+            world.step_with_commands(&vec![WheelCommand::STOP; robots]);
+        }
+        Ok(WorldSlot {
+            world,
+            scripted,
+            commands: vec![WheelCommand::STOP; robots],
+            episode,
+            steps: 0,
+            terminated: vec![false; agents.len()],
+            prev_terminated: vec![false; agents.len()],
+            done: false,
+        })
+    }
+
+    /// Lets the scripted robots decide their commands from their current observations.
+    pub fn decide_scripted(&mut self) {
+        let obs = self.world.observations();
+        for (i, behaviour, rng) in &mut self.scripted {
+            self.commands[*i] = behaviour.act(&obs[*i], rng);
+        }
+    }
+}

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# CI for the GPU field backend and the display window, on Debian's software Vulkan driver (lavapipe).
+# Called from .ci/run; needs root for apt-get (or the packages preinstalled).
+#   apt packages: mesa-vulkan-drivers libvulkan1 (lavapipe), xvfb (X server), imagemagick (`import`
+#   for the screenshot), xauth (xvfb-run).
+# With COLCOS_REQUIRE_GPU=1 / COLCOS_REQUIRE_DISPLAY=1 the tests fail instead of skipping when the
+# adapter or the display is missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [ "${COLCOS_CI_SKIP_APT:-0}" != 1 ]; then
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+        mesa-vulkan-drivers libvulkan1 xvfb xauth imagemagick >/dev/null
+fi
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
+export COLCOS_REQUIRE_GPU=1 COLCOS_REQUIRE_DISPLAY=1
+# GPU against CPU: every scheme and option, screens and sensors of both case studies, worlds.
+cargo test --release -p colcos-gpu -- --test-threads=1
+# The window under Xvfb: screenshot against the headless PNG.
+xvfb-run -a -s "-screen 0 640x480x24" cargo test --release -p colcos-display -- --test-threads=1
+# The CLI: `gpu` on lavapipe works, `auto` prefers the CPU over a software adapter.
+cargo run --release -q -- run scenarios/three_trails.toml --duration 0.2 --backend gpu --quiet --out target/ci-gpu-run
+cargo run --release -q -- run scenarios/three_trails.toml --duration 0.2 --backend auto --quiet --out target/ci-auto-run | grep -q "field backend: cpu"
+cargo run --release -q -- display scenarios/three_trails.toml --png target/ci-display.png --size 480x270 --seconds 0.1

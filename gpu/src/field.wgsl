@@ -1,0 +1,347 @@
+// Grid model of eq. (2) for a batch of fields, one pass per dispatch. The arithmetic of every pass is
+// written to be the same f32 operations, in the same order, as the CPU backend (sim/src/field/grid.rs).
+//
+// Field f keeps two slots of n = nx * ny cells at vals[(2 f + slot) n ..]; the per-field plan entry of a
+// pass says whether the field takes part and which slot it reads. Passes that ping-pong write the other
+// slot; in-place passes write the slot they read.
+
+struct PF {
+    active: u32,
+    src: u32,
+    inj: i32,    // offset of the field's static injection map in `inj`, or -1
+    coef: u32,   // offset of the field's Thomas coefficients in `coef`
+    a: f32,
+    b: f32,
+    r: f32,
+    c: f32,
+};
+
+struct Pass {
+    index: u32,     // row of the plan (plan[index * nfields + f]) or first deposit of a round
+    nfields: u32,
+    nx: u32,
+    ny: u32,
+    groups_x: u32,  // workgroups along x of the dispatch (linear ids fold x and y)
+    count: u32,     // deposits in the round
+    cell: f32,
+    _pad: u32,
+};
+
+struct Dep {
+    field: u32,
+    slot: u32,
+    i0: u32,
+    j0: u32,
+    w: u32,
+    h: u32,
+    kind: u32,      // 0 disc, 1 cone, 2 gaussian
+    _pad: u32,
+    ax: f32,
+    ay: f32,
+    abx: f32,
+    aby: f32,
+    len2: f32,
+    support: f32,
+    param: f32,     // radius or sigma
+    amount: f32,
+};
+
+@group(0) @binding(0) var<storage, read_write> vals: array<f32>;
+@group(0) @binding(1) var<storage, read> plan: array<PF>;
+@group(0) @binding(2) var<uniform> P: Pass;
+@group(0) @binding(3) var<storage, read> inj: array<f32>;
+@group(0) @binding(4) var<storage, read> coef: array<f32>;
+@group(0) @binding(5) var<storage, read> deps: array<Dep>;
+
+fn linear_id(wg: vec3<u32>, lid: u32) -> u32 {
+    return (wg.x + wg.y * P.groups_x) * 256u + lid;
+}
+
+fn entry(f: u32) -> PF {
+    return plan[P.index * P.nfields + f];
+}
+
+// a Phi + b J at cell k of the source slot (the CPU's psi).
+fn psi(e: PF, s: u32, k: u32) -> f32 {
+    return e.a * vals[s + k] + e.b * inj[u32(e.inj) + k];
+}
+
+// Phi <- a Phi + b J, in place.
+@compute @workgroup_size(256)
+fn evaporate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let n = P.nx * P.ny;
+    let k = linear_id(wg, lid);
+    let f = wg.z;
+    if (k >= n) { return; }
+    let e = entry(f);
+    if (e.active == 0u) { return; }
+    let s = (2u * f + e.src) * n;
+    if (e.inj >= 0) {
+        vals[s + k] = psi(e, s, k);
+    } else {
+        vals[s + k] = vals[s + k] * e.a;
+    }
+}
+
+// One explicit step of the symmetric 5-point Laplacian, dst = scale (w c + r ((l + r) + (up + dn))),
+// walls count as the cell itself (no flux). With an injection map the stencil acts on psi (scale 1),
+// otherwise on the values with scale a.
+@compute @workgroup_size(256)
+fn explicit_step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let nx = P.nx;
+    let ny = P.ny;
+    let n = nx * ny;
+    let k = linear_id(wg, lid);
+    let f = wg.z;
+    if (k >= n) { return; }
+    let e = entry(f);
+    if (e.active == 0u) { return; }
+    let s = (2u * f + e.src) * n;
+    let d = (2u * f + 1u - e.src) * n;
+    let x = k % nx;
+    let y = k / nx;
+    let w = 1.0 - 4.0 * e.r;
+    var c: f32;
+    var l: f32;
+    var rt: f32;
+    var up: f32;
+    var dn: f32;
+    var scale: f32;
+    if (e.inj >= 0) {
+        c = psi(e, s, k);
+        l = c;
+        rt = c;
+        up = c;
+        dn = c;
+        if (x > 0u) { l = psi(e, s, k - 1u); }
+        if (x + 1u < nx) { rt = psi(e, s, k + 1u); }
+        if (y + 1u < ny) { up = psi(e, s, k + nx); }
+        if (y > 0u) { dn = psi(e, s, k - nx); }
+        scale = 1.0;
+    } else {
+        c = vals[s + k];
+        l = c;
+        rt = c;
+        up = c;
+        dn = c;
+        if (x > 0u) { l = vals[s + k - 1u]; }
+        if (x + 1u < nx) { rt = vals[s + k + 1u]; }
+        if (y + 1u < ny) { up = vals[s + k + nx]; }
+        if (y > 0u) { dn = vals[s + k - nx]; }
+        scale = e.a;
+    }
+    vals[d + k] = scale * (w * c + e.r * ((l + rt) + (up + dn)));
+}
+
+// The paper's one-sided scheme, eq. (4), conservative reading: each cell sends s/2 right and s/2 up.
+@compute @workgroup_size(256)
+fn one_sided(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let nx = P.nx;
+    let ny = P.ny;
+    let n = nx * ny;
+    let k = linear_id(wg, lid);
+    let f = wg.z;
+    if (k >= n) { return; }
+    let e = entry(f);
+    if (e.active == 0u) { return; }
+    let s = (2u * f + e.src) * n;
+    let d = (2u * f + 1u - e.src) * n;
+    let x = k % nx;
+    let y = k / nx;
+    let half = 0.5 * e.r;
+    var keep_v = 0.0;
+    if (y + 1u < ny) { keep_v = half; }
+    var keep_h = 0.0;
+    if (x + 1u < nx) { keep_h = half; }
+    var v = vals[s + k] * (1.0 - keep_h - keep_v);
+    if (x > 0u) { v = v + half * vals[s + k - 1u]; }
+    if (y > 0u) { v = v + half * vals[s + k - nx]; }
+    vals[d + k] = v;
+}
+
+// Backward-Euler x-solve, one thread per row (Thomas), fused with evaporation and injection.
+@compute @workgroup_size(64)
+fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let nx = P.nx;
+    let ny = P.ny;
+    let n = nx * ny;
+    let row = gid.x + gid.y * P.groups_x * 64u;
+    let f = gid.z;
+    if (row >= ny) { return; }
+    let e = entry(f);
+    if (e.active == 0u) { return; }
+    let s = (2u * f + e.src) * n + row * nx;
+    let d = (2u * f + 1u - e.src) * n + row * nx;
+    let m = e.coef;
+    let cp = e.coef + nx;
+    var prev = 0.0;
+    for (var i = 0u; i < nx; i = i + 1u) {
+        var fv: f32;
+        if (e.inj >= 0) {
+            fv = e.a * vals[s + i] + e.b * inj[u32(e.inj) + row * nx + i];
+        } else {
+            fv = e.a * vals[s + i];
+        }
+        let v = (fv + e.r * prev) * coef[m + i];
+        vals[d + i] = v;
+        prev = v;
+    }
+    if (nx > 1u) {
+        var i = nx - 1u;
+        loop {
+            i = i - 1u;
+            vals[d + i] = vals[d + i] + coef[cp + i] * vals[d + i + 1u];
+            if (i == 0u) { break; }
+        }
+    }
+}
+
+// Backward-Euler y-solve, one thread per column.
+@compute @workgroup_size(64)
+fn ysolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let nx = P.nx;
+    let ny = P.ny;
+    let n = nx * ny;
+    let col = gid.x + gid.y * P.groups_x * 64u;
+    let f = gid.z;
+    if (col >= nx) { return; }
+    let e = entry(f);
+    if (e.active == 0u) { return; }
+    let s = (2u * f + e.src) * n + col;
+    let d = (2u * f + 1u - e.src) * n + col;
+    let m = e.coef + 2u * nx;
+    let cp = m + ny;
+    vals[d] = vals[s] * coef[m];
+    for (var j = 1u; j < ny; j = j + 1u) {
+        vals[d + j * nx] = (vals[s + j * nx] + e.r * vals[d + (j - 1u) * nx]) * coef[m + j];
+    }
+    if (ny < 2u) { return; }
+    var j = ny - 1u;
+    loop {
+        j = j - 1u;
+        vals[d + j * nx] = vals[d + j * nx] + coef[cp + j] * vals[d + (j + 1u) * nx];
+        if (j == 0u) { break; }
+    }
+}
+
+// Upwind advection along x by Courant number c (|c| <= 1/2), no-flux walls.
+@compute @workgroup_size(256)
+fn advect_x(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let nx = P.nx;
+    let n = nx * P.ny;
+    let k = linear_id(wg, lid);
+    let f = wg.z;
+    if (k >= n) { return; }
+    let e = entry(f);
+    if (e.active == 0u) { return; }
+    let s = (2u * f + e.src) * n;
+    let d = (2u * f + 1u - e.src) * n;
+    let x = k % nx;
+    let c = e.c;
+    let old = vals[s + k];
+    var v: f32;
+    if (c > 0.0) {
+        if (x == nx - 1u) {
+            v = old + c * vals[s + k - 1u];
+        } else if (x == 0u) {
+            v = old * (1.0 - c);
+        } else {
+            v = old * (1.0 - c) + c * vals[s + k - 1u];
+        }
+    } else {
+        let ca = -c;
+        if (x == 0u) {
+            v = old + ca * vals[s + k + 1u];
+        } else if (x == nx - 1u) {
+            v = old * (1.0 - ca);
+        } else {
+            v = old * (1.0 - ca) + ca * vals[s + k + 1u];
+        }
+    }
+    vals[d + k] = v;
+}
+
+// Upwind advection along y.
+@compute @workgroup_size(256)
+fn advect_y(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let nx = P.nx;
+    let ny = P.ny;
+    let n = nx * ny;
+    let k = linear_id(wg, lid);
+    let f = wg.z;
+    if (k >= n) { return; }
+    let e = entry(f);
+    if (e.active == 0u) { return; }
+    let s = (2u * f + e.src) * n;
+    let d = (2u * f + 1u - e.src) * n;
+    let y = k / nx;
+    let c = e.c;
+    let old = vals[s + k];
+    var v: f32;
+    if (c > 0.0) {
+        if (y == ny - 1u) {
+            v = old * 1.0 + c * vals[s + k - nx];
+        } else if (y == 0u) {
+            v = old * (1.0 - c);
+        } else {
+            v = old * (1.0 - c) + c * vals[s + k - nx];
+        }
+    } else {
+        let ca = -c;
+        if (y == 0u) {
+            v = old * 1.0 + ca * vals[s + k + nx];
+        } else if (y == ny - 1u) {
+            v = old * (1.0 - ca);
+        } else {
+            v = old * (1.0 - ca) + ca * vals[s + k + nx];
+        }
+    }
+    vals[d + k] = v;
+}
+
+fn kernel_weight(kind: u32, param: f32, dist: f32) -> f32 {
+    let d = abs(dist);
+    if (kind == 0u) {
+        if (d <= param) { return 1.0; }
+        return 0.0;
+    }
+    if (kind == 1u) {
+        if (d < param) { return 1.0 - d / param; }
+        return 0.0;
+    }
+    if (d <= 3.0 * param && param > 0.0) {
+        return exp(-d * d / (2.0 * param * param));
+    }
+    if (d == 0.0) { return 1.0; }
+    return 0.0;
+}
+
+// One round of trail deposits: deposit P.index + wg.z adds amount * kernel(distance to its segment) to
+// the cells of its bounding box. A round holds at most one deposit per field, so no two threads write
+// the same cell; rounds run in order, which keeps the CPU's order of additions.
+@compute @workgroup_size(256)
+fn deposit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    if (wg.z >= P.count) { return; }
+    let dp = deps[P.index + wg.z];
+    let k = linear_id(wg, lid);
+    if (k >= dp.w * dp.h) { return; }
+    let i = dp.i0 + k % dp.w;
+    let j = dp.j0 + k / dp.w;
+    let n = P.nx * P.ny;
+    let px = (f32(i) + 0.5) * P.cell;
+    let py = (f32(j) + 0.5) * P.cell;
+    var t = 0.0;
+    if (dp.len2 > 0.0) {
+        t = clamp(((px - dp.ax) * dp.abx + (py - dp.ay) * dp.aby) / dp.len2, 0.0, 1.0);
+    }
+    let qx = px - (dp.ax + dp.abx * t);
+    let qy = py - (dp.ay + dp.aby * t);
+    let dist = sqrt(qx * qx + qy * qy);
+    if (dist <= dp.support) {
+        let w = kernel_weight(dp.kind, dp.param, dist);
+        if (w != 0.0) {
+            let idx = (2u * dp.field + dp.slot) * n + j * P.nx + i;
+            vals[idx] = vals[idx] + dp.amount * w;
+        }
+    }
+}

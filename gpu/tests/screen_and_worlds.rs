@@ -1,0 +1,219 @@
+//! Screen images, sensor readings and whole worlds: GPU against CPU on the paper's two case studies
+//! (case I: static pheromone maps on the grid; case II: Gaussian sources that follow or are refreshed).
+mod common;
+use colcos_gpu::screen::{mean_levels, GpuScreen, ScreenScene, SensorQuery};
+use colcos_gpu::GpuGrids;
+use colcos_sim::field::{BackendChoice, FieldModel, GridField};
+use colcos_sim::prelude::*;
+use colcos_sim::screen;
+use colcos_sim::sensors::{sensor_positions, SENSOR_RADIUS};
+use common::{compare, ctx};
+
+/// Case I of the paper: static maps of three pheromones drawn on the grid (d = 0, steady state e J),
+/// robots following them and laying a trail.
+const CASE_I: &str = r#"
+name = "case_i_like"
+duration = 4.0
+seed = 3
+[screen]
+resolution = [3840, 2160]
+size = [1.439, 0.809]
+[field]
+cell = 0.005
+[[pheromones]]
+name = "red"
+colour = [255, 0, 0]
+evaporation = 5.0
+[[pheromones.maps]]
+polyline = [[0.2, 0.2], [1.2, 0.2], [1.2, 0.6]]
+width = 0.03
+rate = 0.2
+[[pheromones]]
+name = "green"
+colour = [0, 255, 0]
+evaporation = 8.0
+diffusion = 1e-6
+[[pheromones.maps]]
+polyline = [[0.2, 0.6], [0.7, 0.4], [1.2, 0.6]]
+width = 0.05
+rate = 0.15
+[[pheromones]]
+name = "blue"
+colour = [40, 0, 255]
+evaporation = 3.0
+[[robots]]
+count = 6
+behaviour = "follow"
+params = { channel = "r", speed = 0.1, sensitivity = 0.5, threshold = 0.05 }
+deposits = [{ pheromone = "blue", kernel = { shape = "cone", radius = 0.012 }, rate = 5.0 }]
+"#;
+
+/// Case II of the paper: a leader followed by an attractive Gaussian pheromone (AGP) and robots that
+/// refresh a Gaussian source when near the leader (ALP), with a grid trail besides.
+const CASE_II: &str = r#"
+name = "case_ii_like"
+duration = 4.0
+seed = 5
+[screen]
+resolution = [3840, 2160]
+size = [1.439, 0.809]
+[field]
+cell = 0.005
+[[pheromones]]
+name = "agp"
+colour = [0, 255, 0]
+model = "gaussian"
+[[pheromones]]
+name = "alp"
+colour = [255, 0, 0]
+model = "gaussian"
+[[pheromones]]
+name = "trail"
+colour = [0, 0, 255]
+evaporation = 10.0
+diffusion = 2e-6
+[[robots]]
+count = 1
+role = "leader"
+behaviour = "wander"
+emits = [{ pheromone = "agp", k = 0.4, sigma = [0.06, 0.04], rho = 0.3, evaporation = 5.0 }]
+deposits = [{ pheromone = "trail", kernel = { shape = "gaussian", sigma = 0.006 }, rate = 4.0 }]
+[[robots]]
+count = 5
+role = "follower"
+behaviour = "follow"
+params = { channel = "g", speed = 0.1, sensitivity = 0.5, threshold = 0.05 }
+emits = [{ pheromone = "alp", k = 0.2, sigma = [0.03, 0.03], evaporation = 2.0, when = { near = { role = "leader", distance = 0.3 } } }]
+"#;
+
+fn scenario(text: &str) -> Scenario {
+    Scenario::from_toml_str(text, ".").expect("scenario")
+}
+
+/// Uploads a world's grid pheromones into a batch and its layers into a one-world scene.
+fn upload(ctx: std::sync::Arc<colcos_gpu::GpuContext>, world: &World) -> (Option<GpuGrids>, ScreenScene) {
+    let mut index = vec![None; world.pheromones().len()];
+    let mut fields: Vec<&GridField> = Vec::new();
+    for (j, p) in world.pheromones().iter().enumerate() {
+        if let FieldModel::Grid(g) = &p.model {
+            index[j] = Some(fields.len());
+            fields.push(g);
+        }
+    }
+    let grids = (!fields.is_empty()).then(|| GpuGrids::from_fields(ctx, &fields).unwrap());
+    let scene = ScreenScene { worlds: vec![ScreenScene::world_layers(world.pheromones(), |j| index[j])] };
+    (grids, scene)
+}
+
+fn check_screen_and_sensors(name: &str, text: &str, steps: usize, sizes: &[(u32, u32)]) {
+    let Some(ctx) = ctx() else { return };
+    let sc = scenario(text);
+    let mut world = World::new(&sc).unwrap();
+    for _ in 0..steps {
+        world.step();
+    }
+    let (grids, scene) = upload(ctx.clone(), &world);
+    let mut gs = GpuScreen::new(ctx.clone());
+    for &(w, h) in sizes {
+        let cpu = screen::render(world.pheromones(), world.screen(), w, h);
+        let gpu = gs.render(grids.as_ref(), &scene, 0, world.screen(), w, h).unwrap();
+        let differ = cpu.pixels().zip(gpu.pixels()).filter(|(a, b)| a != b).count();
+        let lit = cpu.pixels().filter(|p| p.0 != [0, 0, 0]).count();
+        assert_eq!(differ, 0, "{name}: {differ} of {} pixels differ at {w}x{h} ({lit} lit)", w * h);
+        assert!(lit > 100, "{name}: the screen is almost black ({lit} lit pixels): a weak test");
+        eprintln!("{name}: {w}x{h} screen identical ({lit} lit pixels)");
+    }
+    // Sensors: every robot's four footprints, plus a grid of probes over the arena.
+    let sensor = world.sensor().clone();
+    let mut centres = Vec::new();
+    for pose in world.poses() {
+        centres.extend(sensor_positions(pose, SENSOR_RADIUS));
+    }
+    let a = world.arena();
+    for j in 0..40 {
+        for i in 0..70 {
+            centres.push(Vec2::new((i as f32 + 0.37) / 70.0 * a.x, (j as f32 + 0.61) / 40.0 * a.y));
+        }
+    }
+    let queries: Vec<SensorQuery> = centres.iter().map(|&c| SensorQuery { world: 0, points: sensor.sample_points(c) }).collect();
+    let sums = gs.sense(grids.as_ref(), &scene, world.screen(), &queries).unwrap();
+    let mut nonzero = 0;
+    for (c, s) in centres.iter().zip(&sums) {
+        let cpu = sensor.screen_levels(world.pheromones(), world.screen(), *c);
+        let gpu = mean_levels(*s);
+        assert_eq!(cpu, gpu, "{name}: sensor at {c} reads {cpu:?} on the CPU, {gpu:?} on the GPU");
+        if cpu != [0.0; 3] {
+            nonzero += 1;
+        }
+    }
+    assert!(nonzero > 20, "{name}: only {nonzero} sensors see anything");
+    eprintln!("{name}: {} sensor readings identical ({nonzero} non-zero)", centres.len());
+}
+
+#[test]
+fn case_i_screen_and_sensors_match() {
+    check_screen_and_sensors("case I", CASE_I, 150, &[(3840, 2160), (480, 270), (333, 199)]);
+}
+
+#[test]
+fn case_ii_screen_and_sensors_match() {
+    check_screen_and_sensors("case II", CASE_II, 150, &[(3840, 2160), (480, 270)]);
+}
+
+/// Two worlds from one scenario, one with the GPU backend installed: the fields stay within 1e-5 and
+/// (the GPU reproducing the CPU's arithmetic) the robots' observations and trajectories agree.
+fn check_world(name: &str, text: &str, steps: usize) {
+    let Some(_ctx) = ctx() else { return };
+    let sc = scenario(text);
+    let mut cpu = World::new(&sc).unwrap();
+    let mut gpu = World::new(&sc).unwrap();
+    let sel = colcos_gpu::install(&mut gpu, BackendChoice::Gpu).unwrap();
+    eprintln!("{name}: {sel}");
+    assert!(matches!(sel, colcos_gpu::BackendSelection::Gpu { .. }));
+    let mut same_obs = 0;
+    for step in 1..=steps {
+        cpu.step();
+        gpu.step();
+        for (k, (pc, pg)) in cpu.pheromones().iter().zip(gpu.pheromones()).enumerate() {
+            if let (FieldModel::Grid(c), FieldModel::Grid(g)) = (&pc.model, &pg.model) {
+                let (err, _) = compare(g.values(), c.values());
+                assert!(err <= 1e-5, "{name}: pheromone {k}, step {step}: relative error {err:e}");
+            }
+        }
+        if cpu.observations().iter().zip(gpu.observations()).all(|(a, b)| a.counts == b.counts) {
+            same_obs += 1;
+        }
+    }
+    eprintln!("{name}: observations identical in {same_obs} of {steps} steps");
+    assert_eq!(same_obs, steps, "{name}: observations differ");
+    for (a, b) in cpu.poses().iter().zip(gpu.poses()) {
+        assert_eq!(a.pos, b.pos, "{name}: trajectories differ");
+    }
+}
+
+#[test]
+fn case_i_world_on_gpu_matches_cpu() {
+    check_world("case I world", CASE_I, 200);
+}
+
+#[test]
+fn case_ii_world_on_gpu_matches_cpu() {
+    check_world("case II world", CASE_II, 200);
+}
+
+#[test]
+fn backend_choice_cpu_and_auto() {
+    let sc = scenario(CASE_I);
+    let mut w = World::new(&sc).unwrap();
+    let sel = colcos_gpu::install(&mut w, BackendChoice::Cpu).unwrap();
+    assert!(matches!(sel, colcos_gpu::BackendSelection::Cpu { .. }));
+    assert!(w.field_backend().is_none());
+    // `auto` never fails: a hardware adapter or the CPU (lavapipe counts as software).
+    let sel = colcos_gpu::install(&mut w, BackendChoice::Auto).unwrap();
+    eprintln!("auto chose {sel}");
+    if let Some(c) = ctx() {
+        if c.is_software() {
+            assert!(matches!(sel, colcos_gpu::BackendSelection::Cpu { .. }), "auto took a software adapter");
+        }
+    }
+}

@@ -1,0 +1,60 @@
+"""colcos: ColCOSPhi multi-pheromone swarm robotics as PettingZoo and Gymnasium environments.
+
+Environments over a batched Rust core. Every task's agents observe only their own robot's sensors
+(four colour sensors x three channels, three bumpers, their last wheel command) and set its two
+wheel speeds.
+
+>>> import colcos
+>>> env = colcos.parallel_env(task="aggregation", max_cycles=500)
+>>> obs, infos = env.reset(seed=0)
+
+| task          | agents                | observation           | action                         |
+|---------------|-----------------------|-----------------------|--------------------------------|
+| `aggregation` | followers (3)         | Box(-1, 1, (17,)) f32 | Box(-1, 1, (2,)) or Discrete(6) |
+| `foraging`    | foragers (2)          | Box(-1, 1, (17,)) f32 | same                           |
+| `trail`       | trail robots (4)      | Box(-1, 1, (17,)) f32 | same                           |
+"""
+
+from __future__ import annotations
+
+from colcos import _core
+from colcos._core import (
+    ActionError,
+    ColcosError,
+    ScenarioError,
+    StateError,
+    TaskError,
+    default_scenario,
+    discrete_actions,
+    observation_names,
+)
+from colcos.pettingzoo_env import ColcosParallelEnv, env, parallel_env, raw_env
+
+__version__ = _core.__version__
+
+__all__ = [
+    "ActionError",
+    "ColcosError",
+    "ColcosParallelEnv",
+    "ScenarioError",
+    "StateError",
+    "TaskError",
+    "behaviours",
+    "default_scenario",
+    "discrete_actions",
+    "env",
+    "observation_names",
+    "parallel_env",
+    "raw_env",
+    "tasks",
+]
+
+
+def tasks() -> dict[str, str]:
+    """Every task: name -> one-line description."""
+    return dict(_core.tasks())
+
+
+def behaviours() -> dict[str, str]:
+    """Every hand-written behaviour (usable with `colcos.baselines.Baseline`): name -> description."""
+    return dict(_core.behaviours())

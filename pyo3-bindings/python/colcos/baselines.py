@@ -1,0 +1,52 @@
+"""The paper's hand-written behaviours as baseline policies over a `colcos.vector.VecEnv`.
+
+A behaviour decides from the same raw sensor readings an agent's observation vector is built from
+(and keeps its own state, e.g. a turn in progress), so it is evaluated in Rust next to the worlds.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import numpy as np
+
+from colcos import _core
+from colcos.vector import VecEnv
+
+__all__ = ["Baseline", "RandomPolicy"]
+
+
+class Baseline:
+    """Behaviour `name` (see `colcos.behaviours()`) driving every agent of `env`.
+
+    >>> venv = VecEnv("aggregation", num_envs=8)
+    >>> policy = Baseline(venv, "avoid", speed=0.1)
+    >>> obs, _ = venv.reset(seed=0)
+    >>> obs, rew, term, trunc, _ = venv.step(policy.act())
+    """
+
+    def __init__(self, env: VecEnv, name: str, seed: int = 0, **params: Any) -> None:
+        if not env.continuous:
+            raise _core.TaskError("baseline policies produce continuous wheel speeds; make the env with continuous=True")
+        self.env = env
+        self.name = name
+        self._policy = _core.Baseline(env._core, name, json.dumps(params) if params else None, int(seed))
+
+    def act(self, obs: np.ndarray | None = None) -> np.ndarray:
+        """Actions (E, N, 2) float32 for the env's current sensor readings (`obs` is ignored)."""
+        return self._policy.act(self.env._core)
+
+
+class RandomPolicy:
+    """Uniform random actions, seeded."""
+
+    def __init__(self, env: VecEnv, seed: int = 0) -> None:
+        self.env = env
+        self.rng = np.random.default_rng(seed)
+
+    def act(self, obs: np.ndarray | None = None) -> np.ndarray:
+        e, n = self.env.num_envs, self.env.num_agents
+        if self.env.continuous:
+            return self.rng.uniform(-1.0, 1.0, size=(e, n, 2)).astype(np.float32)
+        return self.rng.integers(0, self.env.single_action_space.n, size=(e, n))

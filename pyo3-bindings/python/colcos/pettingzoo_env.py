@@ -1,0 +1,225 @@
+"""The PettingZoo faces: `parallel_env` (native), `raw_env` / `env` (AEC, derived)."""
+
+from __future__ import annotations
+
+import os
+import warnings
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+from pettingzoo.utils import wrappers
+from pettingzoo.utils.conversions import parallel_to_aec_wrapper
+
+from colcos import _core
+from colcos._core import ActionError, StateError
+from colcos._options import core_kwargs, make_space
+
+RENDER_WIDTH = 640
+
+
+class ColcosParallelEnv(ParallelEnv):
+    """A colcos task as a PettingZoo `ParallelEnv`: one world, agents `robot_0..`.
+
+    Built on the batched core with one world, so a run here and world 0 of `colcos.vector.VecEnv`
+    with the same seed follow the same trajectory. Observations are copies (safe to keep).
+
+    Args:
+        task: `"aggregation"`, `"foraging"` or `"trail"` (see `colcos.tasks()`).
+        scenario: a scenario file (path) or scenario TOML text; default: the task's own.
+        max_cycles: steps per episode before truncation (default: the scenario's duration / dt).
+        render_mode: None, `"human"` or `"rgb_array"` (the screen with the robots drawn on it).
+        continuous: two wheel speeds in [-1, 1] (True) or `Discrete(6)` (False).
+        global_state: offer `state()` (all robot poses) for centralised critics.
+        patch: if set, each observation is a dict with `"vector"` and an egocentric `"patch"` of the
+            screen, `patch x patch x 3` uint8, covering `patch_side` m under and ahead of the robot.
+        **params: task parameters (see the task's docs); unknown ones raise `colcos.TaskError`.
+    """
+
+    metadata = {
+        "render_modes": ["human", "rgb_array"],
+        "name": "colcos_v0",
+        "is_parallelizable": True,
+        "render_fps": 50,
+    }
+
+    def __init__(
+        self,
+        task: str = "aggregation",
+        scenario: str | os.PathLike[str] | None = None,
+        max_cycles: int | None = 500,
+        render_mode: str | None = None,
+        continuous: bool = True,
+        global_state: bool = True,
+        patch: int | None = None,
+        patch_side: float = 0.08,
+        seed: int = 0,
+        **params: Any,
+    ) -> None:
+        self._init_kwargs = dict(
+            task=task, scenario=scenario, max_cycles=max_cycles, render_mode=render_mode, continuous=continuous,
+            global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, **params,
+        )
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise _core.TaskError(f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']} or None")
+        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params)
+        self._core = _core.VecEnv(num_envs=1, seed=int(seed), num_threads=1, autoreset_mode="disabled", **kw)
+        spec = self._core.spec()
+        self._spec = spec
+        self.metadata = dict(self.metadata, name=spec["env_name"])
+        self.render_mode = render_mode
+        self.task = task
+        self.possible_agents: list[str] = list(spec["agent_names"])
+        self.agents: list[str] = []
+        self._index = {a: i for i, a in enumerate(self.possible_agents)}
+        vector = make_space(spec["observation"])
+        if spec["patch"] is not None:
+            obs_space: spaces.Space = spaces.Dict({"vector": vector, "patch": make_space(spec["patch"])})
+        else:
+            obs_space = vector
+        # One space object per agent, so seeding one agent's space does not touch another's.
+        self.observation_spaces = {a: _copy_space(obs_space) for a in self.possible_agents}
+        self.action_spaces = {a: make_space(spec["action"]) for a in self.possible_agents}
+        self._continuous = spec["action"]["kind"] == "box"
+        if spec["state"] is not None:
+            self.state_space = make_space(spec["state"])
+        self._views = self._core.views()
+        n = len(self.possible_agents)
+        self._actions = np.zeros((1, n, 2), np.float32) if self._continuous else np.zeros((1, n), np.int64)
+        self._needs_reset = True
+
+    def __getstate__(self) -> dict[str, Any]:
+        # Pickling (SuperSuit, multiprocessing) rebuilds the env from its arguments: a fresh copy that
+        # needs a reset, as after construction.
+        return {"init_kwargs": self._init_kwargs}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(**state["init_kwargs"])
+
+    def observation_space(self, agent: str) -> spaces.Space:
+        return self.observation_spaces[agent]
+
+    def action_space(self, agent: str) -> spaces.Space:
+        return self.action_spaces[agent]
+
+    @property
+    def num_envs(self) -> int:
+        return 1
+
+    def _obs(self, i: int) -> Any:
+        v = self._views["obs"][0, i].copy()
+        if "patch" in self._views:
+            return {"vector": v, "patch": self._views["patch"][0, i].copy()}
+        return v
+
+    def reset(self, seed: int | None = None, options: dict | None = None) -> tuple[dict, dict]:
+        if seed is not None:
+            seed = _check_seed(seed)
+        self._core.reset(seed)
+        self.agents = self.possible_agents[:]
+        self._needs_reset = False
+        return {a: self._obs(i) for i, a in enumerate(self.agents)}, {a: {} for a in self.agents}
+
+    def step(self, actions: dict[str, Any]) -> tuple[dict, dict, dict, dict, dict]:
+        if self._needs_reset:
+            raise StateError("call reset() before step()")
+        if not self.agents:
+            # Every agent is done. Wrappers such as SuperSuit's black_death step once more with no
+            # actions to learn that; answer with empty dicts (the world is not stepped).
+            if any(k in self._index for k in actions):
+                raise StateError("every agent is done: call reset() before stepping again")
+            return {}, {}, {}, {}, {}
+        if not isinstance(actions, dict):
+            raise ActionError(f"actions must be a dict {{agent name: action}}, got {type(actions).__name__}")
+        buf = self._actions
+        buf.fill(0)
+        index = self._index
+        for name, a in actions.items():
+            i = index.get(name)
+            if i is None:
+                raise ActionError(f"unknown agent {name!r}; the agents are {self.possible_agents}")
+            if a is None:
+                continue
+            try:
+                if self._continuous:
+                    buf[0, i] = a
+                else:
+                    v = int(a)
+                    if v != a:
+                        raise ValueError(f"{a!r} is not an integer")
+                    buf[0, i] = v
+            except (TypeError, ValueError) as e:
+                want = "two wheel speeds in [-1, 1]" if self._continuous else "an integer action"
+                raise ActionError(f"action of agent {name!r} must be {want}, got {a!r} ({e})") from None
+        self._core.step(buf)
+        v = self._views
+        rew, term, trunc = v["rewards"][0], v["terminated"][0], v["truncated"][0]
+        obs, rewards, terminations, truncations, infos = {}, {}, {}, {}, {}
+        live = []
+        for a in self.agents:
+            i = index[a]
+            obs[a] = self._obs(i)
+            rewards[a] = float(rew[i])
+            t, u = bool(term[i]), bool(trunc[i])
+            terminations[a] = t
+            truncations[a] = u
+            infos[a] = {}
+            if not (t or u):
+                live.append(a)
+        self.agents = live
+        return obs, rewards, terminations, truncations, infos
+
+    def state(self) -> np.ndarray:
+        if "state" not in self._views:
+            raise StateError("this environment was made with global_state=False")
+        return self._views["state"][0].copy()
+
+    def render(self, mode: str | None = None) -> np.ndarray | None:
+        mode = mode or self.render_mode
+        if mode is None:
+            warnings.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human'", stacklevel=2)
+            return None
+        frame = self._core.render(0, RENDER_WIDTH)
+        if mode == "rgb_array":
+            return frame
+        self._last_frame = frame  # "human": no window on a headless machine; keep the frame for viewers
+        return None
+
+    def close(self) -> None:
+        pass
+
+    def poses(self) -> np.ndarray:
+        """True poses (R, 3): x m, y m, heading rad, of every robot (for analysis, not for policies)."""
+        return self._core.poses(0)
+
+
+def _copy_space(s: spaces.Space) -> spaces.Space:
+    if isinstance(s, spaces.Box):
+        return spaces.Box(low=s.low, high=s.high, shape=s.shape, dtype=s.dtype)
+    if isinstance(s, spaces.Discrete):
+        return spaces.Discrete(int(s.n))
+    if isinstance(s, spaces.Dict):
+        return spaces.Dict({k: _copy_space(v) for k, v in s.spaces.items()})
+    return s
+
+
+def _check_seed(seed: Any) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise _core.TaskError(f"seed must be a non-negative integer, got {seed!r}")
+    return int(seed) & (2**64 - 1)
+
+
+def parallel_env(**kwargs: Any) -> ColcosParallelEnv:
+    """A colcos task as a PettingZoo `ParallelEnv` (see `ColcosParallelEnv`)."""
+    return ColcosParallelEnv(**kwargs)
+
+
+def raw_env(**kwargs: Any) -> parallel_to_aec_wrapper:
+    """The AEC form of `parallel_env`, without the order-enforcing wrapper."""
+    return parallel_to_aec_wrapper(ColcosParallelEnv(**kwargs))
+
+
+def env(**kwargs: Any) -> wrappers.OrderEnforcingWrapper:
+    """The AEC form of `parallel_env`, wrapped as PettingZoo's `env()` functions are."""
+    return wrappers.OrderEnforcingWrapper(raw_env(**kwargs))

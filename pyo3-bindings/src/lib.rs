@@ -1,0 +1,19 @@
+//! `colcos._core`: the native module behind the `colcos` Python package. A thin layer: the batched
+//! environment, baseline policies and the registries of `colcos-env` and `colcos-sim`, with one
+//! exception tree. The GIL is released around every reset and step.
+use pyo3::prelude::*;
+
+mod baseline;
+mod errors;
+mod registry;
+mod vec_env;
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    errors::register(m)?;
+    vec_env::register(m)?;
+    baseline::register(m)?;
+    registry::register(m)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

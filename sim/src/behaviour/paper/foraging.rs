@@ -1,0 +1,336 @@
+//! Algorithm 1: ant foraging with three pheromones (paper, case I).
+//!
+//! The trails are drawn in three colours: LAP (long-term attractive, blue) on every trail, SAP
+//! (short-term attractive, green) on the branches to the available food, so those look cyan, and SRP
+//! (short-term repellent, red) at the start of the unrewarding branches of a bifurcation, which look
+//! magenta. The robot:
+//!
+//! 1. avoids (a sharp pivot) on a bumper hit;
+//! 2. wanders (correlated random walk) when no sensor sees the LAP;
+//! 3. at a bifurcation, picks a branch (below) and keeps to it for `commit_time` seconds;
+//! 4. otherwise follows the cyan trail (eq. 7 on the green channel) when any sensor sees cyan, else the
+//!    blue trail (eq. 7 on the blue channel).
+//!
+//! ## What a sensor sees
+//!
+//! Each sensor's calibrated intensities are thresholded at `threshold` into a [`TrailClass`]: `Off`
+//! (blue below threshold), `Magenta` (blue and red), `Cyan` (blue and green) or `Blue` (blue only).
+//!
+//! ## Bifurcation detection (the paper does not say how; this is our definition)
+//!
+//! A bifurcation is where the left (`n = 2`) and right (`n = 0`) sensors are both on the LAP and either
+//!
+//! * the front sensor (`n = 1`) is off the LAP: the robot straddles the wedge between two branches that
+//!   leave the fork at a clear angle (the trail maps use symmetric forks of +-35 degrees, so for a robot
+//!   within about a centimetre of the trail's centre line this pattern lasts 2-3 cm of travel), or
+//! * the left and right sensors see different classes (cyan on one side and blue or magenta on the
+//!   other), which happens a little earlier on the maps with SAP or SRP.
+//!
+//! Its kind ([`BifurcationKind`]) and the branch taken ([`Side`]):
+//!
+//! * `Magenta`: a side sees magenta. Take the side whose sensor reads more `green - red` (the cyan
+//!   branch; a coin decides a tie). Algorithm 1: "follow the cyan trail" at an LAP/SRP bifurcation.
+//! * `CyanBlue`: one side cyan, the other blue. Take the cyan side with probability
+//!   `cyan_probability` (0.7), the blue one otherwise (Algorithm 1).
+//! * `Plain`: both sides the same colour (every bifurcation with the LAP alone): a fair coin. Algorithm 1
+//!   only says "follow the LAP" there; with one trail colour a coin is the unbiased reading.
+//!
+//! After the decision the robot commits to the chosen branch for `commit_time` seconds: first it turns
+//! toward the chosen side on an arc, at `turn_rate` rad/s and `commit_speed` times the base speed, for
+//! as long as it takes to turn by `turn_angle` degrees (the fork's half-angle: this points it along the
+//! chosen branch; a robot knows its own wheel commands, nothing more is needed), then it follows the
+//! chosen trail by eq. (7) on that trail's signal (cyan: green; blue-only: `blue - green`; LAP: blue).
+//! No new bifurcation is detected while committed.
+use super::{check, eq7, BLUE, GREEN, RED, SENSOR_FRONT, SENSOR_LEFT, SENSOR_RIGHT};
+use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
+use crate::error::Result;
+use crate::rng::SimRng;
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+
+/// Parameters of [`Foraging`] as written in a scenario's `params` table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ForagingParams {
+    /// Base speed `v_b` of eq. (7), also the wandering speed, m/s.
+    pub speed: f32,
+    /// Sensitivity `p` of eq. (7): wheel speed difference per unit of left-right intensity difference, m/s.
+    pub sensitivity: f32,
+    /// Calibrated intensity (0..1) above which a sensor counts as on a pheromone.
+    pub threshold: f32,
+    /// Probability of following the cyan branch at a cyan/blue bifurcation (paper: 0.7).
+    pub cyan_probability: f32,
+    /// How long the robot keeps to the branch it chose, s.
+    pub commit_time: f32,
+    /// Angle of the turn into the chosen branch, degrees.
+    pub turn_angle: f32,
+    /// Yaw rate of that turn, rad/s.
+    pub turn_rate: f32,
+    /// Forward speed during that turn, as a fraction of `speed`.
+    pub commit_speed: f32,
+}
+
+impl Default for ForagingParams {
+    fn default() -> Self {
+        ForagingParams { speed: 0.1, sensitivity: 0.03, threshold: 0.3, cyan_probability: 0.7, commit_time: 1.0, turn_angle: 35.0, turn_rate: 3.0, commit_speed: 0.5 }
+    }
+}
+
+impl ForagingParams {
+    /// Checks every value; `key` is the scenario key path of the group (for errors).
+    pub fn validate(&self, key: &str) -> Result<()> {
+        check(key, "speed", self.speed, 0.0)?;
+        check(key, "sensitivity", self.sensitivity, 0.0)?;
+        check(key, "threshold", self.threshold, 0.0)?;
+        check(key, "commit_time", self.commit_time, 0.0)?;
+        check(key, "turn_angle", self.turn_angle, 0.0)?;
+        check(key, "turn_rate", self.turn_rate, 1e-3)?;
+        check(key, "commit_speed", self.commit_speed, 0.0)?;
+        if !(0.0..=1.0).contains(&self.cyan_probability) {
+            return Err(crate::error::SimError::invalid(format!("{key}.params.cyan_probability"), self.cyan_probability, "must be a probability in [0, 1]"));
+        }
+        Ok(())
+    }
+}
+
+/// What one colour sensor sees of the trails.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrailClass {
+    /// No LAP.
+    Off,
+    /// LAP only.
+    Blue,
+    /// LAP and SAP.
+    Cyan,
+    /// LAP and SRP.
+    Magenta,
+}
+
+impl TrailClass {
+    /// Class of one sensor's `[r, g, b]` intensities.
+    pub fn of(rgb: [f32; 3], threshold: f32) -> Self {
+        if !(rgb[BLUE] > threshold) {
+            TrailClass::Off
+        } else if rgb[RED] > threshold {
+            TrailClass::Magenta
+        } else if rgb[GREEN] > threshold {
+            TrailClass::Cyan
+        } else {
+            TrailClass::Blue
+        }
+    }
+}
+
+/// Which trail the robot steers on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Trail {
+    /// The LAP (blue channel).
+    Lap,
+    /// The cyan trail, LAP + SAP (green channel).
+    Cyan,
+    /// Blue but not cyan (`blue - green`): the blue branch of a cyan/blue bifurcation.
+    BlueOnly,
+}
+
+impl Trail {
+    /// The steering signal of eq. (7) for this trail at one sensor.
+    pub fn signal(self, rgb: [f32; 3]) -> f32 {
+        match self {
+            Trail::Lap => rgb[BLUE],
+            Trail::Cyan => rgb[GREEN],
+            Trail::BlueOnly => rgb[BLUE] - rgb[GREEN],
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    Left,
+    Right,
+}
+
+impl Side {
+    /// +1 for left (counter-clockwise), -1 for right.
+    pub fn sign(self) -> f32 {
+        match self {
+            Side::Left => 1.0,
+            Side::Right => -1.0,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BifurcationKind {
+    /// One side magenta (LAP + SRP): take the cyan side.
+    Magenta,
+    /// Cyan on one side, blue on the other: cyan with probability `cyan_probability`.
+    CyanBlue,
+    /// Both sides alike: a fair coin.
+    Plain,
+}
+
+/// The branch of Algorithm 1 taken in one control step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ForagingDecision {
+    /// A bumper fired (or a pivot is under way).
+    Avoid,
+    /// No sensor on the LAP.
+    Wander,
+    /// On the LAP only: eq. (7) on blue.
+    FollowLap,
+    /// On the cyan trail: eq. (7) on green.
+    FollowCyan,
+    /// A bifurcation was detected now and `side` chosen.
+    Bifurcation { kind: BifurcationKind, side: Side, trail: Trail },
+    /// Turning into the branch chosen at a recent bifurcation.
+    TurnInto { side: Side, trail: Trail },
+    /// Following the branch chosen at a recent bifurcation (no new bifurcation is detected).
+    Committed { side: Side, trail: Trail },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Commit {
+    /// End of the turn into the branch, s.
+    turn_until: f32,
+    until: f32,
+    side: Side,
+    trail: Trail,
+}
+
+/// Algorithm 1 as a behaviour (registered as `forage`).
+pub struct Foraging {
+    pub params: ForagingParams,
+    /// The robot's wheel base, m (to turn at a given yaw rate; the Colias default).
+    pub wheel_base: f32,
+    avoid: Avoid<Wander>,
+    commit: Option<Commit>,
+}
+
+/// The bifurcation seen by the sensors, if any (see the module documentation).
+pub fn detect_bifurcation(obs: &Observation, threshold: f32) -> Option<BifurcationKind> {
+    let class = |n: usize| TrailClass::of(obs.intensity[n], threshold);
+    let (l, r, f) = (class(SENSOR_LEFT), class(SENSOR_RIGHT), class(SENSOR_FRONT));
+    if l == TrailClass::Off || r == TrailClass::Off {
+        return None;
+    }
+    if f != TrailClass::Off && l == r {
+        return None;
+    }
+    use TrailClass::*;
+    Some(match (l, r) {
+        (Magenta, _) | (_, Magenta) => BifurcationKind::Magenta,
+        (Cyan, Blue) | (Blue, Cyan) => BifurcationKind::CyanBlue,
+        _ => BifurcationKind::Plain,
+    })
+}
+
+impl Foraging {
+    pub fn new(params: ForagingParams) -> Self {
+        let avoid = Avoid::new(Wander::new(params.speed));
+        Foraging { params, wheel_base: crate::robot::ColiasParams::default().wheel_base, avoid, commit: None }
+    }
+
+    /// True while the robot keeps to a chosen branch at `time`.
+    pub fn committed(&self, time: f32) -> bool {
+        self.commit.is_some_and(|c| time < c.until)
+    }
+
+    fn coin(rng: &mut SimRng) -> Side {
+        if rng.random::<f32>() < 0.5 { Side::Left } else { Side::Right }
+    }
+
+    /// The branch to take at a bifurcation of `kind`, and the trail to steer on.
+    pub fn choose(&self, kind: BifurcationKind, obs: &Observation, rng: &mut SimRng) -> (Side, Trail) {
+        let th = self.params.threshold;
+        let (l, r) = (obs.intensity[SENSOR_LEFT], obs.intensity[SENSOR_RIGHT]);
+        let trail_of = |rgb: [f32; 3]| if TrailClass::of(rgb, th) == TrailClass::Cyan { Trail::Cyan } else { Trail::Lap };
+        match kind {
+            BifurcationKind::Magenta => {
+                let score = |rgb: [f32; 3]| rgb[GREEN] - rgb[RED];
+                let side = match score(l).partial_cmp(&score(r)) {
+                    Some(std::cmp::Ordering::Greater) => Side::Left,
+                    Some(std::cmp::Ordering::Less) => Side::Right,
+                    _ => Self::coin(rng),
+                };
+                (side, trail_of(if side == Side::Left { l } else { r }))
+            }
+            BifurcationKind::CyanBlue => {
+                let cyan_side = if TrailClass::of(l, th) == TrailClass::Cyan { Side::Left } else { Side::Right };
+                if rng.random::<f32>() < self.params.cyan_probability {
+                    (cyan_side, Trail::Cyan)
+                } else {
+                    let blue_side = if cyan_side == Side::Left { Side::Right } else { Side::Left };
+                    (blue_side, Trail::BlueOnly)
+                }
+            }
+            BifurcationKind::Plain => {
+                let side = Self::coin(rng);
+                (side, trail_of(if side == Side::Left { l } else { r }))
+            }
+        }
+    }
+
+    /// Algorithm 1: which branch applies now. Updates the commitment state (and draws from `rng` at a
+    /// bifurcation).
+    pub fn decide(&mut self, obs: &Observation, rng: &mut SimRng) -> ForagingDecision {
+        if self.avoid.turning(obs.time) || obs.max_bumper() > self.avoid.threshold {
+            return ForagingDecision::Avoid;
+        }
+        let th = self.params.threshold;
+        if !obs.intensity.iter().any(|s| s[BLUE] > th) {
+            self.commit = None;
+            return ForagingDecision::Wander;
+        }
+        if let Some(c) = self.commit {
+            if obs.time < c.turn_until {
+                return ForagingDecision::TurnInto { side: c.side, trail: c.trail };
+            }
+            if obs.time < c.until {
+                return ForagingDecision::Committed { side: c.side, trail: c.trail };
+            }
+            self.commit = None;
+        }
+        if let Some(kind) = detect_bifurcation(obs, th) {
+            let (side, trail) = self.choose(kind, obs, rng);
+            let turn = self.params.turn_angle.to_radians() / self.params.turn_rate;
+            self.commit = Some(Commit { turn_until: obs.time + turn, until: obs.time + turn.max(self.params.commit_time), side, trail });
+            return ForagingDecision::Bifurcation { kind, side, trail };
+        }
+        if obs.intensity.iter().any(|&s| TrailClass::of(s, th) == TrailClass::Cyan) {
+            ForagingDecision::FollowCyan
+        } else {
+            ForagingDecision::FollowLap
+        }
+    }
+
+    /// Eq. (7) on `trail`.
+    pub fn steer(&self, obs: &Observation, trail: Trail) -> WheelCommand {
+        let p = &self.params;
+        let (l, r) = (trail.signal(obs.intensity[SENSOR_LEFT]), trail.signal(obs.intensity[SENSOR_RIGHT]));
+        eq7(l, r, p.sensitivity, p.speed)
+    }
+
+    /// The arc into the branch on `side`: forward at `commit_speed * speed`, yaw `turn_rate` toward it.
+    pub fn turn_into(&self, side: Side, wheel_base: f32) -> WheelCommand {
+        let p = &self.params;
+        let v = p.commit_speed * p.speed;
+        let half = 0.5 * p.turn_rate * wheel_base * side.sign();
+        WheelCommand::new(v - half, v + half)
+    }
+}
+
+impl Behaviour for Foraging {
+    fn name(&self) -> &str {
+        "forage"
+    }
+    fn act(&mut self, obs: &Observation, rng: &mut SimRng) -> WheelCommand {
+        match self.decide(obs, rng) {
+            // The avoid wrapper pivots on a bumper hit and wanders otherwise.
+            ForagingDecision::Avoid | ForagingDecision::Wander => self.avoid.act(obs, rng),
+            ForagingDecision::FollowLap => self.steer(obs, Trail::Lap),
+            ForagingDecision::FollowCyan => self.steer(obs, Trail::Cyan),
+            ForagingDecision::Bifurcation { side, .. } | ForagingDecision::TurnInto { side, .. } => self.turn_into(side, self.wheel_base),
+            ForagingDecision::Committed { trail, .. } => self.steer(obs, trail),
+        }
+    }
+}

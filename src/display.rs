@@ -1,0 +1,126 @@
+//! `colcos display SCENARIO`: the scenario's screen image, eq. (1), in a window at the field's rate (one
+//! world step per frame), full screen on a chosen monitor or windowed; or `--png` headless.
+use anyhow::{Context, Result};
+use colcos_sim::field::BackendChoice;
+use colcos_sim::prelude::*;
+use colcos_sim::screen;
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct DisplayArgs {
+    /// Scenario file (TOML).
+    pub scenario: PathBuf,
+    /// Borderless full screen (on --monitor, default the primary one), image at the panel's resolution.
+    #[arg(long)]
+    pub fullscreen: bool,
+    /// Monitor index (the window prints the list).
+    #[arg(long)]
+    pub monitor: Option<usize>,
+    /// Image size WxH [default: the panel's resolution full screen, 960 pixels wide in a window].
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Present without waiting for vertical blank.
+    #[arg(long)]
+    pub no_vsync: bool,
+    /// Headless: render the screen to this PNG (after --seconds of simulation) instead of a window.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Simulated seconds before the headless PNG.
+    #[arg(long, default_value_t = 0.0)]
+    pub seconds: f32,
+    /// Close the window after this many seconds of wall time.
+    #[arg(long)]
+    pub close_after: Option<f64>,
+    /// Field backend: cpu, gpu or auto (overrides the scenario's `field.backend`).
+    #[arg(long)]
+    pub backend: Option<BackendChoice>,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once('x').ok_or("expected WxH, e.g. 1920x1080")?;
+    let (w, h) = (w.parse::<u32>().map_err(|e| e.to_string())?, h.parse::<u32>().map_err(|e| e.to_string())?);
+    if w == 0 || h == 0 {
+        return Err("the size must be positive".into());
+    }
+    Ok((w, h))
+}
+
+fn rgba(img: image::RgbImage) -> Vec<u8> {
+    image::DynamicImage::ImageRgb8(img).to_rgba8().into_raw()
+}
+
+#[cfg(feature = "display")]
+struct WorldFrames {
+    world: World,
+    size: (u32, u32),
+    first: bool,
+}
+
+#[cfg(feature = "display")]
+impl colcos_display::FrameSource for WorldFrames {
+    fn size(&self) -> (u32, u32) {
+        self.size
+    }
+    fn next_frame(&mut self) -> Option<Vec<u8>> {
+        if !self.first {
+            if self.world.is_finished() {
+                return None;
+            }
+            self.world.step();
+        }
+        self.first = false;
+        let s = *self.world.screen();
+        Some(rgba(screen::render(self.world.pheromones(), &s, self.size.0, self.size.1)))
+    }
+}
+
+pub fn main(args: DisplayArgs) -> Result<()> {
+    let mut sc = Scenario::from_file(&args.scenario)?;
+    if let Some(b) = args.backend {
+        sc.spec.field.backend = b;
+    }
+    let mut world = World::new(&sc)?;
+    let backend = crate::backend::install(&mut world, sc.spec.field.backend)?;
+    eprintln!("field backend: {backend}");
+    let res = sc.spec.screen.resolution;
+    let size = args.size.unwrap_or(if args.fullscreen || args.png.is_some() {
+        (res[0], res[1])
+    } else {
+        (960, ((960.0 * res[1] as f64 / res[0].max(1) as f64).round() as u32).max(1))
+    });
+    if let Some(png) = &args.png {
+        while world.time() + 0.5 * world.dt() < args.seconds && !world.is_finished() {
+            world.step();
+        }
+        let img = screen::render(world.pheromones(), world.screen(), size.0, size.1);
+        #[cfg(feature = "display")]
+        let img = {
+            let rgba = image::RgbaImage::from_raw(size.0, size.1, rgba(img)).context("image buffer")?;
+            colcos_display::render_headless(&rgba, size)?
+        };
+        screen::save_png(&img, png)?;
+        println!("wrote {}", png.display());
+        return Ok(());
+    }
+    #[cfg(feature = "display")]
+    {
+        let opts = colcos_display::DisplayOptions {
+            title: format!("colcos: {}", sc.spec.name),
+            fullscreen: args.fullscreen,
+            monitor: args.monitor,
+            window_size: None,
+            position: None,
+            decorations: true,
+            vsync: !args.no_vsync,
+            frame_period: std::time::Duration::from_secs_f32(sc.spec.dt),
+            close_after: args.close_after.map(std::time::Duration::from_secs_f64),
+            announce_first_frame: false,
+        };
+        colcos_display::run_window(opts, Box::new(WorldFrames { world, size, first: true })).context("display window")
+    }
+    #[cfg(not(feature = "display"))]
+    {
+        let _ = world;
+        anyhow::bail!("this colcos was built without the `display` feature")
+    }
+}

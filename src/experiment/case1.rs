@@ -1,0 +1,191 @@
+//! Case I: three pheromones in ant foraging. Groups G1 (LAP), G2 (LAP + SAP), G3 (LAP + SAP + SRP),
+//! `trials` trials each; one robot per trial starting at the nest; a trial ends when the robot comes
+//! within `arrival_radius` of an end point, or times out.
+//!
+//! Speed-up (exact): with `d = 0` the field of eq. (2) under a static injection `J` tends to the steady
+//! state `e J`, and `Phi = e J` stays there for ever (`Phi <- a Phi + e (1 - a) J = e J`). The paper
+//! builds the trails before the robot starts ("the pheromone branches have been constructed already"),
+//! so every trial pre-loads `e J` at t = 0 and freezes the grid (no evaporation, no injection), which
+//! leaves the same field without stepping 140,000 cells per time step.
+use super::layout::TrailLayout;
+use anyhow::Result;
+use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::field::FieldModel;
+use colcos_sim::metrics::{arrival, ArrivalCounts, TrialOutcome};
+use colcos_sim::prelude::*;
+use rayon::prelude::*;
+
+/// The three groups: name and pheromones.
+pub const GROUPS: [(&str, &[&str]); 3] = [("G1", &["LAP"]), ("G2", &["LAP", "SAP"]), ("G3", &["LAP", "SAP", "SRP"])];
+
+#[derive(Clone, Debug)]
+pub struct Case1Config {
+    pub layout: TrailLayout,
+    /// Available food points, 1-based end point numbers.
+    pub foods: Vec<usize>,
+    pub trials: usize,
+    pub seed: u64,
+    /// Time limit of a trial, s.
+    pub timeout: f32,
+    /// A trial ends when the robot's centre is this close to an end point, m.
+    pub arrival_radius: f32,
+    /// Field grid cell, m.
+    pub cell: f32,
+    /// Keep one position every this many steps in the trajectories.
+    pub trajectory_every: u64,
+    /// Parameters of the `forage` behaviour (Algorithm 1).
+    pub forage: toml::Table,
+}
+
+impl Case1Config {
+    pub fn new(layout: TrailLayout, trials: usize, seed: u64) -> Self {
+        let foods = layout.default_foods();
+        let forage = std::env::var("COLCOS_FORAGE").ok().and_then(|t| toml::from_str(&t).ok()).unwrap_or_default();
+        Case1Config { layout, foods, trials, seed, timeout: 60.0, arrival_radius: 0.03, cell: 0.005, trajectory_every: 5, forage }
+    }
+
+    /// The scenario of group `g` (0, 1, 2 for G1, G2, G3).
+    pub fn scenario(&self, g: usize) -> Result<Scenario> {
+        let mut spec = self.layout.scenario_spec(&self.foods, GROUPS[g].1, self.seed, self.timeout, self.cell);
+        spec.robots[0].params = self.forage.clone();
+        Ok(Scenario::from_spec(spec, ".")?)
+    }
+}
+
+/// One trial: how it ended and the path (true positions).
+#[derive(Clone, Debug)]
+pub struct Trial {
+    pub outcome: TrialOutcome,
+    pub path: Vec<Vec2>,
+}
+
+#[derive(Clone, Debug)]
+pub struct GroupResult {
+    pub name: String,
+    pub pheromones: Vec<String>,
+    pub trials: Vec<Trial>,
+    pub counts: ArrivalCounts,
+}
+
+impl GroupResult {
+    /// Arrivals at the available food points.
+    pub fn at_food(&self, foods: &[usize]) -> usize {
+        let idx: Vec<usize> = foods.iter().map(|f| f - 1).collect();
+        self.counts.at(&idx)
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Case1Result {
+    pub config: Case1Config,
+    pub groups: Vec<GroupResult>,
+    pub wall_seconds: f64,
+}
+
+/// Sets every static grid field with no diffusion or wind to its steady state `e J` and freezes it.
+pub fn preload_steady_state(world: &mut World) {
+    for p in world.pheromones_mut() {
+        if let FieldModel::Grid(g) = &mut p.model {
+            let mut params = *g.params();
+            let e = params.evaporation;
+            if params.diffusion != 0.0 || params.wind != Vec2::ZERO || !(e.is_finite() && e > 0.0) {
+                continue;
+            }
+            let Some(j) = g.static_injection().map(|j| j.to_vec()) else { continue };
+            for (v, j) in g.values_mut().iter_mut().zip(j) {
+                *v = e * j;
+            }
+            g.clear_static_injection();
+            params.evaporation = f32::INFINITY;
+            g.set_params(params);
+        }
+    }
+}
+
+/// Runs one trial of `scenario` (world index `trial`).
+pub fn run_trial(scenario: &Scenario, trial: usize, ends: &[Vec2], radius: f32, every: u64) -> Result<Trial> {
+    let mut world = World::with_index(scenario, trial as u64)?;
+    preload_steady_state(&mut world);
+    // One still step so that the first observation the robot acts on sees the loaded trails.
+    world.step_with_commands(&[WheelCommand::STOP]);
+    let mut path = vec![world.poses()[0].pos];
+    let steps = scenario.steps();
+    let every = every.max(1);
+    for k in 1..=steps {
+        world.step();
+        let p = world.poses()[0].pos;
+        if k % every == 0 {
+            path.push(p);
+        }
+        if let Some(point) = arrival(p, ends, radius) {
+            path.push(p);
+            return Ok(Trial { outcome: TrialOutcome::Arrived { point, time: world.time() }, path });
+        }
+    }
+    Ok(Trial { outcome: TrialOutcome::TimedOut, path })
+}
+
+/// The (group, trial) tasks of case I, for a shared progress count.
+pub fn task_count(cfg: &Case1Config) -> usize {
+    GROUPS.len() * cfg.trials
+}
+
+/// Runs every trial of every group in parallel; results are gathered by (group, trial) index, so
+/// they do not depend on the thread count. `tick` is called once per finished trial.
+pub fn run(cfg: &Case1Config, tick: &(dyn Fn() + Sync)) -> Result<Case1Result> {
+    let started = std::time::Instant::now();
+    let scenarios: Vec<Scenario> = (0..GROUPS.len()).map(|g| cfg.scenario(g)).collect::<Result<_>>()?;
+    let ends = cfg.layout.end_points();
+    let tasks: Vec<(usize, usize)> = (0..GROUPS.len()).flat_map(|g| (0..cfg.trials).map(move |t| (g, t))).collect();
+    let results: Vec<Result<Trial>> = tasks
+        .par_iter()
+        .map(|&(g, t)| {
+            let r = run_trial(&scenarios[g], t, &ends, cfg.arrival_radius, cfg.trajectory_every);
+            tick();
+            r
+        })
+        .collect();
+    let mut groups: Vec<GroupResult> = GROUPS
+        .iter()
+        .map(|(name, ph)| GroupResult { name: name.to_string(), pheromones: ph.iter().map(|s| s.to_string()).collect(), trials: Vec::new(), counts: ArrivalCounts::default() })
+        .collect();
+    for (&(g, _), r) in tasks.iter().zip(results) {
+        groups[g].trials.push(r?);
+    }
+    for g in &mut groups {
+        let outcomes: Vec<TrialOutcome> = g.trials.iter().map(|t| t.outcome).collect();
+        g.counts = ArrivalCounts::tally(&outcomes, ends.len());
+    }
+    Ok(Case1Result { config: cfg.clone(), groups, wall_seconds: started.elapsed().as_secs_f64() })
+}
+
+/// `group,end_point,food,arrivals` rows, then one `group,timeout,,n` row per group.
+pub fn arrivals_csv(r: &Case1Result) -> String {
+    let mut s = String::from("group,pheromones,end_point,food,arrivals\n");
+    for g in &r.groups {
+        let ph = g.pheromones.join("+");
+        for (k, n) in g.counts.per_point.iter().enumerate() {
+            let food = r.config.foods.contains(&(k + 1));
+            s.push_str(&format!("{},{},{},{},{}\n", g.name, ph, k + 1, food as u8, n));
+        }
+        s.push_str(&format!("{},{},timeout,0,{}\n", g.name, ph, g.counts.timeouts));
+    }
+    s
+}
+
+/// One row per trial: group, trial, end point (or empty on timeout), time.
+pub fn trials_csv(r: &Case1Result) -> String {
+    let mut s = String::from("group,trial,end_point,food,time\n");
+    for g in &r.groups {
+        for (t, trial) in g.trials.iter().enumerate() {
+            match trial.outcome {
+                TrialOutcome::Arrived { point, time } => {
+                    let food = r.config.foods.contains(&(point + 1));
+                    s.push_str(&format!("{},{},{},{},{:.2}\n", g.name, t, point + 1, food as u8, time));
+                }
+                TrialOutcome::TimedOut => s.push_str(&format!("{},{},,0,{:.2}\n", g.name, t, r.config.timeout)),
+            }
+        }
+    }
+    s
+}

@@ -1,0 +1,200 @@
+//! `colcos experiment {case1,case2,all}`: the paper's two case studies, every trial in parallel, with
+//! their figures and a summary table beside the paper's numbers.
+//!
+//! Case I ([`case1`]): groups G1 (LAP), G2 (LAP + SAP), G3 (LAP + SAP + SRP) on a trail map generated
+//! from a tree ([`layout`]); arrivals per end point. Case II ([`case2`]): a leader, three followers and a
+//! predator under the aggregation (AGP) and alarm (ALP) pheromones; S(t) of eq. (9) with its phases.
+//! Results are deterministic per seed: each trial is its own world with its own random streams, and
+//! results are gathered by trial index, never by completion order.
+pub mod case1;
+pub mod case2;
+pub mod layout;
+pub mod plots;
+pub mod summary;
+
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+
+/// Which case studies to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Which {
+    Case1,
+    Case2,
+    All,
+}
+
+/// Arguments of `colcos experiment`.
+#[derive(Clone, Debug, clap::Args)]
+pub struct ExperimentArgs {
+    /// case1, case2 or all.
+    #[arg(value_enum)]
+    pub which: Which,
+    /// Trials per group in case I (the paper: 20).
+    #[arg(long, default_value_t = 20)]
+    pub trials: usize,
+    /// Independent runs of case II (the figures show the first).
+    #[arg(long, default_value_t = 4)]
+    pub runs: usize,
+    /// Output directory.
+    #[arg(long, default_value = "runs/experiment")]
+    pub out: PathBuf,
+    /// Seed of every random stream.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Trail layout of case I: A (default) or B.
+    #[arg(long, default_value = "A")]
+    pub layout: String,
+    /// Available food points of case I, 1-based, comma separated [default: the layout's, A: 3,10].
+    #[arg(long, value_delimiter = ',')]
+    pub foods: Option<Vec<usize>>,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Options of a whole experiment, as the library takes them.
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub which: Which,
+    pub trials: usize,
+    pub runs: usize,
+    pub out: PathBuf,
+    pub seed: u64,
+    pub layout: layout::TrailLayout,
+    pub foods: Vec<usize>,
+    pub progress: bool,
+}
+
+impl Options {
+    /// The defaults of the command line: 20 trials per group, 4 case-II runs, layout A, foods 3 and 10.
+    pub fn new(which: Which, out: impl Into<PathBuf>) -> Self {
+        let layout = layout::TrailLayout::a();
+        let foods = layout.default_foods();
+        Options { which, trials: 20, runs: 4, out: out.into(), seed: 1, layout, foods, progress: false }
+    }
+
+    pub fn from_args(a: &ExperimentArgs) -> Result<Self> {
+        let Some(layout) = layout::TrailLayout::by_name(&a.layout) else { bail!("unknown layout {:?} (known: A, B)", a.layout) };
+        let foods = a.foods.clone().unwrap_or_else(|| layout.default_foods());
+        for &f in &foods {
+            if f == 0 || f > layout.ends.len() {
+                bail!("food point {f} does not exist: layout {} has end points 1..={}", layout.name, layout.ends.len());
+            }
+        }
+        if a.trials == 0 {
+            bail!("--trials must be at least 1");
+        }
+        Ok(Options { which: a.which, trials: a.trials, runs: a.runs.max(1), out: a.out.clone(), seed: a.seed, layout, foods, progress: !a.quiet })
+    }
+}
+
+/// What an experiment produced.
+pub struct Report {
+    pub case1: Option<case1::Case1Result>,
+    pub case2: Option<case2::Case2Result>,
+    pub files: Vec<PathBuf>,
+    pub wall_seconds: f64,
+}
+
+fn progress_bar(len: u64, show: bool) -> indicatif::ProgressBar {
+    if !show {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40.cyan/blue} {pos}/{len} trials ({per_sec}, eta {eta})")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// Runs the chosen case studies (all their trials in parallel on rayon's pool) and writes every file
+/// under `opts.out`.
+pub fn run(opts: &Options) -> Result<Report> {
+    let started = std::time::Instant::now();
+    let out = &opts.out;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let do1 = matches!(opts.which, Which::Case1 | Which::All);
+    let do2 = matches!(opts.which, Which::Case2 | Which::All);
+    let cfg1 = do1.then(|| {
+        let mut c = case1::Case1Config::new(opts.layout.clone(), opts.trials, opts.seed);
+        c.foods = opts.foods.clone();
+        c
+    });
+    let cfg2 = if do2 { Some(case2::Case2Config::paper(opts.runs, opts.seed)?) } else { None };
+    let total = cfg1.as_ref().map_or(0, case1::task_count) + cfg2.as_ref().map_or(0, |c| c.runs);
+    let bar = progress_bar(total as u64, opts.progress);
+    let tick = || bar.inc(1);
+    // Both cases share the pool: case II's few long runs start first, case I's trials fill the gaps.
+    let (r2, r1) = rayon::join(|| cfg2.as_ref().map(|c| case2::run(c, &tick)).transpose(), || cfg1.as_ref().map(|c| case1::run(c, &tick)).transpose());
+    bar.finish_and_clear();
+    let (r1, r2) = (r1?, r2?);
+    let mut files = Vec::new();
+    if let Some(r) = &r1 {
+        files.extend(write_case1(r, &out.join("case1"))?);
+    }
+    if let Some(r) = &r2 {
+        files.extend(write_case2(r, &out.join("case2"))?);
+    }
+    let wall = started.elapsed().as_secs_f64();
+    files.extend(summary::write(out, r1.as_ref(), r2.as_ref(), wall)?);
+    Ok(Report { case1: r1, case2: r2, files, wall_seconds: wall })
+}
+
+fn write_case1(r: &case1::Case1Result, dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut files = Vec::new();
+    let csv = dir.join("arrivals.csv");
+    std::fs::write(&csv, case1::arrivals_csv(r)).with_context(|| format!("writing {}", csv.display()))?;
+    files.push(csv);
+    let trials = dir.join("trials.csv");
+    std::fs::write(&trials, case1::trials_csv(r)).with_context(|| format!("writing {}", trials.display()))?;
+    files.push(trials);
+    let f5 = dir.join("fig5_arrivals.png");
+    plots::fig5_arrivals(r, &f5)?;
+    files.push(f5);
+    let f6 = dir.join("fig6_g3_trajectories.png");
+    plots::fig6_trajectories(r, 2, &f6)?;
+    files.push(f6);
+    let all = dir.join("trajectories_all_groups.png");
+    plots::trajectories_all_groups(r, &all)?;
+    files.push(all);
+    Ok(files)
+}
+
+fn write_case2(r: &case2::Case2Result, dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut files = Vec::new();
+    let csv = dir.join("s_t.csv");
+    std::fs::write(&csv, case2::s_t_csv(r)).with_context(|| format!("writing {}", csv.display()))?;
+    files.push(csv);
+    let f8 = dir.join("fig8_s_t.png");
+    plots::fig8_s_t(r, &f8)?;
+    files.push(f8);
+    let f7 = dir.join("fig7_snapshots.png");
+    plots::fig7_snapshots(r, &f7)?;
+    files.push(f7);
+    let tr = dir.join("trajectories.png");
+    plots::case2_trajectories(r, &tr)?;
+    files.push(tr);
+    Ok(files)
+}
+
+/// Entry point of the command line: sets up the thread pool, runs, prints where the files are.
+pub fn main(args: ExperimentArgs) -> Result<()> {
+    if let Some(n) = args.threads {
+        rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting up the thread pool")?;
+    }
+    let opts = Options::from_args(&args)?;
+    let report = run(&opts)?;
+    print!("{}", summary::console(&report));
+    println!("wall time {:.2} s", report.wall_seconds);
+    for f in &report.files {
+        println!("  wrote {}", f.display());
+    }
+    Ok(())
+}
