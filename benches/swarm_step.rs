@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 const ARGOS_10K_REAL_TIME_FACTOR: f64 = 1.4;
 
-fn scenario(robots: usize, size: [f32; 2], resolution: [u32; 2], cell: f32) -> Scenario {
+pub fn scenario(robots: usize, size: [f32; 2], resolution: [u32; 2], cell: f32, physics: &str) -> Scenario {
     let per_group = robots / 3;
     let group = |lay: &str, follow: &str, count: usize| {
         format!(
@@ -26,6 +26,7 @@ deposits = [{{ pheromone = "{lay}", kernel = {{ shape = "disc", radius = 0.01 }}
     let text = format!(
         r#"
 duration = 10.0
+physics = "{physics}"
 [screen]
 resolution = [{rx}, {ry}]
 size = [{w}, {h}]
@@ -91,23 +92,32 @@ fn report(label: &str, step_s: f64, dt: f64, target: f64, peer: Option<(&str, f6
 }
 
 fn bench(c: &mut Criterion) {
-    let big = scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01);
-    let small = scenario(100, [1.439, 0.809], [3840, 2160], 0.005);
+    let big = scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, "discs");
+    let big_rapier = scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, "rapier");
+    let small = scenario(100, [1.439, 0.809], [3840, 2160], 0.005, "rapier");
     let mut w_big = World::new(&big).unwrap();
+    let mut w_big_rapier = World::new(&big_rapier).unwrap();
     let mut w_small = World::new(&small).unwrap();
 
     let mut g = c.benchmark_group("swarm_step");
     g.sample_size(20).measurement_time(Duration::from_secs(8)).warm_up_time(Duration::from_secs(2));
-    g.bench_function("10k_robots_1cm_grid", |b| b.iter(|| w_big.step()));
+    g.bench_function("10k_robots_1cm_grid_discs", |b| b.iter(|| w_big.step()));
+    g.bench_function("10k_robots_1cm_grid_rapier", |b| b.iter(|| w_big_rapier.step()));
     g.bench_function("100_robots_5mm_grid", |b| b.iter(|| w_small.step()));
     g.finish();
 
     println!("\n== swarm_step summary (dt = 20 ms, {} threads) ==", rayon::current_num_threads());
     let big_s = time_steps(&mut w_big, 10, 100);
-    report("10,000 robots, 14.4 x 8.1 m, 1 cm grid x3", big_s, 0.02, 2.0, Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)));
+    report("10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, disc solver", big_s, 0.02, 2.0, Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)));
+    let big_r = time_steps(&mut w_big_rapier, 5, 30);
+    report("10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, rapier", big_r, 0.02, 2.0, Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)));
     let small_s = time_steps(&mut w_small, 50, 2000);
     report("100 robots, 65-inch screen, 5 mm grid x3", small_s, 0.02, 100.0, None);
 }
 
-criterion_group!(benches, bench);
+criterion_group! {
+    name = benches;
+    config = Criterion::default().without_plots();
+    targets = bench
+}
 criterion_main!(benches);

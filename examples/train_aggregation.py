@@ -167,7 +167,7 @@ def main() -> None:
     learned = evaluate(lambda v: lambda o: model.act(o), task_kwargs, worlds, horizon)
     rand = evaluate(lambda v: RandomPolicy(v, seed=1).act, task_kwargs, worlds, horizon)
     names = colcos.behaviours()
-    follower = "follower" if "follower" in names else "avoid"
+    follower = "aggregation_follower" if "aggregation_follower" in names else "avoid"
     hand = evaluate(lambda v: Baseline(v, follower).act, task_kwargs, worlds, horizon)
     result = {
         "train_seconds": round(train_time, 1),

@@ -32,6 +32,19 @@ make_venv() { # name requirements
     "$v/bin/pip" install -q --force-reinstall --no-deps "$wheel"
 }
 
+peers="${COLCOS_PY_PEERS:-0}"
+cd "$here"
+status=0
+if [ "$peers" != 1 ]; then
+    echo "== core venv (PettingZoo, errors, vector env, determinism; COLCOS_PY_PEERS=1 adds the peer libraries)"
+    make_venv venv-core "$here/requirements-core.txt"
+    t2=$(stamp); echo "   installed in $((t2 - t1)) s"
+    "$work/venv-core/bin/python" -m pytest -q -p no:cacheprovider \
+        test_pettingzoo.py test_errors.py test_vector.py test_determinism.py "$@" || status=1
+    echo "== python part done in $(( $(stamp) - t0 )) s (status $status)"
+    exit $status
+fi
+
 echo "== main venv"
 make_venv venv-main "$here/requirements.txt"
 t2=$(stamp); echo "   installed in $((t2 - t1)) s"
@@ -39,8 +52,6 @@ echo "== rllib venv"
 make_venv venv-rllib "$here/requirements-rllib.txt"
 t3=$(stamp); echo "   installed in $((t3 - t2)) s"
 
-cd "$here"
-status=0
 echo "== pytest (main venv)"
 "$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --ignore=test_rllib.py "$@" || status=1
 t4=$(stamp); echo "   main suites in $((t4 - t3)) s"

@@ -19,7 +19,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut actions = vec![0.0f32; num_envs * n * 2];
     let t0 = std::time::Instant::now();
     for _ in 0..steps {
-        actions.iter_mut().for_each(|a| *a = rng.random_range(-1.0..1.0));
+        actions
+            .iter_mut()
+            .for_each(|a| *a = rng.random_range(-1.0..1.0));
         env.step(Actions::Continuous(&actions))?;
     }
     let secs = t0.elapsed().as_secs_f64();

@@ -3,7 +3,7 @@
 use crate::encoding::command_to_action;
 use crate::error::{EnvError, Result};
 use crate::vec_env::VecEnv;
-use colcos_sim::behaviour::{registry, Behaviour};
+use colcos_sim::behaviour::{Behaviour, registry};
 use colcos_sim::rng::{self, SimRng};
 
 /// Random streams of baseline policies sit far above the world's own.
@@ -24,11 +24,22 @@ impl BaselinePolicy {
     pub fn new(env: &VecEnv, name: &str, params: &serde_json::Value, seed: u64) -> Result<Self> {
         let params: toml::Table = match params {
             serde_json::Value::Null => toml::Table::new(),
-            v => toml::Table::try_from(v).map_err(|e| EnvError::param("params", format!("not a table of TOML-compatible values: {e}")))?,
+            v => toml::Table::try_from(v).map_err(|e| {
+                EnvError::param(
+                    "params",
+                    format!("not a table of TOML-compatible values: {e}"),
+                )
+            })?,
         };
         // Build once to check the name and parameters.
         registry::build(name, &params, "baseline")?;
-        let mut policy = BaselinePolicy { name: name.into(), params, seed, slots: Vec::new(), seen: Vec::new() };
+        let mut policy = BaselinePolicy {
+            name: name.into(),
+            params,
+            seed,
+            slots: Vec::new(),
+            seen: Vec::new(),
+        };
         let (e, n) = (env.spec().num_envs, env.spec().num_agents);
         for w in 0..e {
             for i in 0..n {
@@ -41,7 +52,14 @@ impl BaselinePolicy {
 
     fn make(&self, w: usize, i: usize, episode: u64) -> Result<(Box<dyn Behaviour>, SimRng)> {
         let b = registry::build(&self.name, &self.params, "baseline")?;
-        Ok((b, rng::stream(self.seed, crate::world_slot::world_index(w, episode), STREAM_BASELINE + i as u64)))
+        Ok((
+            b,
+            rng::stream(
+                self.seed,
+                crate::world_slot::world_index(w, episode),
+                STREAM_BASELINE + i as u64,
+            ),
+        ))
     }
 
     /// Continuous actions `[E, N, 2]` for the env's current observations.
@@ -49,7 +67,11 @@ impl BaselinePolicy {
         let spec = env.spec();
         let (e, n) = (spec.num_envs, spec.num_agents);
         if self.seen.len() != e || out.len() != e * n * 2 {
-            return Err(EnvError::Action(format!("baseline policy built for {} worlds; output must hold {} values", self.seen.len(), e * n * 2)));
+            return Err(EnvError::Action(format!(
+                "baseline policy built for {} worlds; output must hold {} values",
+                self.seen.len(),
+                e * n * 2
+            )));
         }
         for w in 0..e {
             let now = (env.episode(w), env.episode_steps(w));
@@ -64,7 +86,8 @@ impl BaselinePolicy {
             for (i, &robot) in spec.agent_robots.iter().enumerate() {
                 let (b, rng) = &mut self.slots[w * n + i];
                 let cmd = b.act(&world.observations()[robot], rng);
-                out[(w * n + i) * 2..(w * n + i) * 2 + 2].copy_from_slice(&command_to_action(cmd, max));
+                out[(w * n + i) * 2..(w * n + i) * 2 + 2]
+                    .copy_from_slice(&command_to_action(cmd, max));
             }
         }
         Ok(())

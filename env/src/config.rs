@@ -42,7 +42,10 @@ impl std::str::FromStr for ActionKind {
         match s {
             "continuous" => Ok(ActionKind::Continuous),
             "discrete" => Ok(ActionKind::Discrete),
-            _ => Err(EnvError::param("action", format!("{s:?} is not \"continuous\" or \"discrete\""))),
+            _ => Err(EnvError::param(
+                "action",
+                format!("{s:?} is not \"continuous\" or \"discrete\""),
+            )),
         }
     }
 }
@@ -66,7 +69,10 @@ impl std::str::FromStr for AutoresetMode {
             "next_step" | "nextstep" => Ok(AutoresetMode::NextStep),
             "same_step" | "samestep" => Ok(AutoresetMode::SameStep),
             "disabled" => Ok(AutoresetMode::Disabled),
-            _ => Err(EnvError::param("autoreset_mode", format!("{s:?} is not \"next_step\", \"same_step\" or \"disabled\""))),
+            _ => Err(EnvError::param(
+                "autoreset_mode",
+                format!("{s:?} is not \"next_step\", \"same_step\" or \"disabled\""),
+            )),
         }
     }
 }
@@ -83,7 +89,10 @@ pub struct PatchConfig {
 impl Default for PatchConfig {
     /// 16 x 16 pixels over 8 cm (2 robot diameters).
     fn default() -> Self {
-        PatchConfig { pixels: 16, side: 0.08 }
+        PatchConfig {
+            pixels: 16,
+            side: 0.08,
+        }
     }
 }
 

@@ -7,8 +7,23 @@ pub const OBS_DIM: usize = 17;
 
 /// Names of the observation vector's entries, in order.
 pub const OBS_NAMES: [&str; OBS_DIM] = [
-    "right_r", "right_g", "right_b", "front_r", "front_g", "front_b", "left_r", "left_g", "left_b", "back_r", "back_g", "back_b",
-    "bumper_front_left", "bumper_front", "bumper_front_right", "last_left", "last_right",
+    "right_r",
+    "right_g",
+    "right_b",
+    "front_r",
+    "front_g",
+    "front_b",
+    "left_r",
+    "left_g",
+    "left_b",
+    "back_r",
+    "back_g",
+    "back_b",
+    "bumper_front_left",
+    "bumper_front",
+    "bumper_front_right",
+    "last_left",
+    "last_right",
 ];
 
 /// Writes an observation: intensities in `[0, 1]` (sensors n = 0..3: right, front, left, back), bumpers
@@ -20,7 +35,11 @@ pub fn encode(obs: &Observation, max_speed: f32, out: &mut [f32]) {
         out[3 * n..3 * n + 3].copy_from_slice(&obs.intensity[n]);
     }
     out[12..15].copy_from_slice(&obs.bumpers);
-    let inv = if max_speed > 0.0 { 1.0 / max_speed } else { 0.0 };
+    let inv = if max_speed > 0.0 {
+        1.0 / max_speed
+    } else {
+        0.0
+    };
     out[15] = (obs.last_command.left * inv).clamp(-1.0, 1.0);
     out[16] = (obs.last_command.right * inv).clamp(-1.0, 1.0);
 }
@@ -38,7 +57,10 @@ pub const DISCRETE_ACTIONS: [(f32, f32); 6] = [
 /// A continuous action (fractions of `max_speed`, clamped to `[-1, 1]`) as a wheel command, m/s.
 #[inline]
 pub fn continuous_command(left: f32, right: f32, max_speed: f32) -> WheelCommand {
-    WheelCommand::new(left.clamp(-1.0, 1.0) * max_speed, right.clamp(-1.0, 1.0) * max_speed)
+    WheelCommand::new(
+        left.clamp(-1.0, 1.0) * max_speed,
+        right.clamp(-1.0, 1.0) * max_speed,
+    )
 }
 
 /// A discrete action as a wheel command, m/s (`None` if out of range).
@@ -51,6 +73,13 @@ pub fn discrete_command(action: i64, max_speed: f32) -> Option<WheelCommand> {
 /// A wheel command as the continuous action that produces it.
 #[inline]
 pub fn command_to_action(cmd: WheelCommand, max_speed: f32) -> [f32; 2] {
-    let inv = if max_speed > 0.0 { 1.0 / max_speed } else { 0.0 };
-    [(cmd.left * inv).clamp(-1.0, 1.0), (cmd.right * inv).clamp(-1.0, 1.0)]
+    let inv = if max_speed > 0.0 {
+        1.0 / max_speed
+    } else {
+        0.0
+    };
+    [
+        (cmd.left * inv).clamp(-1.0, 1.0),
+        (cmd.right * inv).clamp(-1.0, 1.0),
+    ]
 }

@@ -23,7 +23,10 @@ pub enum EnvError {
 
 impl EnvError {
     pub fn param(key: impl Into<String>, reason: impl Into<String>) -> Self {
-        EnvError::Param { key: key.into(), reason: reason.into() }
+        EnvError::Param {
+            key: key.into(),
+            reason: reason.into(),
+        }
     }
 }
 

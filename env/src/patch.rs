@@ -2,7 +2,7 @@
 use crate::config::PatchConfig;
 use colcos_sim::field::Pheromone;
 use colcos_sim::robot::Pose;
-use colcos_sim::screen::{pixel_at, ScreenSpec};
+use colcos_sim::screen::{ScreenSpec, pixel_at};
 use glam::Vec2;
 
 /// Fills `out` (`pixels * pixels * 3` bytes, row-major, RGB) with the screen around `pose`.
@@ -10,7 +10,13 @@ use glam::Vec2;
 /// The square spans a quarter of its side behind the robot's centre to three quarters ahead, centred
 /// left-right. Row 0 is the far edge ahead, column 0 the robot's left: the image is what the robot
 /// would see looking down with its forward direction up.
-pub fn sample(pheromones: &[Pheromone], screen: &ScreenSpec, pose: &Pose, cfg: &PatchConfig, out: &mut [u8]) {
+pub fn sample(
+    pheromones: &[Pheromone],
+    screen: &ScreenSpec,
+    pose: &Pose,
+    cfg: &PatchConfig,
+    out: &mut [u8],
+) {
     let p = cfg.pixels;
     let px = cfg.side / p as f32;
     for row in 0..p {

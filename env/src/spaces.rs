@@ -5,7 +5,12 @@
 #[derive(Clone, Debug, PartialEq)]
 pub enum Space {
     /// `Box(low, high, shape, dtype)`; `dtype` is `"float32"` or `"uint8"`.
-    Box { low: f32, high: f32, shape: Vec<usize>, dtype: &'static str },
+    Box {
+        low: f32,
+        high: f32,
+        shape: Vec<usize>,
+        dtype: &'static str,
+    },
     /// `Discrete(n)`.
     Discrete { n: usize },
 }

@@ -8,7 +8,7 @@ use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
 use crate::encoding::{self, OBS_DIM};
 use crate::error::{EnvError, Result};
 use crate::spaces::{EnvSpec, Space};
-use crate::task::{registry, Task};
+use crate::task::{Task, registry};
 use crate::world_slot::WorldSlot;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
@@ -77,16 +77,26 @@ impl VecEnv {
         }
         let (task, mut scenario) = registry::build(&cfg.task, &cfg.scenario, &cfg.params)?;
         scenario.spec.seed = cfg.seed;
-        let max_cycles = if cfg.max_cycles > 0 { cfg.max_cycles } else { scenario.steps().max(1) };
+        let max_cycles = if cfg.max_cycles > 0 {
+            cfg.max_cycles
+        } else {
+            scenario.steps().max(1)
+        };
         let n = task.agents().len();
         let robots = scenario.robot_count();
         let e = cfg.num_envs;
         if let Some(p) = cfg.patch {
             if p.pixels == 0 || p.pixels > 256 {
-                return Err(EnvError::param("patch_pixels", format!("{} must be in 1..=256", p.pixels)));
+                return Err(EnvError::param(
+                    "patch_pixels",
+                    format!("{} must be in 1..=256", p.pixels),
+                ));
             }
             if !(p.side.is_finite() && p.side > 0.0) {
-                return Err(EnvError::param("patch_side", format!("{} must be a positive length in m", p.side)));
+                return Err(EnvError::param(
+                    "patch_side",
+                    format!("{} must be a positive length in m", p.side),
+                ));
             }
         }
         let state_dim = if cfg.global_state { 4 * robots + 1 } else { 0 };
@@ -105,17 +115,44 @@ impl VecEnv {
             num_robots: robots,
             agent_names: (0..n).map(|i| format!("robot_{i}")).collect(),
             agent_robots: task.agents().to_vec(),
-            observation: Space::Box { low: -1.0, high: 1.0, shape: vec![OBS_DIM], dtype: "float32" },
-            action: match cfg.action {
-                ActionKind::Continuous => Space::Box { low: -1.0, high: 1.0, shape: vec![2], dtype: "float32" },
-                ActionKind::Discrete => Space::Discrete { n: encoding::DISCRETE_ACTIONS.len() },
+            observation: Space::Box {
+                low: -1.0,
+                high: 1.0,
+                shape: vec![OBS_DIM],
+                dtype: "float32",
             },
-            state: cfg.global_state.then(|| Space::Box { low: -1.0, high: 1.0, shape: vec![state_dim], dtype: "float32" }),
-            patch: cfg.patch.map(|p| Space::Box { low: 0.0, high: 255.0, shape: vec![p.pixels, p.pixels, 3], dtype: "uint8" }),
+            action: match cfg.action {
+                ActionKind::Continuous => Space::Box {
+                    low: -1.0,
+                    high: 1.0,
+                    shape: vec![2],
+                    dtype: "float32",
+                },
+                ActionKind::Discrete => Space::Discrete {
+                    n: encoding::DISCRETE_ACTIONS.len(),
+                },
+            },
+            state: cfg.global_state.then(|| Space::Box {
+                low: -1.0,
+                high: 1.0,
+                shape: vec![state_dim],
+                dtype: "float32",
+            }),
+            patch: cfg.patch.map(|p| Space::Box {
+                low: 0.0,
+                high: 255.0,
+                shape: vec![p.pixels, p.pixels, 3],
+                dtype: "uint8",
+            }),
             max_cycles,
             dt: scenario.spec.dt,
         };
-        let slots = pool.install(|| (0..e).into_par_iter().map(|w| WorldSlot::build(&scenario, task.as_ref(), w, 0)).collect::<Result<Vec<_>>>())?;
+        let slots = pool.install(|| {
+            (0..e)
+                .into_par_iter()
+                .map(|w| WorldSlot::build(&scenario, task.as_ref(), w, 0))
+                .collect::<Result<Vec<_>>>()
+        })?;
         let mut env = VecEnv {
             spec,
             task,
@@ -190,11 +227,19 @@ impl VecEnv {
     }
     /// Global state `[E, S]` (empty if disabled).
     pub fn state(&self) -> &[f32] {
-        if self.state_dim == 0 { &[] } else { &self.state }
+        if self.state_dim == 0 {
+            &[]
+        } else {
+            &self.state
+        }
     }
     /// Screen patches `[E, N, P, P, 3]` (empty if disabled).
     pub fn patch(&self) -> &[u8] {
-        if self.patch_len == 0 { &[] } else { &self.patch }
+        if self.patch_len == 0 {
+            &[]
+        } else {
+            &self.patch
+        }
     }
     /// Final observations of worlds that ended in the last step (same-step autoreset) `[E, N, OBS_DIM]`.
     pub fn final_obs(&self) -> &[f32] {
@@ -225,7 +270,10 @@ impl VecEnv {
     pub fn reset(&mut self, seed: Option<u64>, mask: Option<&[bool]>) -> Result<()> {
         let e = self.spec.num_envs;
         if let Some(m) = mask.filter(|m| m.len() != e) {
-            return Err(EnvError::Action(format!("reset mask has {} entries, expected num_envs = {e}", m.len())));
+            return Err(EnvError::Action(format!(
+                "reset mask has {} entries, expected num_envs = {e}",
+                m.len()
+            )));
         }
         if let Some(s) = seed {
             self.scenario.spec.seed = s;
@@ -236,13 +284,22 @@ impl VecEnv {
         let first = self.needs_reset;
         let slots = &mut self.slots;
         self.pool.install(|| {
-            slots.par_iter_mut().enumerate().try_for_each(|(w, slot)| -> Result<()> {
-                if mask.is_none_or(|m| m[w]) {
-                    let episode = if restart { 0 } else if first { slot.episode } else { slot.episode + 1 };
-                    *slot = WorldSlot::build(scenario, task, w, episode)?;
-                }
-                Ok(())
-            })
+            slots
+                .par_iter_mut()
+                .enumerate()
+                .try_for_each(|(w, slot)| -> Result<()> {
+                    if mask.is_none_or(|m| m[w]) {
+                        let episode = if restart {
+                            0
+                        } else if first {
+                            slot.episode
+                        } else {
+                            slot.episode + 1
+                        };
+                        *slot = WorldSlot::build(scenario, task, w, episode)?;
+                    }
+                    Ok(())
+                })
         })?;
         if mask.is_none() {
             self.needs_reset = false;
@@ -257,10 +314,14 @@ impl VecEnv {
             return Err(EnvError::State("call reset() before step()".into()));
         }
         self.decode(actions)?;
-        if self.mode == AutoresetMode::Disabled {
-            if let Some(w) = self.slots.iter().position(|s| s.done) {
-                return Err(EnvError::State(format!("world {w} has finished its episode; reset it (autoreset mode is disabled)")));
-            }
+        let blocked = match self.mode {
+            AutoresetMode::Disabled => self.slots.iter().position(|s| s.done),
+            _ => None,
+        };
+        if let Some(w) = blocked {
+            return Err(EnvError::State(format!(
+                "world {w} has finished its episode; reset it (autoreset mode is disabled)"
+            )));
         }
         let n = self.spec.num_agents;
         let ctx = Ctx {
@@ -285,18 +346,30 @@ impl VecEnv {
             .zip(self.patch.par_chunks_mut(n * pl))
             .zip(self.final_obs.par_chunks_mut(n * OBS_DIM))
             .zip(self.final_mask.par_iter_mut())
-            .map(|(((((((obs, rewards), terminated), truncated), state), patch), final_obs), final_mask)| Out {
-                obs,
-                rewards,
-                terminated,
-                truncated,
-                state,
-                patch,
-                final_obs,
-                final_mask,
-            });
+            .map(
+                |(
+                    ((((((obs, rewards), terminated), truncated), state), patch), final_obs),
+                    final_mask,
+                )| Out {
+                    obs,
+                    rewards,
+                    terminated,
+                    truncated,
+                    state,
+                    patch,
+                    final_obs,
+                    final_mask,
+                },
+            );
         self.pool.install(|| {
-            slots.par_iter_mut().zip(commands.par_chunks(n)).zip(outs).enumerate().try_for_each(|(w, ((slot, cmds), mut out))| step_world(&ctx, w, slot, cmds, &mut out))
+            slots
+                .par_iter_mut()
+                .zip(commands.par_chunks(n))
+                .zip(outs)
+                .enumerate()
+                .try_for_each(|(w, ((slot, cmds), mut out))| {
+                    step_world(&ctx, w, slot, cmds, &mut out)
+                })
         })
     }
 
@@ -307,11 +380,18 @@ impl VecEnv {
         match (actions, &self.spec.action) {
             (Actions::Continuous(a), Space::Box { .. }) => {
                 if a.len() != e * n * 2 {
-                    return Err(EnvError::Action(format!("expected {} values (num_envs {e} x agents {n} x 2 wheels), got {}", e * n * 2, a.len())));
+                    return Err(EnvError::Action(format!(
+                        "expected {} values (num_envs {e} x agents {n} x 2 wheels), got {}",
+                        e * n * 2,
+                        a.len()
+                    )));
                 }
                 if let Some(k) = a.iter().position(|v| !v.is_finite()) {
                     let (w, i, c) = (k / (2 * n), (k / 2) % n, k % 2);
-                    return Err(EnvError::Action(format!("action of world {w}, agent robot_{i}, wheel {c} is {} (must be finite)", a[k])));
+                    return Err(EnvError::Action(format!(
+                        "action of world {w}, agent robot_{i}, wheel {c} is {} (must be finite)",
+                        a[k]
+                    )));
                 }
                 for (cmd, pair) in self.commands.iter_mut().zip(a.chunks_exact(2)) {
                     *cmd = encoding::continuous_command(pair[0], pair[1], max);
@@ -319,15 +399,33 @@ impl VecEnv {
             }
             (Actions::Discrete(a), Space::Discrete { n: count }) => {
                 if a.len() != e * n {
-                    return Err(EnvError::Action(format!("expected {} actions (num_envs {e} x agents {n}), got {}", e * n, a.len())));
+                    return Err(EnvError::Action(format!(
+                        "expected {} actions (num_envs {e} x agents {n}), got {}",
+                        e * n,
+                        a.len()
+                    )));
                 }
                 for (k, (cmd, &v)) in self.commands.iter_mut().zip(a).enumerate() {
-                    *cmd = encoding::discrete_command(v, max)
-                        .ok_or_else(|| EnvError::Action(format!("action of world {}, agent robot_{} is {v}, not in 0..{count}", k / n, k % n)))?;
+                    *cmd = encoding::discrete_command(v, max).ok_or_else(|| {
+                        EnvError::Action(format!(
+                            "action of world {}, agent robot_{} is {v}, not in 0..{count}",
+                            k / n,
+                            k % n
+                        ))
+                    })?;
                 }
             }
-            (Actions::Continuous(_), _) => return Err(EnvError::Action("this environment has discrete actions (integers), got continuous ones".into())),
-            (Actions::Discrete(_), _) => return Err(EnvError::Action("this environment has continuous actions (floats, [.., 2]), got discrete ones".into())),
+            (Actions::Continuous(_), _) => {
+                return Err(EnvError::Action(
+                    "this environment has discrete actions (integers), got continuous ones".into(),
+                ));
+            }
+            (Actions::Discrete(_), _) => {
+                return Err(EnvError::Action(
+                    "this environment has continuous actions (floats, [.., 2]), got discrete ones"
+                        .into(),
+                ));
+            }
         }
         Ok(())
     }
@@ -339,12 +437,27 @@ impl VecEnv {
         let (sd, pl) = (self.state_dim, self.patch_len);
         let agents = self.task.agents();
         for (w, slot) in self.slots.iter().enumerate() {
-            write_obs(&slot.world, agents, ctx_max, &mut self.obs[w * n * OBS_DIM..(w + 1) * n * OBS_DIM]);
+            write_obs(
+                &slot.world,
+                agents,
+                ctx_max,
+                &mut self.obs[w * n * OBS_DIM..(w + 1) * n * OBS_DIM],
+            );
             if sd > 0 {
-                write_state(&slot.world, slot.steps, self.spec.max_cycles, &mut self.state[w * sd..(w + 1) * sd]);
+                write_state(
+                    &slot.world,
+                    slot.steps,
+                    self.spec.max_cycles,
+                    &mut self.state[w * sd..(w + 1) * sd],
+                );
             }
             if let Some(p) = &self.patch_cfg {
-                write_patch(&slot.world, agents, p, &mut self.patch[w * n * pl..(w + 1) * n * pl]);
+                write_patch(
+                    &slot.world,
+                    agents,
+                    p,
+                    &mut self.patch[w * n * pl..(w + 1) * n * pl],
+                );
             }
         }
         self.rewards.fill(0.0);
@@ -355,7 +468,12 @@ impl VecEnv {
 
     /// The screen with the robots drawn on it, `width` pixels wide, of world `e`.
     pub fn render(&self, e: usize, width: u32) -> Result<image::RgbImage> {
-        let slot = self.slots.get(e).ok_or_else(|| EnvError::param("world", format!("{e} is not below num_envs = {}", self.spec.num_envs)))?;
+        let slot = self.slots.get(e).ok_or_else(|| {
+            EnvError::param(
+                "world",
+                format!("{e} is not below num_envs = {}", self.spec.num_envs),
+            )
+        })?;
         Ok(render_world(&slot.world, self.task.agents(), width))
     }
 }
@@ -372,7 +490,13 @@ pub struct BufferPtrs {
     pub final_mask: *mut bool,
 }
 
-fn step_world(ctx: &Ctx, w: usize, slot: &mut WorldSlot, cmds: &[colcos_sim::behaviour::WheelCommand], out: &mut Out) -> Result<()> {
+fn step_world(
+    ctx: &Ctx,
+    w: usize,
+    slot: &mut WorldSlot,
+    cmds: &[colcos_sim::behaviour::WheelCommand],
+    out: &mut Out,
+) -> Result<()> {
     let agents = ctx.task.agents();
     *out.final_mask = false;
     if slot.done {
@@ -386,12 +510,17 @@ fn step_world(ctx: &Ctx, w: usize, slot: &mut WorldSlot, cmds: &[colcos_sim::beh
     }
     slot.decide_scripted();
     for ((&i, cmd), &term) in agents.iter().zip(cmds).zip(&slot.terminated) {
-        slot.commands[i] = if term { colcos_sim::behaviour::WheelCommand::STOP } else { *cmd };
+        slot.commands[i] = if term {
+            colcos_sim::behaviour::WheelCommand::STOP
+        } else {
+            *cmd
+        };
     }
     slot.world.step_with_commands(&slot.commands);
     slot.steps += 1;
     slot.prev_terminated.copy_from_slice(&slot.terminated);
-    ctx.task.evaluate(&slot.world, out.rewards, &mut slot.terminated);
+    ctx.task
+        .evaluate(&slot.world, out.rewards, &mut slot.terminated);
     for (r, &was) in out.rewards.iter_mut().zip(&slot.prev_terminated) {
         if was {
             *r = 0.0;
@@ -479,6 +608,12 @@ pub fn render_world(world: &World, agents: &[usize], width: u32) -> image::RgbIm
             image::Rgb(OTHERS[k % OTHERS.len()])
         })
         .collect();
-    colcos_sim::output::draw::robots(&mut img, screen, world.poses(), world.robot_params().radius, &colours);
+    colcos_sim::output::draw::robots(
+        &mut img,
+        screen,
+        world.poses(),
+        world.robot_params().radius,
+        &colours,
+    );
     img
 }

@@ -1,7 +1,7 @@
 //! One world of a batch: the sim world, the behaviours of its scripted robots, and episode bookkeeping.
 use crate::error::Result;
 use crate::task::Task;
-use colcos_sim::behaviour::{registry, Behaviour, WheelCommand};
+use colcos_sim::behaviour::{Behaviour, WheelCommand, registry};
 use colcos_sim::rng::{self, SimRng};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
@@ -44,8 +44,13 @@ impl WorldSlot {
         for (g, group) in scenario.spec.robots.iter().enumerate() {
             for i in first..first + group.count {
                 if !agents.contains(&i) {
-                    let behaviour = registry::build(&group.behaviour, &group.params, &format!("robots[{g}]"))?;
-                    scripted.push((i, behaviour, rng::stream(scenario.spec.seed, index, STREAM_SCRIPTED0 + i as u64)));
+                    let behaviour =
+                        registry::build(&group.behaviour, &group.params, &format!("robots[{g}]"))?;
+                    scripted.push((
+                        i,
+                        behaviour,
+                        rng::stream(scenario.spec.seed, index, STREAM_SCRIPTED0 + i as u64),
+                    ));
                 }
             }
             first += group.count;

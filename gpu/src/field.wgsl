@@ -6,7 +6,7 @@
 // slot; in-place passes write the slot they read.
 
 struct PF {
-    active: u32,
+    on: u32,
     src: u32,
     inj: i32,    // offset of the field's static injection map in `inj`, or -1
     coef: u32,   // offset of the field's Thomas coefficients in `coef`
@@ -74,7 +74,7 @@ fn evaporate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
     let f = wg.z;
     if (k >= n) { return; }
     let e = entry(f);
-    if (e.active == 0u) { return; }
+    if (e.on == 0u) { return; }
     let s = (2u * f + e.src) * n;
     if (e.inj >= 0) {
         vals[s + k] = psi(e, s, k);
@@ -95,7 +95,7 @@ fn explicit_step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation
     let f = wg.z;
     if (k >= n) { return; }
     let e = entry(f);
-    if (e.active == 0u) { return; }
+    if (e.on == 0u) { return; }
     let s = (2u * f + e.src) * n;
     let d = (2u * f + 1u - e.src) * n;
     let x = k % nx;
@@ -143,7 +143,7 @@ fn one_sided(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
     let f = wg.z;
     if (k >= n) { return; }
     let e = entry(f);
-    if (e.active == 0u) { return; }
+    if (e.on == 0u) { return; }
     let s = (2u * f + e.src) * n;
     let d = (2u * f + 1u - e.src) * n;
     let x = k % nx;
@@ -169,7 +169,7 @@ fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let f = gid.z;
     if (row >= ny) { return; }
     let e = entry(f);
-    if (e.active == 0u) { return; }
+    if (e.on == 0u) { return; }
     let s = (2u * f + e.src) * n + row * nx;
     let d = (2u * f + 1u - e.src) * n + row * nx;
     let m = e.coef;
@@ -206,7 +206,7 @@ fn ysolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let f = gid.z;
     if (col >= nx) { return; }
     let e = entry(f);
-    if (e.active == 0u) { return; }
+    if (e.on == 0u) { return; }
     let s = (2u * f + e.src) * n + col;
     let d = (2u * f + 1u - e.src) * n + col;
     let m = e.coef + 2u * nx;
@@ -233,7 +233,7 @@ fn advect_x(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
     let f = wg.z;
     if (k >= n) { return; }
     let e = entry(f);
-    if (e.active == 0u) { return; }
+    if (e.on == 0u) { return; }
     let s = (2u * f + e.src) * n;
     let d = (2u * f + 1u - e.src) * n;
     let x = k % nx;
@@ -271,7 +271,7 @@ fn advect_y(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
     let f = wg.z;
     if (k >= n) { return; }
     let e = entry(f);
-    if (e.active == 0u) { return; }
+    if (e.on == 0u) { return; }
     let s = (2u * f + e.src) * n;
     let d = (2u * f + 1u - e.src) * n;
     let y = k / nx;

@@ -19,7 +19,7 @@ const MAX_GROUPS: u32 = 65535;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 struct PlanEntry {
-    active: u32,
+    on: u32,
     src: u32,
     inj: i32,
     coef: u32,
@@ -554,7 +554,7 @@ impl GpuGrids {
                 .map(|f| match make(f) {
                     Some(mut e) => {
                         any = true;
-                        e.active = 1;
+                        e.on = 1;
                         e.src = slots[f];
                         e.coef = (f * coef_stride) as u32;
                         if kind.flips() {
@@ -622,7 +622,7 @@ impl GpuGrids {
                     .map(|f| match make(f) {
                         Some(mut e) => {
                             any = true;
-                            e.active = 1;
+                            e.on = 1;
                             e.src = slots[f];
                             slots[f] ^= 1;
                             e

@@ -63,10 +63,12 @@ cell = 0.005
 name = "agp"
 colour = [0, 255, 0]
 model = "gaussian"
+evaporation = 5.0
 [[pheromones]]
 name = "alp"
 colour = [255, 0, 0]
 model = "gaussian"
+evaporation = 2.0
 [[pheromones]]
 name = "trail"
 colour = [0, 0, 255]

@@ -4,11 +4,36 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-create_exception!(colcos, ColcosError, PyValueError, "Base of every error colcos raises on bad input.");
-create_exception!(colcos, ScenarioError, ColcosError, "A scenario file or text could not be read, parsed or validated.");
-create_exception!(colcos, TaskError, ColcosError, "Unknown task, or an unknown or invalid task/environment parameter.");
-create_exception!(colcos, ActionError, ColcosError, "Actions of the wrong shape or dtype, non-finite, out of range, or for an unknown agent.");
-create_exception!(colcos, StateError, ColcosError, "A call that is not valid now (e.g. step before reset).");
+create_exception!(
+    colcos,
+    ColcosError,
+    PyValueError,
+    "Base of every error colcos raises on bad input."
+);
+create_exception!(
+    colcos,
+    ScenarioError,
+    ColcosError,
+    "A scenario file or text could not be read, parsed or validated."
+);
+create_exception!(
+    colcos,
+    TaskError,
+    ColcosError,
+    "Unknown task, or an unknown or invalid task/environment parameter."
+);
+create_exception!(
+    colcos,
+    ActionError,
+    ColcosError,
+    "Actions of the wrong shape or dtype, non-finite, out of range, or for an unknown agent."
+);
+create_exception!(
+    colcos,
+    StateError,
+    ColcosError,
+    "A call that is not valid now (e.g. step before reset)."
+);
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();

@@ -1,8 +1,12 @@
 //! `colcos._core.VecEnv`: the batched environment, its buffers handed to Python as numpy views.
-use crate::errors::{to_py, ActionError, TaskError};
-use colcos_env::{ActionKind, Actions, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource, Space, VecEnv};
+use crate::errors::{ActionError, TaskError, to_py};
+use colcos_env::{
+    ActionKind, Actions, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource, Space, VecEnv,
+};
 use numpy::ndarray::{ArrayView, IxDyn};
-use numpy::{Element, PyArray, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{
+    Element, PyArray, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Mutex;
@@ -31,7 +35,12 @@ impl PyVecEnv {
 fn space_dict<'py>(py: Python<'py>, space: &Space) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     match space {
-        Space::Box { low, high, shape, dtype } => {
+        Space::Box {
+            low,
+            high,
+            shape,
+            dtype,
+        } => {
             d.set_item("kind", "box")?;
             d.set_item("low", low)?;
             d.set_item("high", high)?;
@@ -50,7 +59,11 @@ fn space_dict<'py>(py: Python<'py>, space: &Space) -> PyResult<Bound<'py, PyDict
 ///
 /// # Safety
 /// `ptr..ptr + product(shape)` must stay valid for as long as `owner` lives.
-unsafe fn view<'py, T: Element>(owner: &Bound<'py, PyAny>, ptr: *mut T, shape: Vec<usize>) -> PyResult<Bound<'py, PyAny>> {
+unsafe fn view<'py, T: Element>(
+    owner: &Bound<'py, PyAny>,
+    ptr: *mut T,
+    shape: Vec<usize>,
+) -> PyResult<Bound<'py, PyAny>> {
     let a = unsafe { ArrayView::from_shape_ptr(IxDyn(&shape), ptr as *const T) };
     Ok(unsafe { PyArray::borrow_from_array(&a, owner.clone()) }.into_any())
 }
@@ -78,13 +91,19 @@ impl PyVecEnv {
     ) -> PyResult<Self> {
         let mut cfg = EnvConfig::new(task);
         cfg.scenario = match (scenario, scenario_text) {
-            (Some(_), Some(_)) => return Err(TaskError::new_err("give either scenario (a path) or scenario_text, not both")),
+            (Some(_), Some(_)) => {
+                return Err(TaskError::new_err(
+                    "give either scenario (a path) or scenario_text, not both",
+                ));
+            }
             (Some(p), None) => ScenarioSource::File(p),
             (None, Some(t)) => ScenarioSource::Text(t),
             (None, None) => ScenarioSource::Default,
         };
         cfg.params = match params_json {
-            Some(s) => serde_json::from_str(s).map_err(|e| TaskError::new_err(format!("task parameters are not valid JSON: {e}")))?,
+            Some(s) => serde_json::from_str(s).map_err(|e| {
+                TaskError::new_err(format!("task parameters are not valid JSON: {e}"))
+            })?,
             None => serde_json::Value::Object(Default::default()),
         };
         cfg.num_envs = num_envs;
@@ -94,10 +113,19 @@ impl PyVecEnv {
         cfg.action = action.parse::<ActionKind>().map_err(to_py)?;
         cfg.autoreset = autoreset_mode.parse::<AutoresetMode>().map_err(to_py)?;
         cfg.global_state = global_state;
-        cfg.patch = patch_pixels.map(|pixels| PatchConfig { pixels, side: patch_side });
+        cfg.patch = patch_pixels.map(|pixels| PatchConfig {
+            pixels,
+            side: patch_side,
+        });
         let env = py.detach(|| VecEnv::new(&cfg)).map_err(to_py)?;
         let (e, n) = (env.spec().num_envs, env.spec().num_agents);
-        Ok(PyVecEnv { inner: Mutex::new(Inner { env, actions_f: vec![0.0; e * n * 2], actions_i: vec![0; e * n] }) })
+        Ok(PyVecEnv {
+            inner: Mutex::new(Inner {
+                env,
+                actions_f: vec![0.0; e * n * 2],
+                actions_i: vec![0; e * n],
+            }),
+        })
     }
 
     /// Sizes, names and spaces, as a dict.
@@ -114,11 +142,20 @@ impl PyVecEnv {
         d.set_item("agent_robots", s.agent_robots.clone())?;
         d.set_item("observation", space_dict(py, &s.observation)?)?;
         d.set_item("action", space_dict(py, &s.action)?)?;
-        d.set_item("state", s.state.as_ref().map(|x| space_dict(py, x)).transpose()?)?;
-        d.set_item("patch", s.patch.as_ref().map(|x| space_dict(py, x)).transpose()?)?;
+        d.set_item(
+            "state",
+            s.state.as_ref().map(|x| space_dict(py, x)).transpose()?,
+        )?;
+        d.set_item(
+            "patch",
+            s.patch.as_ref().map(|x| space_dict(py, x)).transpose()?,
+        )?;
         d.set_item("max_cycles", s.max_cycles)?;
         d.set_item("dt", s.dt)?;
-        d.set_item("autoreset_mode", format!("{:?}", inner.env.autoreset_mode()))?;
+        d.set_item(
+            "autoreset_mode",
+            format!("{:?}", inner.env.autoreset_mode()),
+        )?;
         Ok(d)
     }
 
@@ -144,13 +181,19 @@ impl PyVecEnv {
             d.set_item("rewards", view(&owner, ptrs.rewards, vec![e, n])?)?;
             d.set_item("terminated", view(&owner, ptrs.terminated, vec![e, n])?)?;
             d.set_item("truncated", view(&owner, ptrs.truncated, vec![e, n])?)?;
-            d.set_item("final_obs", view(&owner, ptrs.final_obs, vec![e, n, d_obs])?)?;
+            d.set_item(
+                "final_obs",
+                view(&owner, ptrs.final_obs, vec![e, n, d_obs])?,
+            )?;
             d.set_item("final_mask", view(&owner, ptrs.final_mask, vec![e])?)?;
             if let Some(s) = &spec.state {
                 d.set_item("state", view(&owner, ptrs.state, vec![e, s.flat_len()])?)?;
             }
             if let Some(Space::Box { shape, .. }) = &spec.patch {
-                d.set_item("patch", view(&owner, ptrs.patch, vec![e, n, shape[0], shape[1], shape[2]])?)?;
+                d.set_item(
+                    "patch",
+                    view(&owner, ptrs.patch, vec![e, n, shape[0], shape[1], shape[2]])?,
+                )?;
             }
         }
         Ok(d)
@@ -158,17 +201,26 @@ impl PyVecEnv {
 
     /// Resets the worlds where `mask` is true (all if None); a seed restarts the episode count.
     #[pyo3(signature = (seed=None, mask=None))]
-    fn reset(&self, py: Python<'_>, seed: Option<u64>, mask: Option<PyReadonlyArrayDyn<'_, bool>>) -> PyResult<()> {
+    fn reset(
+        &self,
+        py: Python<'_>,
+        seed: Option<u64>,
+        mask: Option<PyReadonlyArrayDyn<'_, bool>>,
+    ) -> PyResult<()> {
         let mask: Option<Vec<bool>> = match mask {
             Some(m) => {
                 if m.ndim() != 1 {
-                    return Err(ActionError::new_err(format!("reset mask must be 1-D of length num_envs, got shape {:?}", m.shape())));
+                    return Err(ActionError::new_err(format!(
+                        "reset mask must be 1-D of length num_envs, got shape {:?}",
+                        m.shape()
+                    )));
                 }
                 Some(m.as_array().iter().copied().collect())
             }
             None => None,
         };
-        py.detach(|| self.lock().env.reset(seed, mask.as_deref())).map_err(to_py)
+        py.detach(|| self.lock().env.reset(seed, mask.as_deref()))
+            .map_err(to_py)
     }
 
     /// Steps every world. `actions`: float32 `[E, N, 2]` (continuous) or int64 `[E, N]` (discrete),
@@ -180,35 +232,60 @@ impl PyVecEnv {
         let (e, n) = (s.num_envs, s.num_agents);
         let discrete = matches!(s.action, Space::Discrete { .. });
         if discrete {
-            let a: PyReadonlyArrayDyn<'_, i64> = actions
-                .extract()
-                .map_err(|_| ActionError::new_err("discrete actions must be an int64 numpy array of shape (num_envs, num_agents)"))?;
+            let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
+                ActionError::new_err(
+                    "discrete actions must be an int64 numpy array of shape (num_envs, num_agents)",
+                )
+            })?;
             if a.shape() != [e, n] {
-                return Err(ActionError::new_err(format!("actions have shape {:?}, expected ({e}, {n}) = (num_envs, num_agents)", a.shape())));
+                return Err(ActionError::new_err(format!(
+                    "actions have shape {:?}, expected ({e}, {n}) = (num_envs, num_agents)",
+                    a.shape()
+                )));
             }
-            inner.actions_i.iter_mut().zip(a.as_array().iter()).for_each(|(d, s)| *d = *s);
+            inner
+                .actions_i
+                .iter_mut()
+                .zip(a.as_array().iter())
+                .for_each(|(d, s)| *d = *s);
             let (env, acts) = (&mut inner.env, &inner.actions_i);
-            py.detach(|| env.step(Actions::Discrete(acts))).map_err(to_py)
+            py.detach(|| env.step(Actions::Discrete(acts)))
+                .map_err(to_py)
         } else {
             let a: PyReadonlyArrayDyn<'_, f32> = actions
                 .extract()
                 .map_err(|_| ActionError::new_err("continuous actions must be a float32 numpy array of shape (num_envs, num_agents, 2)"))?;
             if a.shape() != [e, n, 2] {
-                return Err(ActionError::new_err(format!("actions have shape {:?}, expected ({e}, {n}, 2) = (num_envs, num_agents, wheels)", a.shape())));
+                return Err(ActionError::new_err(format!(
+                    "actions have shape {:?}, expected ({e}, {n}, 2) = (num_envs, num_agents, wheels)",
+                    a.shape()
+                )));
             }
             match a.as_slice() {
                 Ok(src) => inner.actions_f.copy_from_slice(src),
-                Err(_) => inner.actions_f.iter_mut().zip(a.as_array().iter()).for_each(|(d, s)| *d = *s),
+                Err(_) => inner
+                    .actions_f
+                    .iter_mut()
+                    .zip(a.as_array().iter())
+                    .for_each(|(d, s)| *d = *s),
             }
             let (env, acts) = (&mut inner.env, &inner.actions_f);
-            py.detach(|| env.step(Actions::Continuous(acts))).map_err(to_py)
+            py.detach(|| env.step(Actions::Continuous(acts)))
+                .map_err(to_py)
         }
     }
 
     /// The screen of world `world` with the robots drawn on it, `(H, W, 3)` uint8.
     #[pyo3(signature = (world=0, width=640))]
-    fn render<'py>(&self, py: Python<'py>, world: usize, width: u32) -> PyResult<Bound<'py, PyAny>> {
-        let img = py.detach(|| self.lock().env.render(world, width)).map_err(to_py)?;
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        world: usize,
+        width: u32,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let img = py
+            .detach(|| self.lock().env.render(world, width))
+            .map_err(to_py)?;
         let (w, h) = (img.width() as usize, img.height() as usize);
         let flat = PyArray1::from_vec(py, img.into_raw());
         Ok(flat.reshape([h, w, 3])?.into_any())
@@ -232,7 +309,11 @@ impl PyVecEnv {
         self.check_world(world)?;
         let inner = self.lock();
         let w = inner.env.world(world).expect("checked");
-        let flat: Vec<f32> = w.poses().iter().flat_map(|p| [p.pos.x, p.pos.y, p.heading]).collect();
+        let flat: Vec<f32> = w
+            .poses()
+            .iter()
+            .flat_map(|p| [p.pos.x, p.pos.y, p.heading])
+            .collect();
         let r = w.robot_count();
         Ok(PyArray1::from_vec(py, flat).reshape([r, 3])?.into_any())
     }
@@ -241,7 +322,9 @@ impl PyVecEnv {
     fn roles(&self) -> Vec<String> {
         let inner = self.lock();
         let w = inner.env.world(0).expect("num_envs >= 1");
-        (0..w.robot_count()).map(|i| w.role(i).to_string()).collect()
+        (0..w.robot_count())
+            .map(|i| w.role(i).to_string())
+            .collect()
     }
 
     /// The scenario actually used, as TOML.
@@ -260,7 +343,9 @@ impl PyVecEnv {
     fn check_world(&self, world: usize) -> PyResult<()> {
         let e = self.lock().env.spec().num_envs;
         if world >= e {
-            return Err(TaskError::new_err(format!("world {world} does not exist (num_envs = {e})")));
+            return Err(TaskError::new_err(format!(
+                "world {world} does not exist (num_envs = {e})"
+            )));
         }
         Ok(())
     }

@@ -33,15 +33,14 @@ pub struct Case1Config {
     pub cell: f32,
     /// Keep one position every this many steps in the trajectories.
     pub trajectory_every: u64,
-    /// Parameters of the `forage` behaviour (Algorithm 1).
+    /// Parameters of the `forage` behaviour (Algorithm 1); empty: its defaults.
     pub forage: toml::Table,
 }
 
 impl Case1Config {
     pub fn new(layout: TrailLayout, trials: usize, seed: u64) -> Self {
         let foods = layout.default_foods();
-        let forage = std::env::var("COLCOS_FORAGE").ok().and_then(|t| toml::from_str(&t).ok()).unwrap_or_default();
-        Case1Config { layout, foods, trials, seed, timeout: 60.0, arrival_radius: 0.03, cell: 0.005, trajectory_every: 5, forage }
+        Case1Config { layout, foods, trials, seed, timeout: 60.0, arrival_radius: 0.03, cell: 0.005, trajectory_every: 5, forage: toml::Table::new() }
     }
 
     /// The scenario of group `g` (0, 1, 2 for G1, G2, G3).

@@ -48,9 +48,10 @@ pub struct Case2Run {
     pub roles: Vec<String>,
     /// (time, screen with the robots drawn on it).
     pub snapshots: Vec<(f32, image::RgbImage)>,
-    /// Relative fall of S over the first aggregation phase.
+    /// Largest relative fall of S over an aggregation phase (from the phase's start to its minimum).
     pub aggregation_fall: f32,
-    /// Relative rise of S over the first dispersion phase (None: no alarm in the run).
+    /// Largest relative rise of S over a dispersion phase (from the alarm to the phase's maximum; None:
+    /// no alarm in the run).
     pub alarm_rise: Option<f32>,
 }
 
@@ -116,8 +117,8 @@ pub fn run_one(cfg: &Case2Config, index: usize) -> Result<Case2Run> {
         }
     }
     let phases = phases(&times, &alarm);
-    let aggregation_fall = phases.iter().find(|p| p.kind == PhaseKind::Aggregation).map_or(0.0, |p| relative_fall(&s, p.first, p.last));
-    let alarm_rise = phases.iter().find(|p| p.kind == PhaseKind::Dispersion).map(|p| relative_rise(&s, p.first, p.last));
+    let aggregation_fall = phases.iter().filter(|p| p.kind == PhaseKind::Aggregation).map(|p| relative_fall(&s, p.first, p.last)).fold(0.0, f32::max);
+    let alarm_rise = phases.iter().filter(|p| p.kind == PhaseKind::Dispersion).map(|p| relative_rise(&s, p.first, p.last)).reduce(f32::max);
     Ok(Case2Run { times, s, alarm, phases, paths, roles, snapshots, aggregation_fall, alarm_rise })
 }
 

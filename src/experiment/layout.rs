@@ -101,7 +101,7 @@ fn banded(name: &str, bands: [Band; 4], mirror: bool) -> TrailLayout {
         nodes,
         ends,
         fork_half_angle_deg: 35.0,
-        width: 0.04,
+        width: 0.06,
         arena: Vec2::from(SCREEN),
         srp_start: 0.03,
         srp_end: 0.15,
@@ -176,7 +176,7 @@ impl TrailLayout {
         };
         let (p0, p3) = (p.pos, c.pos);
         let len = p0.distance(p3);
-        let a = 0.4 * len;
+        let a = 0.3 * len;
         let p1 = p0 + Vec2::from_angle(start) * a;
         let p2 = p3 - Vec2::from_angle(c.heading_deg.to_radians()) * a;
         let n = ((len / 0.01).ceil() as usize).max(2);

@@ -59,9 +59,9 @@ pub fn case1_claims(r: &Case1Result) -> Case1Claims {
 /// The reading of the paper's case-II claims, measured on every run.
 #[derive(Clone, Debug, Serialize)]
 pub struct Case2Claims {
-    /// Per run: relative fall of S over the first aggregation phase.
+    /// Per run: the largest relative fall of S over an aggregation phase.
     pub falls: Vec<f32>,
-    /// Per run: relative rise of S over the first dispersion phase (None: no alarm happened).
+    /// Per run: the largest relative rise of S over a dispersion phase (None: no alarm happened).
     pub rises: Vec<Option<f32>>,
     /// Every run: fall >= 0.5.
     pub fall_ok: bool,

@@ -4,13 +4,14 @@
 //! Reward per follower and step: `-distance_weight * d(leader) / arena diagonal`, minus
 //! `capture_penalty` while a predator is within `capture_distance`. No termination: episodes end by
 //! truncation.
-use super::{check_non_negative, parse_params, require_role, Task};
+use super::{Task, check_non_negative, parse_params, require_role};
 use crate::error::Result;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
 use serde::Deserialize;
 
-pub const DESCRIPTION: &str = "case II: followers gather at the leader and flee the alarm near the predator";
+pub const DESCRIPTION: &str =
+    "case II: followers gather at the leader and flee the alarm near the predator";
 pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/aggregation.toml");
 
 #[derive(Deserialize)]
@@ -80,7 +81,11 @@ impl Task for Aggregation {
         for (r, &i) in rewards.iter_mut().zip(&self.agents) {
             let p = poses[i].pos;
             let mut reward = -self.distance_weight * p.distance(leader) * self.inv_diagonal;
-            if self.predators.iter().any(|&k| poses[k].pos.distance_squared(p) < c2) {
+            if self
+                .predators
+                .iter()
+                .any(|&k| poses[k].pos.distance_squared(p) < c2)
+            {
                 reward -= self.capture_penalty;
             }
             *r = reward;

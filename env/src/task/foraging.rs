@@ -5,14 +5,15 @@
 //! agent terminates when it reaches a branch end: `+food_reward` at a food end, `-wrong_end_penalty`
 //! at any other; every step costs `step_penalty`. At reset the static maps are brought to their
 //! steady state `e J` (the paper assumes the trails are already laid).
-use super::{check_non_negative, parse_params, require_role, Task};
+use super::{Task, check_non_negative, parse_params, require_role};
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
 use glam::Vec2;
 use serde::Deserialize;
 
-pub const DESCRIPTION: &str = "case I: follow the trails from the nest to the available food, avoid unrewarded ends";
+pub const DESCRIPTION: &str =
+    "case I: follow the trails from the nest to the available food, avoid unrewarded ends";
 pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/foraging.toml");
 
 #[derive(Deserialize)]
@@ -63,7 +64,10 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
     let p: Params = parse_params("foraging", params)?;
     let agents = require_role(scenario, &p.agent_role, "foraging.agent_role")?;
     if p.food.is_empty() {
-        return Err(EnvError::param("foraging.food", "give at least one food end [[x, y], ...]"));
+        return Err(EnvError::param(
+            "foraging.food",
+            "give at least one food end [[x, y], ...]",
+        ));
     }
     let arena = scenario.arena_size();
     let points = |key: &str, v: &[[f32; 2]]| -> Result<Vec<Vec2>> {
@@ -74,7 +78,10 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
                 if q.is_finite() && q.x >= 0.0 && q.y >= 0.0 && q.x <= arena.x && q.y <= arena.y {
                     Ok(q)
                 } else {
-                    Err(EnvError::param(format!("foraging.{key}[{k}]"), format!("{q} lies outside the arena {arena}")))
+                    Err(EnvError::param(
+                        format!("foraging.{key}[{k}]"),
+                        format!("{q} lies outside the arena {arena}"),
+                    ))
                 }
             })
             .collect()
@@ -107,7 +114,11 @@ impl Task for Foraging {
     fn evaluate(&self, world: &World, rewards: &mut [f32], terminated: &mut [bool]) {
         let poses = world.poses();
         let r2 = self.reach_distance * self.reach_distance;
-        for ((r, t), &i) in rewards.iter_mut().zip(terminated.iter_mut()).zip(&self.agents) {
+        for ((r, t), &i) in rewards
+            .iter_mut()
+            .zip(terminated.iter_mut())
+            .zip(&self.agents)
+        {
             let p = poses[i].pos;
             *r = -self.step_penalty;
             if self.food.iter().any(|q| q.distance_squared(p) <= r2) {

@@ -32,10 +32,18 @@ pub trait Task: Send + Sync {
 
 /// Deserialises a task's parameter object, naming the key at fault; unknown keys are refused.
 pub fn parse_params<T: DeserializeOwned>(task: &str, params: &serde_json::Value) -> Result<T> {
-    let value = if params.is_null() { serde_json::Value::Object(Default::default()) } else { params.clone() };
+    let value = if params.is_null() {
+        serde_json::Value::Object(Default::default())
+    } else {
+        params.clone()
+    };
     serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
-        let key = if path == "." || path.is_empty() { task.to_string() } else { format!("{task}.{path}") };
+        let key = if path == "." || path.is_empty() {
+            task.to_string()
+        } else {
+            format!("{task}.{path}")
+        };
         EnvError::param(key, e.into_inner().to_string())
     })
 }
@@ -57,8 +65,16 @@ pub fn robots_with_role(scenario: &Scenario, role: &str) -> Vec<usize> {
 pub fn require_role(scenario: &Scenario, role: &str, key: &str) -> Result<Vec<usize>> {
     let robots = robots_with_role(scenario, role);
     if robots.is_empty() {
-        let roles: Vec<&str> = scenario.spec.robots.iter().map(|g| g.role.as_str()).collect();
-        return Err(EnvError::param(key, format!("no robot group has role {role:?} in this scenario (roles: {roles:?})")));
+        let roles: Vec<&str> = scenario
+            .spec
+            .robots
+            .iter()
+            .map(|g| g.role.as_str())
+            .collect();
+        return Err(EnvError::param(
+            key,
+            format!("no robot group has role {role:?} in this scenario (roles: {roles:?})"),
+        ));
     }
     Ok(robots)
 }
@@ -82,8 +98,13 @@ pub fn prefill_static_maps(world: &mut World) -> bool {
             if !(e.is_finite() && e > 0.0) {
                 continue;
             }
-            let Some(j) = g.static_injection().map(|j| j.to_vec()) else { continue };
-            g.values_mut().iter_mut().zip(&j).for_each(|(v, j)| *v = e * j);
+            let Some(j) = g.static_injection().map(|j| j.to_vec()) else {
+                continue;
+            };
+            g.values_mut()
+                .iter_mut()
+                .zip(&j)
+                .for_each(|(v, j)| *v = e * j);
             changed = true;
         }
     }

@@ -1,5 +1,5 @@
 //! Tasks by name.
-use super::{aggregation, foraging, trail, Task};
+use super::{Task, aggregation, foraging, trail};
 use crate::config::ScenarioSource;
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
@@ -8,9 +8,24 @@ type Builder = fn(&Scenario, &serde_json::Value) -> Result<Box<dyn Task>>;
 
 /// Every task: name, description, default scenario (TOML), builder.
 const REGISTRY: &[(&str, &str, &str, Builder)] = &[
-    ("aggregation", aggregation::DESCRIPTION, aggregation::DEFAULT_SCENARIO, aggregation::build),
-    ("foraging", foraging::DESCRIPTION, foraging::DEFAULT_SCENARIO, foraging::build),
-    ("trail", trail::DESCRIPTION, trail::DEFAULT_SCENARIO, trail::build),
+    (
+        "aggregation",
+        aggregation::DESCRIPTION,
+        aggregation::DEFAULT_SCENARIO,
+        aggregation::build,
+    ),
+    (
+        "foraging",
+        foraging::DESCRIPTION,
+        foraging::DEFAULT_SCENARIO,
+        foraging::build,
+    ),
+    (
+        "trail",
+        trail::DESCRIPTION,
+        trail::DEFAULT_SCENARIO,
+        trail::build,
+    ),
 ];
 
 /// Names and one-line descriptions of all tasks.
@@ -24,7 +39,11 @@ pub fn default_scenario(name: &str) -> Result<&'static str> {
 }
 
 /// Builds task `name` over the scenario from `source`, with `params` (a JSON object).
-pub fn build(name: &str, source: &ScenarioSource, params: &serde_json::Value) -> Result<(Box<dyn Task>, Scenario)> {
+pub fn build(
+    name: &str,
+    source: &ScenarioSource,
+    params: &serde_json::Value,
+) -> Result<(Box<dyn Task>, Scenario)> {
     let (_, _, default, builder) = find(name)?;
     let scenario = source.load(default)?;
     let task = builder(&scenario, params)?;
@@ -35,8 +54,15 @@ pub fn build(name: &str, source: &ScenarioSource, params: &serde_json::Value) ->
 }
 
 fn find(name: &str) -> Result<&'static (&'static str, &'static str, &'static str, Builder)> {
-    REGISTRY.iter().find(|(n, _, _, _)| *n == name).ok_or_else(|| EnvError::UnknownTask {
-        name: name.to_string(),
-        known: REGISTRY.iter().map(|(n, _, _, _)| *n).collect::<Vec<_>>().join(", "),
-    })
+    REGISTRY
+        .iter()
+        .find(|(n, _, _, _)| *n == name)
+        .ok_or_else(|| EnvError::UnknownTask {
+            name: name.to_string(),
+            known: REGISTRY
+                .iter()
+                .map(|(n, _, _, _)| *n)
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
 }

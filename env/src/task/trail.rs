@@ -3,14 +3,15 @@
 //!
 //! Reward per agent and step: `forward speed / max speed * strength of channel` (its own sensors'
 //! mean intensity), minus `bump_penalty * strongest bumper`. No termination.
-use super::{check_non_negative, parse_params, require_role, Task};
+use super::{Task, check_non_negative, parse_params, require_role};
 use crate::error::{EnvError, Result};
 use colcos_sim::behaviour::channel_index;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
 use serde::Deserialize;
 
-pub const DESCRIPTION: &str = "follow a colour trail forward while laying one (static loop plus the robots' own trails)";
+pub const DESCRIPTION: &str =
+    "follow a colour trail forward while laying one (static loop plus the robots' own trails)";
 pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/trail.toml");
 
 #[derive(Deserialize)]
@@ -24,7 +25,11 @@ struct Params {
 
 impl Default for Params {
     fn default() -> Self {
-        Params { agent_role: "agent".into(), channel: "b".into(), bump_penalty: 0.1 }
+        Params {
+            agent_role: "agent".into(),
+            channel: "b".into(),
+            bump_penalty: 0.1,
+        }
     }
 }
 
@@ -38,7 +43,12 @@ pub struct Trail {
 pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn Task>> {
     let p: Params = parse_params("trail", params)?;
     let agents = require_role(scenario, &p.agent_role, "trail.agent_role")?;
-    let channel = channel_index(&p.channel).ok_or_else(|| EnvError::param("trail.channel", format!("{:?} is not \"r\", \"g\" or \"b\"", p.channel)))?;
+    let channel = channel_index(&p.channel).ok_or_else(|| {
+        EnvError::param(
+            "trail.channel",
+            format!("{:?} is not \"r\", \"g\" or \"b\"", p.channel),
+        )
+    })?;
     let max = scenario.spec.robot.max_wheel_speed;
     Ok(Box::new(Trail {
         agents,
@@ -64,7 +74,8 @@ impl Task for Trail {
         for (r, &i) in rewards.iter_mut().zip(&self.agents) {
             let (forward, _) = world.robots()[i].drive.body_velocity(params);
             let o = &obs[i];
-            *r = forward * self.inv_max_speed * o.strength(self.channel) - self.bump_penalty * o.max_bumper();
+            *r = forward * self.inv_max_speed * o.strength(self.channel)
+                - self.bump_penalty * o.max_bumper();
         }
     }
 }

@@ -2,7 +2,7 @@
 //! Checking the values happens in [`super::validate`].
 
 use crate::field::{BackendChoice, DiffusionScheme, Kernel};
-use crate::robot::ColiasParams;
+use crate::robot::{ColiasParams, PhysicsBackend};
 use crate::screen::ScreenSpec;
 use crate::sensors::{BumperParams, ColourSensorParams};
 use crate::tracker::TrackerParams;
@@ -28,6 +28,10 @@ pub struct ScenarioSpec {
     pub screen: ScreenSpec,
     #[serde(default)]
     pub field: FieldSpec,
+    /// Robot-robot and robot-wall contacts: `rapier` (rigid bodies, default) or `discs` (a fast
+    /// position-based solver for very large swarms).
+    #[serde(default)]
+    pub physics: PhysicsBackend,
     #[serde(default)]
     pub robot: ColiasParams,
     #[serde(default)]

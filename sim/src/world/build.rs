@@ -63,7 +63,7 @@ impl World {
                 }
             }
         }
-        let physics = ArenaPhysics::new(arena, &spec.robot, &poses);
+        let physics = ArenaPhysics::with_backend(arena, &spec.robot, &poses, spec.physics);
         let mut tracker = Tracker::new(spec.tracker, poses.len());
         let mut tracker_rng = rng::stream(spec.seed, world_index, STREAM_TRACKER);
         let tracked = tracker.update(0.0, &poses, &mut tracker_rng).to_vec();

@@ -39,8 +39,11 @@
 //! toward the chosen side on an arc, at `turn_rate` rad/s and `commit_speed` times the base speed, for
 //! as long as it takes to turn by `turn_angle` degrees (the fork's half-angle: this points it along the
 //! chosen branch; a robot knows its own wheel commands, nothing more is needed), then it follows the
-//! chosen trail by eq. (7) on that trail's signal (cyan: green; blue-only: `blue - green`; LAP: blue).
-//! No new bifurcation is detected while committed.
+//! outer edge of the chosen branch: eq. (7) with the sensor on the other side (which may lie over the
+//! gap between the branches, or over the other branch) replaced by the front sensor, on the chosen
+//! trail's signal (cyan: green; blue-only: `blue - green`; LAP: blue). It goes straight while both see
+//! the trail, turns away from the chosen side when that sensor leaves the trail and toward it when the
+//! front sensor does. No new bifurcation is detected while committed.
 use super::{check, eq7, BLUE, GREEN, RED, SENSOR_FRONT, SENSOR_LEFT, SENSOR_RIGHT};
 use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
 use crate::error::Result;
@@ -310,6 +313,17 @@ impl Foraging {
         eq7(l, r, p.sensitivity, p.speed)
     }
 
+    /// Eq. (7) between the sensor on `side` and the front sensor (see the module documentation).
+    pub fn steer_committed(&self, obs: &Observation, trail: Trail, side: Side) -> WheelCommand {
+        let p = &self.params;
+        let n = if side == Side::Left { SENSOR_LEFT } else { SENSOR_RIGHT };
+        let (outer, front) = (trail.signal(obs.intensity[n]), trail.signal(obs.intensity[SENSOR_FRONT]));
+        match side {
+            Side::Left => eq7(outer, front, p.sensitivity, p.speed),
+            Side::Right => eq7(front, outer, p.sensitivity, p.speed),
+        }
+    }
+
     /// The arc into the branch on `side`: forward at `commit_speed * speed`, yaw `turn_rate` toward it.
     pub fn turn_into(&self, side: Side, wheel_base: f32) -> WheelCommand {
         let p = &self.params;
@@ -330,7 +344,7 @@ impl Behaviour for Foraging {
             ForagingDecision::FollowLap => self.steer(obs, Trail::Lap),
             ForagingDecision::FollowCyan => self.steer(obs, Trail::Cyan),
             ForagingDecision::Bifurcation { side, .. } | ForagingDecision::TurnInto { side, .. } => self.turn_into(side, self.wheel_base),
-            ForagingDecision::Committed { trail, .. } => self.steer(obs, trail),
+            ForagingDecision::Committed { trail, side } => self.steer_committed(obs, trail, side),
         }
     }
 }

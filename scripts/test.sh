@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# The whole test suite, on a fresh machine (Rust toolchain, Python 3.11 with pip, root for apt-get):
+#   1. formatting and lints of the Rust workspace,
+#   2. the Rust tests (simulator, case studies, CLI, RL core),
+#   3. the GPU field backend on Debian's software Vulkan driver and the display window under Xvfb,
+#   4. the Python package through PettingZoo's, SuperSuit/SB3's, RLlib's and TorchRL's own checks.
+# Set COLCOS_SKIP_GPU=1 or COLCOS_SKIP_PYTHON=1 to leave a part out locally.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export CARGO_TERM_COLOR=never
+t0=$(date +%s)
+say() { echo; echo "== $* ($(( $(date +%s) - t0 )) s)"; }
+
+say "cargo fmt --check"
+cargo fmt --all -- --check
+
+say "cargo clippy"
+cargo clippy --workspace --all-targets -- -D warnings
+
+say "cargo test (release profile, shared with the GPU and Python builds)"
+cargo test --workspace --release
+
+if [ "${COLCOS_SKIP_GPU:-0}" != 1 ]; then
+    say "GPU backend on lavapipe, display window under Xvfb"
+    bash gpu/ci.sh
+fi
+
+if [ "${COLCOS_SKIP_PYTHON:-0}" != 1 ]; then
+    say "Python package"
+    bash python-tests/run.sh
+fi
+
+say "all tests passed"

@@ -1,0 +1,210 @@
+//! Algorithm 1 (ant foraging) decision by decision on hand-made sensor readings, the sign of eq. (7),
+//! and a robot beside a straight trail converging onto it.
+use colcos_sim::behaviour::paper::*;
+use colcos_sim::behaviour::{Behaviour, Observation};
+use colcos_sim::prelude::*;
+use colcos_sim::rng;
+
+const OFF: [f32; 3] = [0.0, 0.0, 0.0];
+const BLUE_: [f32; 3] = [0.0, 0.0, 1.0];
+const CYAN: [f32; 3] = [0.0, 1.0, 1.0];
+const MAGENTA: [f32; 3] = [1.0, 0.0, 1.0];
+
+/// Sensors in the paper's order: right (Y-), front (X+), left (Y+), back (X-).
+fn obs(right: [f32; 3], front: [f32; 3], left: [f32; 3], back: [f32; 3]) -> Observation {
+    Observation { intensity: [right, front, left, back], time: 1.0, ..Observation::default() }
+}
+
+fn forager() -> Foraging {
+    Foraging::new(ForagingParams::default())
+}
+
+#[test]
+fn eq7_turns_toward_the_stronger_side() {
+    // Left sensor on the trail, right off: the right wheel is faster, so the robot turns left.
+    let c = eq7(1.0, 0.0, 0.03, 0.1);
+    assert!(c.right > c.left, "{c:?}");
+    let c = eq7(0.0, 1.0, 0.03, 0.1);
+    assert!(c.left > c.right, "{c:?}");
+    let c = eq7(0.5, 0.5, 0.03, 0.1);
+    assert_eq!((c.left, c.right), (0.1, 0.1));
+}
+
+#[test]
+fn avoids_on_a_bumper_hit() {
+    let mut f = forager();
+    let mut o = obs(CYAN, CYAN, CYAN, CYAN);
+    o.bumpers = [0.0, 0.8, 0.0];
+    let mut r = rng::stream(1, 0, 0);
+    assert_eq!(f.decide(&o, &mut r), ForagingDecision::Avoid);
+    // The pivot turns in place: wheels in opposite directions.
+    let c = f.act(&o, &mut r);
+    assert!(c.left * c.right < 0.0, "{c:?}");
+}
+
+#[test]
+fn wanders_off_the_lap() {
+    let mut f = forager();
+    let mut r = rng::stream(1, 0, 0);
+    assert_eq!(f.decide(&obs(OFF, OFF, OFF, OFF), &mut r), ForagingDecision::Wander);
+    // Green alone (no blue) is not a trail.
+    assert_eq!(f.decide(&obs(OFF, [0.0, 1.0, 0.0], OFF, OFF), &mut r), ForagingDecision::Wander);
+}
+
+#[test]
+fn follows_the_lap_and_prefers_cyan() {
+    let mut f = forager();
+    let mut r = rng::stream(1, 0, 0);
+    assert_eq!(f.decide(&obs(BLUE_, BLUE_, BLUE_, BLUE_), &mut r), ForagingDecision::FollowLap);
+    assert_eq!(f.decide(&obs(CYAN, CYAN, CYAN, CYAN), &mut r), ForagingDecision::FollowCyan);
+    // On the cyan trail it steers on green: cyan on the left only turns it left.
+    let c = f.steer(&obs(BLUE_, CYAN, CYAN, CYAN), Trail::Cyan);
+    assert!(c.right > c.left, "{c:?}");
+}
+
+#[test]
+fn detects_bifurcations() {
+    let th = 0.3;
+    // Front off the trail, both sides on it: the wedge between two branches.
+    assert_eq!(detect_bifurcation(&obs(BLUE_, OFF, BLUE_, BLUE_), th), Some(BifurcationKind::Plain));
+    // Different colours left and right.
+    assert_eq!(detect_bifurcation(&obs(BLUE_, CYAN, CYAN, CYAN), th), Some(BifurcationKind::CyanBlue));
+    assert_eq!(detect_bifurcation(&obs(CYAN, CYAN, BLUE_, CYAN), th), Some(BifurcationKind::CyanBlue));
+    assert_eq!(detect_bifurcation(&obs(MAGENTA, CYAN, CYAN, CYAN), th), Some(BifurcationKind::Magenta));
+    // A plain trail, or a robot at the edge of one, is not a bifurcation.
+    assert_eq!(detect_bifurcation(&obs(BLUE_, BLUE_, BLUE_, BLUE_), th), None);
+    assert_eq!(detect_bifurcation(&obs(OFF, BLUE_, BLUE_, BLUE_), th), None);
+    assert_eq!(detect_bifurcation(&obs(OFF, OFF, BLUE_, BLUE_), th), None);
+}
+
+fn choices(o: &Observation, n: usize) -> (usize, Vec<ForagingDecision>) {
+    let mut left = 0;
+    let mut all = Vec::new();
+    for k in 0..n {
+        let mut f = forager();
+        let mut r = rng::stream(7, k as u64, 0);
+        let d = f.decide(o, &mut r);
+        if let ForagingDecision::Bifurcation { side: Side::Left, .. } = d {
+            left += 1;
+        }
+        all.push(d);
+    }
+    (left, all)
+}
+
+#[test]
+fn magenta_bifurcation_always_takes_the_cyan_side() {
+    let (left, all) = choices(&obs(MAGENTA, OFF, CYAN, CYAN), 500);
+    assert_eq!(left, 500, "{:?}", &all[..3]);
+    let (left, _) = choices(&obs(CYAN, OFF, MAGENTA, CYAN), 500);
+    assert_eq!(left, 0);
+    assert!(matches!(all[0], ForagingDecision::Bifurcation { kind: BifurcationKind::Magenta, trail: Trail::Cyan, .. }));
+}
+
+#[test]
+fn cyan_blue_bifurcation_takes_cyan_seven_times_in_ten() {
+    let n = 4000;
+    let (left, all) = choices(&obs(BLUE_, OFF, CYAN, CYAN), n);
+    let share = left as f64 / n as f64;
+    assert!((share - 0.7).abs() < 0.03, "cyan share {share}");
+    // The blue branch is followed on blue-but-not-green.
+    assert!(all.iter().any(|d| matches!(d, ForagingDecision::Bifurcation { side: Side::Right, trail: Trail::BlueOnly, .. })));
+}
+
+#[test]
+fn plain_bifurcation_is_a_fair_coin() {
+    let n = 4000;
+    let (left, _) = choices(&obs(BLUE_, OFF, BLUE_, BLUE_), n);
+    let share = left as f64 / n as f64;
+    assert!((share - 0.5).abs() < 0.03, "left share {share}");
+}
+
+#[test]
+fn commits_to_the_chosen_branch() {
+    let p = ForagingParams::default();
+    let mut f = Foraging::new(p.clone());
+    let mut r = rng::stream(1, 0, 0);
+    let fork = obs(BLUE_, OFF, CYAN, CYAN);
+    let d = f.decide(&fork, &mut r);
+    let ForagingDecision::Bifurcation { side, .. } = d else { panic!("{d:?}") };
+    // First the turn into the branch, toward the chosen side...
+    let mut o = fork;
+    o.time += 0.05;
+    assert!(matches!(f.decide(&o, &mut r), ForagingDecision::TurnInto { .. }));
+    let c = f.turn_into(side, 0.026);
+    assert_eq!(c.right > c.left, side == Side::Left, "{c:?}");
+    // ...then following it; the same fork pattern does not trigger a new decision while committed.
+    o.time = fork.time + p.turn_angle.to_radians() / p.turn_rate + 0.05;
+    assert!(matches!(f.decide(&o, &mut r), ForagingDecision::Committed { .. }));
+    o.time = fork.time + p.commit_time + 0.05;
+    assert!(matches!(f.decide(&o, &mut r), ForagingDecision::Bifurcation { .. }));
+}
+
+#[test]
+fn committed_steering_uses_the_outer_sensor_and_the_front_one() {
+    let f = forager();
+    // Committed left, the left sensor on and the front one off (heading into the gap): turn left.
+    let c = f.steer_committed(&obs(OFF, OFF, CYAN, CYAN), Trail::Cyan, Side::Left);
+    assert!(c.right > c.left);
+    // The left sensor off, the front on (drifting out over the outer edge): turn right.
+    let c = f.steer_committed(&obs(CYAN, CYAN, OFF, CYAN), Trail::Cyan, Side::Left);
+    assert!(c.left > c.right);
+}
+
+#[test]
+fn params_are_checked() {
+    let bad: toml::Table = toml::from_str("cyan_probability = 1.5").unwrap();
+    assert!(colcos_sim::behaviour::registry::build("forage", &bad, "robots[0]").is_err());
+    let unknown: toml::Table = toml::from_str("speeed = 0.1").unwrap();
+    assert!(colcos_sim::behaviour::registry::build("forage", &unknown, "robots[0]").is_err());
+    assert!(colcos_sim::behaviour::registry::build("forage", &toml::Table::new(), "robots[0]").is_ok());
+}
+
+/// A robot placed 2 cm beside a straight blue trail, heading 20 degrees toward it, ends up on it and
+/// follows it.
+#[test]
+fn converges_onto_a_straight_trail() {
+    let toml = r#"
+        duration = 6.0
+        seed = 3
+        [screen]
+        resolution = [1440, 810]
+        size = [1.439, 0.809]
+        [field]
+        cell = 0.005
+        [tracker]
+        rate_hz = 50.0
+        [[pheromones]]
+        name = "LAP"
+        colour = [0, 0, 255]
+        evaporation = 50.0
+        [[pheromones.maps]]
+        polyline = [[0.05, 0.4], [1.39, 0.4]]
+        width = 0.06
+        rate = 0.02
+        [[robots]]
+        count = 1
+        behaviour = "forage"
+        placement = "explicit"
+        poses = [[0.15, 0.44, -20.0]]
+    "#;
+    let sc = Scenario::from_toml_str(toml, ".").unwrap();
+    let mut w = World::new(&sc).unwrap();
+    // Steady state e J = 1 at once.
+    for p in w.pheromones_mut() {
+        if let colcos_sim::field::FieldModel::Grid(g) = &mut p.model {
+            let j = g.static_injection().unwrap().to_vec();
+            g.values_mut().iter_mut().zip(j).for_each(|(v, j)| *v = 50.0 * j);
+        }
+    }
+    let mut worst_late = 0.0f32;
+    while !w.is_finished() {
+        w.step();
+        if w.time() > 3.0 {
+            worst_late = worst_late.max((w.poses()[0].pos.y - 0.4).abs());
+        }
+    }
+    let p = w.poses()[0];
+    assert!(worst_late < 0.025, "lateral offset after 3 s up to {worst_late} m");
+    assert!(p.pos.x > 0.4, "it moved along the trail: {p:?}");
+}
