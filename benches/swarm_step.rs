@@ -5,12 +5,18 @@
 //!
 //! cargo bench --bench swarm_step
 use colcos::sim::prelude::*;
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
 
 const ARGOS_10K_REAL_TIME_FACTOR: f64 = 1.4;
 
-pub fn scenario(robots: usize, size: [f32; 2], resolution: [u32; 2], cell: f32, physics: &str) -> Scenario {
+pub fn scenario(
+    robots: usize,
+    size: [f32; 2],
+    resolution: [u32; 2],
+    cell: f32,
+    physics: &str,
+) -> Scenario {
     let per_group = robots / 3;
     let group = |lay: &str, follow: &str, count: usize| {
         format!(
@@ -84,7 +90,11 @@ fn time_steps(world: &mut World, warm: usize, n: usize) -> f64 {
 
 fn report(label: &str, step_s: f64, dt: f64, target: f64, peer: Option<(&str, f64)>) {
     let rtf = dt / step_s;
-    print!("{label}: median step {:.3} ms, {rtf:.1}x real time (target >= {target}x: {})", step_s * 1e3, if rtf >= target { "met" } else { "NOT met" });
+    print!(
+        "{label}: median step {:.3} ms, {rtf:.1}x real time (target >= {target}x: {})",
+        step_s * 1e3,
+        if rtf >= target { "met" } else { "NOT met" }
+    );
     if let Some((name, peer_rtf)) = peer {
         print!(", {:.1}x {name}", rtf / peer_rtf);
     }
@@ -100,19 +110,44 @@ fn bench(c: &mut Criterion) {
     let mut w_small = World::new(&small).unwrap();
 
     let mut g = c.benchmark_group("swarm_step");
-    g.sample_size(20).measurement_time(Duration::from_secs(8)).warm_up_time(Duration::from_secs(2));
+    g.sample_size(20)
+        .measurement_time(Duration::from_secs(8))
+        .warm_up_time(Duration::from_secs(2));
     g.bench_function("10k_robots_1cm_grid_discs", |b| b.iter(|| w_big.step()));
-    g.bench_function("10k_robots_1cm_grid_rapier", |b| b.iter(|| w_big_rapier.step()));
+    g.bench_function("10k_robots_1cm_grid_rapier", |b| {
+        b.iter(|| w_big_rapier.step())
+    });
     g.bench_function("100_robots_5mm_grid", |b| b.iter(|| w_small.step()));
     g.finish();
 
-    println!("\n== swarm_step summary (dt = 20 ms, {} threads) ==", rayon::current_num_threads());
+    println!(
+        "\n== swarm_step summary (dt = 20 ms, {} threads) ==",
+        rayon::current_num_threads()
+    );
     let big_s = time_steps(&mut w_big, 10, 100);
-    report("10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, disc solver", big_s, 0.02, 2.0, Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)));
+    report(
+        "10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, disc solver",
+        big_s,
+        0.02,
+        2.0,
+        Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)),
+    );
     let big_r = time_steps(&mut w_big_rapier, 5, 30);
-    report("10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, rapier", big_r, 0.02, 2.0, Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)));
+    report(
+        "10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, rapier",
+        big_r,
+        0.02,
+        2.0,
+        Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)),
+    );
     let small_s = time_steps(&mut w_small, 50, 2000);
-    report("100 robots, 65-inch screen, 5 mm grid x3", small_s, 0.02, 100.0, None);
+    report(
+        "100 robots, 65-inch screen, 5 mm grid x3",
+        small_s,
+        0.02,
+        100.0,
+        None,
+    );
 }
 
 criterion_group! {

@@ -27,14 +27,30 @@ fn main() {
         } else {
             ""
         };
-        let dep = if deposits { "deposits = [{ pheromone = \"red\", kernel = { shape = \"disc\", radius = 0.01 }, rate = 3.0 }]" } else { "" };
+        let dep = if deposits {
+            "deposits = [{ pheromone = \"red\", kernel = { shape = \"disc\", radius = 0.01 }, rate = 3.0 }]"
+        } else {
+            ""
+        };
         format!(
             "duration = 10.0\nphysics = \"{physics}\"\n[screen]\nresolution = [38400, 21600]\nsize = [14.4, 8.1]\n[field]\ncell = 0.01\n{ph}\n[[robots]]\ncount = {robots}\nbehaviour = \"{behaviour}\"\n{dep}\n"
         )
     };
-    time("full (follow, 3 fields, deposits, discs)", &base(10_000, "follow", true, true, "discs"));
+    time(
+        "full (follow, 3 fields, deposits, discs)",
+        &base(10_000, "follow", true, true, "discs"),
+    );
     time("no deposits", &base(10_000, "follow", true, false, "discs"));
-    time("no pheromones (sensing empty list)", &base(10_000, "avoid", false, false, "discs"));
-    time("full with rapier", &base(10_000, "follow", true, true, "rapier"));
-    time("1,000 robots full discs", &base(1_000, "follow", true, true, "discs"));
+    time(
+        "no pheromones (sensing empty list)",
+        &base(10_000, "avoid", false, false, "discs"),
+    );
+    time(
+        "full with rapier",
+        &base(10_000, "follow", true, true, "rapier"),
+    );
+    time(
+        "1,000 robots full discs",
+        &base(1_000, "follow", true, true, "discs"),
+    );
 }

@@ -7,7 +7,9 @@ use colcos_sim::world::World;
 /// `gpu: <adapter>`). `gpu` without an adapter is an error; `auto` falls back to the CPU and says why.
 #[cfg(feature = "gpu")]
 pub fn install(world: &mut World, choice: BackendChoice) -> Result<String> {
-    Ok(colcos_gpu::install(world, choice).map_err(|e| anyhow::anyhow!("field backend {choice}: {e}"))?.to_string())
+    Ok(colcos_gpu::install(world, choice)
+        .map_err(|e| anyhow::anyhow!("field backend {choice}: {e}"))?
+        .to_string())
 }
 
 /// Without the `gpu` feature only the CPU backend exists.
@@ -17,6 +19,8 @@ pub fn install(world: &mut World, choice: BackendChoice) -> Result<String> {
     match choice {
         BackendChoice::Cpu => Ok("cpu (asked for)".into()),
         BackendChoice::Auto => Ok("cpu (auto: built without the `gpu` feature)".into()),
-        BackendChoice::Gpu => anyhow::bail!("field backend gpu: this colcos was built without the `gpu` feature"),
+        BackendChoice::Gpu => {
+            anyhow::bail!("field backend gpu: this colcos was built without the `gpu` feature")
+        }
     }
 }

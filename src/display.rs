@@ -38,7 +38,10 @@ pub struct DisplayArgs {
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once('x').ok_or("expected WxH, e.g. 1920x1080")?;
-    let (w, h) = (w.parse::<u32>().map_err(|e| e.to_string())?, h.parse::<u32>().map_err(|e| e.to_string())?);
+    let (w, h) = (
+        w.parse::<u32>().map_err(|e| e.to_string())?,
+        h.parse::<u32>().map_err(|e| e.to_string())?,
+    );
     if w == 0 || h == 0 {
         return Err("the size must be positive".into());
     }
@@ -70,7 +73,12 @@ impl colcos_display::FrameSource for WorldFrames {
         }
         self.first = false;
         let s = *self.world.screen();
-        Some(rgba(screen::render(self.world.pheromones(), &s, self.size.0, self.size.1)))
+        Some(rgba(screen::render(
+            self.world.pheromones(),
+            &s,
+            self.size.0,
+            self.size.1,
+        )))
     }
 }
 
@@ -83,11 +91,16 @@ pub fn main(args: DisplayArgs) -> Result<()> {
     let backend = crate::backend::install(&mut world, sc.spec.field.backend)?;
     eprintln!("field backend: {backend}");
     let res = sc.spec.screen.resolution;
-    let size = args.size.unwrap_or(if args.fullscreen || args.png.is_some() {
-        (res[0], res[1])
-    } else {
-        (960, ((960.0 * res[1] as f64 / res[0].max(1) as f64).round() as u32).max(1))
-    });
+    let size = args
+        .size
+        .unwrap_or(if args.fullscreen || args.png.is_some() {
+            (res[0], res[1])
+        } else {
+            (
+                960,
+                ((960.0 * res[1] as f64 / res[0].max(1) as f64).round() as u32).max(1),
+            )
+        });
     if let Some(png) = &args.png {
         while world.time() + 0.5 * world.dt() < args.seconds && !world.is_finished() {
             world.step();
@@ -95,7 +108,8 @@ pub fn main(args: DisplayArgs) -> Result<()> {
         let img = screen::render(world.pheromones(), world.screen(), size.0, size.1);
         #[cfg(feature = "display")]
         let img = {
-            let rgba = image::RgbaImage::from_raw(size.0, size.1, rgba(img)).context("image buffer")?;
+            let rgba =
+                image::RgbaImage::from_raw(size.0, size.1, rgba(img)).context("image buffer")?;
             colcos_display::render_headless(&rgba, size)?
         };
         screen::save_png(&img, png)?;
@@ -116,7 +130,15 @@ pub fn main(args: DisplayArgs) -> Result<()> {
             close_after: args.close_after.map(std::time::Duration::from_secs_f64),
             announce_first_frame: false,
         };
-        colcos_display::run_window(opts, Box::new(WorldFrames { world, size, first: true })).context("display window")
+        colcos_display::run_window(
+            opts,
+            Box::new(WorldFrames {
+                world,
+                size,
+                first: true,
+            }),
+        )
+        .context("display window")
     }
     #[cfg(not(feature = "display"))]
     {

@@ -1,13 +1,17 @@
 //! The `colcos` command line.
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use colcos::run::{run, RunOptions};
+use colcos::run::{RunOptions, run};
 use colcos::sim::prelude::*;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "colcos", version, about = "Multi-pheromone swarm robotics simulator (ColCOSPhi)")]
+#[command(
+    name = "colcos",
+    version,
+    about = "Multi-pheromone swarm robotics simulator (ColCOSPhi)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -63,16 +67,36 @@ fn real_main() -> Result<()> {
     match Cli::parse().command {
         Command::Display(args) => colcos::display::main(args),
         Command::Experiment(args) => colcos::experiment::main(args),
-        Command::Run { scenario, out, seed, duration, threads, quiet, backend } => {
+        Command::Run {
+            scenario,
+            out,
+            seed,
+            duration,
+            threads,
+            quiet,
+            backend,
+        } => {
             if let Some(n) = threads {
-                rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting up the thread pool")?;
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build_global()
+                    .context("setting up the thread pool")?;
             }
             let mut sc = Scenario::from_file(&scenario)?.with_overrides(seed, duration)?;
             if let Some(b) = backend {
                 sc.spec.field.backend = b;
             }
-            let out = out.unwrap_or_else(|| PathBuf::from("runs").join(scenario.file_stem().unwrap_or_default()));
-            let report = run(&sc, &out, &RunOptions { progress: !quiet, no_gif: false })?;
+            let out = out.unwrap_or_else(|| {
+                PathBuf::from("runs").join(scenario.file_stem().unwrap_or_default())
+            });
+            let report = run(
+                &sc,
+                &out,
+                &RunOptions {
+                    progress: !quiet,
+                    no_gif: false,
+                },
+            )?;
             println!("field backend: {}", report.backend);
             println!(
                 "{} robots, {} steps ({} s simulated) in {:.2} s: {:.1}x real time",
@@ -91,12 +115,26 @@ fn real_main() -> Result<()> {
             let sc = Scenario::from_file(&scenario)?;
             let a = sc.arena_size();
             println!("{}: ok", scenario.display());
-            println!("  arena {} x {} m, {} s at dt {} s ({} steps), seed {}", a.x, a.y, sc.spec.duration, sc.spec.dt, sc.steps(), sc.spec.seed);
+            println!(
+                "  arena {} x {} m, {} s at dt {} s ({} steps), seed {}",
+                a.x,
+                a.y,
+                sc.spec.duration,
+                sc.spec.dt,
+                sc.steps(),
+                sc.spec.seed
+            );
             for p in &sc.spec.pheromones {
-                println!("  pheromone {:?}: {:?} model, colour {:?}", p.name, p.model, p.colour);
+                println!(
+                    "  pheromone {:?}: {:?} model, colour {:?}",
+                    p.name, p.model, p.colour
+                );
             }
             for g in &sc.spec.robots {
-                println!("  {} robot(s), role {:?}, behaviour {:?}", g.count, g.role, g.behaviour);
+                println!(
+                    "  {} robot(s), role {:?}, behaviour {:?}",
+                    g.count, g.role, g.behaviour
+                );
             }
             Ok(())
         }

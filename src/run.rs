@@ -2,7 +2,7 @@
 //! GIF, the final fields and a summary.
 use anyhow::{Context, Result};
 use colcos_sim::field::{FieldModel, GridSpec};
-use colcos_sim::output::{npy, GifRecorder, TrajectoryLog};
+use colcos_sim::output::{GifRecorder, TrajectoryLog, npy};
 use colcos_sim::prelude::*;
 use colcos_sim::screen;
 use std::path::{Path, PathBuf};
@@ -39,10 +39,12 @@ pub struct RunOptions {
 
 /// Runs `scenario` to its end, writing into `out_dir`.
 pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<RunReport> {
-    std::fs::create_dir_all(out_dir).with_context(|| format!("creating output directory {}", out_dir.display()))?;
+    std::fs::create_dir_all(out_dir)
+        .with_context(|| format!("creating output directory {}", out_dir.display()))?;
     let mut files = Vec::new();
     let scenario_copy = out_dir.join("scenario.toml");
-    std::fs::write(&scenario_copy, scenario.to_toml()).with_context(|| format!("writing {}", scenario_copy.display()))?;
+    std::fs::write(&scenario_copy, scenario.to_toml())
+        .with_context(|| format!("writing {}", scenario_copy.display()))?;
     files.push(scenario_copy);
 
     let mut world = World::new(scenario)?;
@@ -54,7 +56,16 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
 
     let out = &scenario.spec.output;
     let gif_path = out_dir.join("run.gif");
-    let mut gif = if out.gif_interval > 0.0 && !opts.no_gif { Some(GifRecorder::create(&gif_path, &world, out.gif_width, out.gif_interval)?) } else { None };
+    let mut gif = if out.gif_interval > 0.0 && !opts.no_gif {
+        Some(GifRecorder::create(
+            &gif_path,
+            &world,
+            out.gif_width,
+            out.gif_interval,
+        )?)
+    } else {
+        None
+    };
     let gif_every = ((out.gif_interval / scenario.spec.dt).round() as u64).max(1);
     if let Some(g) = gif.as_mut() {
         g.frame(&world)?;
@@ -62,7 +73,11 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
     }
 
     let steps = scenario.steps();
-    let bar = if opts.progress { progress_bar(steps) } else { indicatif::ProgressBar::hidden() };
+    let bar = if opts.progress {
+        progress_bar(steps)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
     let started = Instant::now();
     let mut stepping = 0.0f64;
     for _ in 0..steps {
@@ -89,7 +104,15 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
     files.push(png);
     files.extend(write_fields(&world, scenario, out_dir)?);
 
-    let report = RunReport { out_dir: out_dir.to_path_buf(), steps, robots: world.robot_count(), sim_seconds: world.time(), wall_seconds: stepping, files, backend };
+    let report = RunReport {
+        out_dir: out_dir.to_path_buf(),
+        steps,
+        robots: world.robot_count(),
+        sim_seconds: world.time(),
+        wall_seconds: stepping,
+        files,
+        backend,
+    };
     let summary = out_dir.join("summary.json");
     let json = format!(
         "{{\n  \"scenario\": {:?},\n  \"seed\": {},\n  \"steps\": {},\n  \"robots\": {},\n  \"sim_seconds\": {},\n  \"step_wall_seconds\": {:.4},\n  \"real_time_factor\": {:.2},\n  \"total_wall_seconds\": {:.3},\n  \"backend\": {:?}\n}}\n",
@@ -128,12 +151,19 @@ fn write_fields(world: &World, scenario: &Scenario, out_dir: &Path) -> Result<Ve
     for p in world.pheromones() {
         let path = dir.join(format!("{}.npy", sanitize(&p.name)));
         match &p.model {
-            FieldModel::Grid(g) => npy::write_npy_f32(&path, &[g.spec().ny, g.spec().nx], g.values())?,
+            FieldModel::Grid(g) => {
+                npy::write_npy_f32(&path, &[g.spec().ny, g.spec().nx], g.values())?
+            }
             FieldModel::Gaussian(g) => {
                 let spec = GridSpec::covering(world.arena(), scenario.spec.field.cell);
                 let values: Vec<f32> = (0..spec.ny)
                     .flat_map(|j| (0..spec.nx).map(move |i| (i, j)))
-                    .map(|(i, j)| g.value_at(Vec2::new((i as f32 + 0.5) * spec.cell, (j as f32 + 0.5) * spec.cell)))
+                    .map(|(i, j)| {
+                        g.value_at(Vec2::new(
+                            (i as f32 + 0.5) * spec.cell,
+                            (j as f32 + 0.5) * spec.cell,
+                        ))
+                    })
                     .collect();
                 npy::write_npy_f32(&path, &[spec.ny, spec.nx], &values)?
             }
@@ -145,5 +175,13 @@ fn write_fields(world: &World, scenario: &Scenario, out_dir: &Path) -> Result<Ve
 
 /// A pheromone name made safe as a file name.
 fn sanitize(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }

@@ -1,5 +1,5 @@
 //! Same scenario and seed give byte-identical logs, whatever the number of threads.
-use colcos::run::{run, RunOptions};
+use colcos::run::{RunOptions, run};
 use colcos::sim::prelude::*;
 
 /// Enough robots and a large enough grid that the parallel paths (robots and field rows) are taken.
@@ -38,8 +38,21 @@ deposits = [{ pheromone = "blue", kernel = { shape = "disc", radius = 0.01 }, ra
 fn run_with_threads(threads: usize) -> (Vec<u8>, Vec<u8>) {
     let sc = Scenario::from_toml_str(SCENARIO, ".").unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| run(&sc, dir.path(), &RunOptions { progress: false, no_gif: true })).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        run(
+            &sc,
+            dir.path(),
+            &RunOptions {
+                progress: false,
+                no_gif: true,
+            },
+        )
+    })
+    .unwrap();
     let log = std::fs::read(dir.path().join("trajectory.csv")).unwrap();
     let field = std::fs::read(dir.path().join("fields/red.npy")).unwrap();
     (log, field)

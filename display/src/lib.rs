@@ -15,12 +15,20 @@ use winit::window::{Fullscreen, Window, WindowId};
 
 #[derive(Debug, thiserror::Error)]
 pub enum DisplayError {
-    #[error("no display to open a window on ({0}); set DISPLAY/WAYLAND_DISPLAY, or render headless to PNG")]
+    #[error(
+        "no display to open a window on ({0}); set DISPLAY/WAYLAND_DISPLAY, or render headless to PNG"
+    )]
     NoDisplay(String),
-    #[error("no GPU adapter for the window (wgpu: {0}); install a Vulkan driver (e.g. mesa-vulkan-drivers)")]
+    #[error(
+        "no GPU adapter for the window (wgpu: {0}); install a Vulkan driver (e.g. mesa-vulkan-drivers)"
+    )]
     NoAdapter(String),
     #[error("monitor {index} does not exist ({count} found: {names})")]
-    NoMonitor { index: usize, count: usize, names: String },
+    NoMonitor {
+        index: usize,
+        count: usize,
+        names: String,
+    },
     #[error("window: {0}")]
     Window(String),
     #[error("GPU: {0}")]
@@ -142,30 +150,55 @@ pub struct Presenter {
 }
 
 impl Presenter {
-    pub fn new(device: wgpu::Device, queue: wgpu::Queue, target: wgpu::TextureFormat, size: (u32, u32)) -> Self {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("colcos display"), source: wgpu::ShaderSource::Wgsl(SHADER.into()) });
+    pub fn new(
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        target: wgpu::TextureFormat,
+        size: (u32, u32),
+    ) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("colcos display"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: None,
             entries: &[
                 wgpu::BindGroupLayoutEntry {
                     binding: 0,
                     visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable: false }, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false },
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
                     count: None,
                 },
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
                     visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
                     count: None,
                 },
             ],
         });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: None,
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("colcos display"),
             layout: Some(&pl),
-            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs"), compilation_options: Default::default(), buffers: &[] },
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: None,
             multisample: wgpu::MultisampleState::default(),
@@ -173,7 +206,11 @@ impl Presenter {
                 module: &module,
                 entry_point: Some("fs"),
                 compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState { format: target, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: target,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
             }),
             multiview_mask: None,
             cache: None,
@@ -185,13 +222,31 @@ impl Presenter {
             mapped_at_creation: false,
         });
         let (texture, bind) = Self::make_texture(&device, &layout, &uniform, size);
-        Presenter { device, queue, pipeline, layout, texture, uniform, bind, size }
+        Presenter {
+            device,
+            queue,
+            pipeline,
+            layout,
+            texture,
+            uniform,
+            bind,
+            size,
+        }
     }
 
-    fn make_texture(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, uniform: &wgpu::Buffer, size: (u32, u32)) -> (wgpu::Texture, wgpu::BindGroup) {
+    fn make_texture(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        uniform: &wgpu::Buffer,
+        size: (u32, u32),
+    ) -> (wgpu::Texture, wgpu::BindGroup) {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("colcos screen image"),
-            size: wgpu::Extent3d { width: size.0.max(1), height: size.1.max(1), depth_or_array_layers: 1 },
+            size: wgpu::Extent3d {
+                width: size.0.max(1),
+                height: size.1.max(1),
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -204,8 +259,14 @@ impl Presenter {
             label: None,
             layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 1, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: uniform.as_entire_binding(),
+                },
             ],
         });
         (texture, bind)
@@ -223,29 +284,51 @@ impl Presenter {
             return;
         }
         self.queue.write_texture(
-            wgpu::TexelCopyTextureInfo { texture: &self.texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
             rgba,
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * size.0), rows_per_image: Some(size.1) },
-            wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * size.0),
+                rows_per_image: Some(size.1),
+            },
+            wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 1,
+            },
         );
     }
 
     /// Draws the image onto `target` (`target_size` pixels): 1:1 when the sizes agree, else scaled to fit.
-    pub fn draw(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView, target_size: (u32, u32)) {
+    pub fn draw(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        target_size: (u32, u32),
+    ) {
         let (w, h) = (self.size.0.max(1) as f32, self.size.1.max(1) as f32);
         let (tw, th) = (target_size.0 as f32, target_size.1 as f32);
         let s = (tw / w).min(th / h);
         let s = if (s - 1.0).abs() < 1e-6 { 1.0 } else { s };
         let off = [((tw - w * s) * 0.5).floor(), ((th - h * s) * 0.5).floor()];
         let data: [f32; 8] = [w, h, off[0], off[1], 1.0 / s, 1.0 / s, 0.0, 0.0];
-        self.queue.write_buffer(&self.uniform, 0, bytemuck_cast(&data));
+        self.queue
+            .write_buffer(&self.uniform, 0, bytemuck_cast(&data));
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("colcos display"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: target,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
             })],
             depth_stencil_attachment: None,
             timestamp_writes: None,
@@ -271,14 +354,21 @@ fn instance() -> wgpu::Instance {
 /// back: exactly what the window shows at that size.
 pub fn render_headless(img: &image::RgbaImage, size: (u32, u32)) -> Result<image::RgbImage> {
     let inst = instance();
-    let adapter = pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions::default())).map_err(|e| DisplayError::NoAdapter(e.to_string()))?;
-    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default())).map_err(|e| DisplayError::Gpu(e.to_string()))?;
+    let adapter = pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions::default()))
+        .map_err(|e| DisplayError::NoAdapter(e.to_string()))?;
+    let (device, queue) =
+        pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
+            .map_err(|e| DisplayError::Gpu(e.to_string()))?;
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let mut p = Presenter::new(device.clone(), queue.clone(), format, img.dimensions());
     p.upload(img.as_raw(), img.dimensions());
     let target = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("colcos headless target"),
-        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        size: wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        },
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
@@ -296,20 +386,42 @@ pub fn render_headless(img: &image::RgbaImage, size: (u32, u32)) -> Result<image
     let mut enc = device.create_command_encoder(&Default::default());
     p.draw(&mut enc, &target.create_view(&Default::default()), size);
     enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo { texture: &target, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
-        wgpu::TexelCopyBufferInfo { buffer: &buf, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(size.1) } },
-        wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        wgpu::TexelCopyTextureInfo {
+            texture: &target,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buf,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(size.1),
+            },
+        },
+        wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        },
     );
     queue.submit([enc.finish()]);
     let (tx, rx) = std::sync::mpsc::channel();
     buf.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = tx.send(r);
     });
-    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| DisplayError::Gpu(e.to_string()))?;
-    rx.recv().map_err(|e| DisplayError::Gpu(e.to_string()))?.map_err(|e| DisplayError::Gpu(e.to_string()))?;
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| DisplayError::Gpu(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| DisplayError::Gpu(e.to_string()))?
+        .map_err(|e| DisplayError::Gpu(e.to_string()))?;
     let mut out = image::RgbImage::new(size.0, size.1);
     {
-        let view = buf.get_mapped_range(..).map_err(|e| DisplayError::Gpu(format!("{e:?}")))?;
+        let view = buf
+            .get_mapped_range(..)
+            .map_err(|e| DisplayError::Gpu(format!("{e:?}")))?;
         for y in 0..size.1 as usize {
             let src = &view[y * row as usize..][..4 * size.0 as usize];
             let dst = &mut out.as_mut()[y * 3 * size.0 as usize..][..3 * size.0 as usize];
@@ -344,30 +456,67 @@ struct App {
 impl App {
     fn open(&mut self, el: &ActiveEventLoop) -> Result<WindowState> {
         let monitors: Vec<_> = el.available_monitors().collect();
-        let names = monitors.iter().enumerate().map(|(i, m)| format!("{i}: {} {:?}", m.name().unwrap_or_default(), m.size())).collect::<Vec<_>>().join(", ");
+        let names = monitors
+            .iter()
+            .enumerate()
+            .map(|(i, m)| format!("{i}: {} {:?}", m.name().unwrap_or_default(), m.size()))
+            .collect::<Vec<_>>()
+            .join(", ");
         let monitor = match self.opts.monitor {
-            Some(i) => Some(monitors.get(i).cloned().ok_or(DisplayError::NoMonitor { index: i, count: monitors.len(), names: names.clone() })?),
+            Some(i) => Some(monitors.get(i).cloned().ok_or(DisplayError::NoMonitor {
+                index: i,
+                count: monitors.len(),
+                names: names.clone(),
+            })?),
             None => el.primary_monitor().or_else(|| monitors.first().cloned()),
         };
         eprintln!("colcos-display: monitors [{names}]");
         let size = self.opts.window_size.unwrap_or(self.source.size());
         let mut attrs = Window::default_attributes().with_title(self.opts.title.clone());
         if self.opts.fullscreen {
+            // The monitor's size and position too: without a window manager (a bare X server, a kiosk)
+            // the fullscreen hint alone does not resize the window.
+            if let Some(m) = &monitor {
+                attrs = attrs.with_inner_size(m.size()).with_position(m.position()).with_decorations(false);
+            }
             attrs = attrs.with_fullscreen(Some(Fullscreen::Borderless(monitor)));
         } else {
-            attrs = attrs.with_inner_size(winit::dpi::PhysicalSize::new(size.0.max(1), size.1.max(1))).with_decorations(self.opts.decorations).with_resizable(true);
+            attrs = attrs
+                .with_inner_size(winit::dpi::PhysicalSize::new(size.0.max(1), size.1.max(1)))
+                .with_decorations(self.opts.decorations)
+                .with_resizable(true);
             if let Some((x, y)) = self.opts.position {
                 attrs = attrs.with_position(winit::dpi::PhysicalPosition::new(x, y));
             }
         }
-        let window = Arc::new(el.create_window(attrs).map_err(|e| DisplayError::Window(e.to_string()))?);
+        let window = Arc::new(
+            el.create_window(attrs)
+                .map_err(|e| DisplayError::Window(e.to_string()))?,
+        );
         let inst = instance();
-        let surface = inst.create_surface(window.clone()).map_err(|e| DisplayError::Gpu(e.to_string()))?;
-        let adapter = pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions { compatible_surface: Some(&surface), ..Default::default() })).map_err(|e| DisplayError::NoAdapter(e.to_string()))?;
-        eprintln!("colcos-display: adapter {} ({:?}, {:?})", adapter.get_info().name, adapter.get_info().device_type, adapter.get_info().backend);
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default())).map_err(|e| DisplayError::Gpu(e.to_string()))?;
+        let surface = inst
+            .create_surface(window.clone())
+            .map_err(|e| DisplayError::Gpu(e.to_string()))?;
+        let adapter = pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions {
+            compatible_surface: Some(&surface),
+            ..Default::default()
+        }))
+        .map_err(|e| DisplayError::NoAdapter(e.to_string()))?;
+        eprintln!(
+            "colcos-display: adapter {} ({:?}, {:?})",
+            adapter.get_info().name,
+            adapter.get_info().device_type,
+            adapter.get_info().backend
+        );
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
+                .map_err(|e| DisplayError::Gpu(e.to_string()))?;
         let inner = window.inner_size();
-        let mut config = surface.get_default_config(&adapter, inner.width.max(1), inner.height.max(1)).ok_or_else(|| DisplayError::Gpu("the surface is not supported by the adapter".into()))?;
+        let mut config = surface
+            .get_default_config(&adapter, inner.width.max(1), inner.height.max(1))
+            .ok_or_else(|| {
+                DisplayError::Gpu("the surface is not supported by the adapter".into())
+            })?;
         let caps = surface.get_capabilities(&adapter);
         // A non-sRGB format, so the 8-bit levels are shown as they are.
         if let Some(f) = caps.formats.iter().find(|f| !f.is_srgb()) {
@@ -375,11 +524,22 @@ impl App {
         } else {
             config.view_formats = vec![config.format.remove_srgb_suffix()];
         }
-        config.present_mode = if self.opts.vsync { wgpu::PresentMode::Fifo } else if caps.present_modes.contains(&wgpu::PresentMode::Immediate) { wgpu::PresentMode::Immediate } else { wgpu::PresentMode::AutoNoVsync };
+        config.present_mode = if self.opts.vsync {
+            wgpu::PresentMode::Fifo
+        } else if caps.present_modes.contains(&wgpu::PresentMode::Immediate) {
+            wgpu::PresentMode::Immediate
+        } else {
+            wgpu::PresentMode::AutoNoVsync
+        };
         surface.configure(&device, &config);
         let view_format = config.format.remove_srgb_suffix();
         let presenter = Presenter::new(device, queue, view_format, self.source.size());
-        Ok(WindowState { window, surface, config, presenter })
+        Ok(WindowState {
+            window,
+            surface,
+            config,
+            presenter,
+        })
     }
 
     fn redraw(&mut self) -> Result<()> {
@@ -394,21 +554,33 @@ impl App {
             }
         }
         let size = self.source.size();
-        let Some(st) = self.state.as_mut() else { return Ok(()) };
+        let Some(st) = self.state.as_mut() else {
+            return Ok(());
+        };
         if let Some(f) = self.pending.take() {
             st.presenter.upload(&f, size);
         }
         let frame = match st.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => return Ok(()),
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(());
+            }
             _ => {
                 st.surface.configure(&st.presenter.device, &st.config);
                 return Ok(());
             }
         };
-        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor { format: Some(st.config.format.remove_srgb_suffix()), ..Default::default() });
-        let mut enc = st.presenter.device.create_command_encoder(&Default::default());
-        st.presenter.draw(&mut enc, &view, (st.config.width, st.config.height));
+        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(st.config.format.remove_srgb_suffix()),
+            ..Default::default()
+        });
+        let mut enc = st
+            .presenter
+            .device
+            .create_command_encoder(&Default::default());
+        st.presenter
+            .draw(&mut enc, &view, (st.config.width, st.config.height));
         st.presenter.queue.submit([enc.finish()]);
         st.window.pre_present_notify();
         st.presenter.queue.present(frame);
@@ -443,7 +615,9 @@ impl ApplicationHandler for App {
         match event {
             WindowEvent::CloseRequested => el.exit(),
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                if matches!(event.logical_key, Key::Named(NamedKey::Escape)) || event.logical_key == Key::Character("q".into()) {
+                if matches!(event.logical_key, Key::Named(NamedKey::Escape))
+                    || event.logical_key == Key::Character("q".into())
+                {
                     el.exit();
                 }
             }
@@ -476,14 +650,23 @@ impl ApplicationHandler for App {
             st.window.request_redraw();
         }
         // With vsync, presenting paces the loop; without, wait for the next frame time.
-        el.set_control_flow(if self.opts.vsync { ControlFlow::Poll } else { ControlFlow::WaitUntil(self.next_frame) });
+        el.set_control_flow(if self.opts.vsync {
+            ControlFlow::Poll
+        } else {
+            ControlFlow::WaitUntil(self.next_frame)
+        });
     }
 }
 
 /// Opens the window and shows `source`'s frames until it is closed (or `close_after`).
 pub fn run_window(opts: DisplayOptions, source: Box<dyn FrameSource>) -> Result<()> {
-    if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() && cfg!(target_os = "linux") {
-        return Err(DisplayError::NoDisplay("neither DISPLAY nor WAYLAND_DISPLAY is set".into()));
+    if std::env::var_os("DISPLAY").is_none()
+        && std::env::var_os("WAYLAND_DISPLAY").is_none()
+        && cfg!(target_os = "linux")
+    {
+        return Err(DisplayError::NoDisplay(
+            "neither DISPLAY nor WAYLAND_DISPLAY is set".into(),
+        ));
     }
     let mut builder = EventLoop::builder();
     #[cfg(target_os = "linux")]
@@ -491,10 +674,23 @@ pub fn run_window(opts: DisplayOptions, source: Box<dyn FrameSource>) -> Result<
         use winit::platform::x11::EventLoopBuilderExtX11;
         builder.with_any_thread(true);
     }
-    let event_loop = builder.build().map_err(|e| DisplayError::NoDisplay(e.to_string()))?;
+    let event_loop = builder
+        .build()
+        .map_err(|e| DisplayError::NoDisplay(e.to_string()))?;
     let now = Instant::now();
-    let mut app = App { opts, source, state: None, error: None, started: now, next_frame: now, presented: 0, pending: None };
-    event_loop.run_app(&mut app).map_err(|e| DisplayError::Window(e.to_string()))?;
+    let mut app = App {
+        opts,
+        source,
+        state: None,
+        error: None,
+        started: now,
+        next_frame: now,
+        presented: 0,
+        pending: None,
+    };
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| DisplayError::Window(e.to_string()))?;
     match app.error {
         Some(e) => Err(e),
         None => Ok(()),

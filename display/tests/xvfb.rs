@@ -1,7 +1,7 @@
 //! The display window under X (Xvfb in CI): open it, take a screenshot of the screen, compare it with
 //! the headless PNG of the same image. Skips (and says why) without DISPLAY, ImageMagick's `import` or a
 //! GPU adapter, unless COLCOS_REQUIRE_DISPLAY=1 (CI), where a skip is a failure.
-use colcos_display::{render_headless, DisplayError};
+use colcos_display::{DisplayError, render_headless};
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -17,22 +17,45 @@ fn skip(why: &str) {
 fn pattern(w: u32, h: u32) -> image::RgbaImage {
     image::RgbaImage::from_fn(w, h, |x, y| {
         let bar = (x * 8 / w) as u8;
-        let r = if bar & 1 != 0 { 255 } else { (x * 255 / w) as u8 };
-        let g = if bar & 2 != 0 { 200 } else { (y * 255 / h) as u8 };
-        let b = if bar & 4 != 0 { 37 } else { ((x ^ y) & 0xff) as u8 };
+        let r = if bar & 1 != 0 {
+            255
+        } else {
+            (x * 255 / w) as u8
+        };
+        let g = if bar & 2 != 0 {
+            200
+        } else {
+            (y * 255 / h) as u8
+        };
+        let b = if bar & 4 != 0 {
+            37
+        } else {
+            ((x ^ y) & 0xff) as u8
+        };
         image::Rgba([r, g, b, 255])
     })
 }
 
 fn screenshot(path: &std::path::Path) -> Result<(), String> {
-    let out = Command::new("import").args(["-window", "root"]).arg(path).output().map_err(|e| format!("import: {e}"))?;
+    let out = Command::new("import")
+        .args(["-window", "root"])
+        .arg(path)
+        .output()
+        .map_err(|e| format!("import: {e}"))?;
     if !out.status.success() {
-        return Err(format!("import failed: {}", String::from_utf8_lossy(&out.stderr)));
+        return Err(format!(
+            "import failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        ));
     }
     Ok(())
 }
 
-fn show_and_capture(img_path: &std::path::Path, extra: &[&str], shot: &std::path::Path) -> Result<(), String> {
+fn show_and_capture(
+    img_path: &std::path::Path,
+    extra: &[&str],
+    shot: &std::path::Path,
+) -> Result<(), String> {
     let mut child = Command::new(env!("CARGO_BIN_EXE_colcos-show"))
         .arg(img_path)
         .args(extra)
@@ -62,11 +85,14 @@ fn show_and_capture(img_path: &std::path::Path, extra: &[&str], shot: &std::path
     let r = screenshot(shot);
     let _ = child.kill();
     let _ = child.wait();
-    eprintln!("window up and captured in {:.1} s", started.elapsed().as_secs_f64());
+    eprintln!(
+        "window up and captured in {:.1} s",
+        started.elapsed().as_secs_f64()
+    );
     r
 }
 
-fn check(name: &str, img: image::RgbaImage, extra: &[&str], region: Option<(u32, u32)>) {
+fn check(name: &str, img: image::RgbaImage, extra: &[&str], whole_screen: bool) {
     if std::env::var_os("DISPLAY").is_none() {
         return skip("DISPLAY is not set (run under xvfb-run, see gpu/ci.sh)");
     }
@@ -82,14 +108,19 @@ fn check(name: &str, img: image::RgbaImage, extra: &[&str], region: Option<(u32,
         return skip(&format!("the window could not be shown: {e}"));
     }
     let shot = image::open(&shot_path).unwrap().to_rgb8();
-    let (w, h) = region.unwrap_or(img.dimensions());
+    let (w, h) = if whole_screen { shot.dimensions() } else { img.dimensions() };
     let headless = match render_headless(&img, (w, h)) {
         Ok(i) => i,
         Err(DisplayError::NoAdapter(e)) => return skip(&format!("no GPU adapter: {e}")),
         Err(e) => panic!("headless rendering failed: {e}"),
     };
     headless.save(dir.join("headless.png")).unwrap();
-    assert!(shot.width() >= w && shot.height() >= h, "screenshot {}x{} smaller than {w}x{h}", shot.width(), shot.height());
+    assert!(
+        shot.width() >= w && shot.height() >= h,
+        "screenshot {}x{} smaller than {w}x{h}",
+        shot.width(),
+        shot.height()
+    );
     let mut differ = 0;
     for y in 0..h {
         for x in 0..w {
@@ -98,12 +129,30 @@ fn check(name: &str, img: image::RgbaImage, extra: &[&str], region: Option<(u32,
             }
         }
     }
-    assert_eq!(differ, 0, "{name}: {differ} of {} pixels differ between the screenshot and the headless PNG (see {})", w * h, dir.display());
+    assert_eq!(
+        differ,
+        0,
+        "{name}: {differ} of {} pixels differ between the screenshot and the headless PNG (see {})",
+        w * h,
+        dir.display()
+    );
     eprintln!("{name}: screenshot of {w}x{h} identical to the headless PNG");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn windowed_screenshot_matches_headless_png() {
-    check("windowed", pattern(320, 180), &["--at", "0,0", "--no-decorations"], None);
+    check(
+        "windowed",
+        pattern(320, 180),
+        &["--at", "0,0", "--no-decorations"],
+        false,
+    );
+}
+
+/// Borderless full screen: the image scaled by the largest factor that fits, black bars; the whole
+/// screen must equal the headless rendering at the screen's size.
+#[test]
+fn fullscreen_screenshot_matches_headless_png() {
+    check("fullscreen", pattern(320, 180), &["--fullscreen", "--monitor", "0"], true);
 }

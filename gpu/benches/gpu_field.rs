@@ -10,34 +10,58 @@
 //! `COLCOS_BENCH_STEPS` scales the number of steps (default 20 for 4K, 50 for the batch).
 use colcos_gpu::screen::{GpuScreen, ScreenLayer, ScreenScene, SensorQuery};
 use colcos_gpu::{AdapterPolicy, Deposit, GpuContext, GpuGrids};
-use colcos_sim::field::{DiffusionScheme, FieldModel, GridField, GridParams, GridSpec, Kernel, Pheromone};
+use colcos_sim::Vec2;
+use colcos_sim::field::{
+    DiffusionScheme, FieldModel, GridField, GridParams, GridSpec, Kernel, Pheromone,
+};
 use colcos_sim::screen::ScreenSpec;
 use colcos_sim::sensors::{ColourSensor, ColourSensorParams};
-use colcos_sim::Vec2;
 use rayon::prelude::*;
 use std::time::Instant;
 
 fn steps(default: usize) -> usize {
-    std::env::var("COLCOS_BENCH_STEPS").ok().and_then(|s| s.parse().ok()).unwrap_or(default)
+    std::env::var("COLCOS_BENCH_STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(default)
 }
 
 /// Memory bandwidth of the adapter, GB/s, where known.
 fn bandwidth(ctx: &GpuContext) -> Option<f64> {
-    if let Some(b) = std::env::var("COLCOS_GPU_BANDWIDTH_GBS").ok().and_then(|s| s.parse().ok()) {
+    if let Some(b) = std::env::var("COLCOS_GPU_BANDWIDTH_GBS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
         return Some(b);
     }
     let n = ctx.info.name.to_ascii_lowercase();
-    [("h200", 4800.0), ("h100", 3350.0), ("a100", 2039.0), ("l40s", 864.0), ("4090", 1008.0), ("3090", 936.0)]
-        .iter()
-        .find(|(k, _)| n.contains(k))
-        .map(|&(_, b)| b)
+    [
+        ("h200", 4800.0),
+        ("h100", 3350.0),
+        ("a100", 2039.0),
+        ("l40s", 864.0),
+        ("4090", 1008.0),
+        ("3090", 936.0),
+    ]
+    .iter()
+    .find(|(k, _)| n.contains(k))
+    .map(|&(_, b)| b)
 }
 
 fn bench_4k(ctx: &std::sync::Arc<GpuContext>, d: f32, label: &str) {
     let screen = ScreenSpec::default();
-    let spec = GridSpec { nx: 3840, ny: 2160, cell: screen.size[0] / 3840.0 };
+    let spec = GridSpec {
+        nx: 3840,
+        ny: 2160,
+        cell: screen.size[0] / 3840.0,
+    };
     let dt = 0.02;
-    let params = GridParams { evaporation: 20.0, diffusion: d, scheme: DiffusionScheme::Auto, wind: Vec2::ZERO };
+    let params = GridParams {
+        evaporation: 20.0,
+        diffusion: d,
+        scheme: DiffusionScheme::Auto,
+        wind: Vec2::ZERO,
+    };
     let r = d * dt / (spec.cell * spec.cell);
     let mut cpu: Vec<GridField> = (0..3).map(|_| GridField::new(spec, params)).collect();
     for (k, f) in cpu.iter_mut().enumerate() {
@@ -76,7 +100,10 @@ fn bench_4k(ctx: &std::sync::Arc<GpuContext>, d: f32, label: &str) {
         gpu_s * 1e3,
         1.0 / gpu_s,
         0.02 / gpu_s,
-        bandwidth(ctx).map_or(" (adapter bandwidth unknown: set COLCOS_GPU_BANDWIDTH_GBS)".to_string(), |b| format!(" = {:.1} % of the adapter's {b} GB/s", 100.0 * gbs / b)),
+        bandwidth(ctx).map_or(
+            " (adapter bandwidth unknown: set COLCOS_GPU_BANDWIDTH_GBS)".to_string(),
+            |b| format!(" = {:.1} % of the adapter's {b} GB/s", 100.0 * gbs / b)
+        ),
         cpu_s * 1e3,
         1.0 / cpu_s,
         cpu_s / gpu_s
@@ -88,7 +115,12 @@ fn bench_batch(ctx: &std::sync::Arc<GpuContext>, worlds: usize) {
     let arena = Vec2::new(screen.size[0], screen.size[1]);
     let spec = GridSpec::covering(arena, 0.005);
     let dt = 0.02;
-    let params = GridParams { evaporation: 20.0, diffusion: 2e-6, scheme: DiffusionScheme::Auto, wind: Vec2::ZERO };
+    let params = GridParams {
+        evaporation: 20.0,
+        diffusion: 2e-6,
+        scheme: DiffusionScheme::Auto,
+        wind: Vec2::ZERO,
+    };
     let kernel = Kernel::Disc { radius: 0.008 };
     let robots = 4;
     let mut cpu: Vec<GridField> = (0..worlds).map(|_| GridField::new(spec, params)).collect();
@@ -104,17 +136,47 @@ fn bench_batch(ctx: &std::sync::Arc<GpuContext>, worlds: usize) {
     };
     let n = steps(50);
     let sensors_of = |w: usize, t: f32| -> Vec<Vec2> {
-        (0..robots).flat_map(|r| (0..4).map(move |k| pos(w, r, t) + 0.015 * Vec2::from_angle(k as f32 * std::f32::consts::FRAC_PI_2))).collect()
+        (0..robots)
+            .flat_map(|r| {
+                (0..4).map(move |k| {
+                    pos(w, r, t) + 0.015 * Vec2::from_angle(k as f32 * std::f32::consts::FRAC_PI_2)
+                })
+            })
+            .collect()
     };
     // GPU: deposits, step, sensing, all in the batch; only the sensor sums come back.
-    let scene = ScreenScene { worlds: (0..worlds).map(|w| vec![ScreenLayer::Grid { colour: [255.0, 0.0, 0.0], field: w }]).collect() };
+    let scene = ScreenScene {
+        worlds: (0..worlds)
+            .map(|w| {
+                vec![ScreenLayer::Grid {
+                    colour: [255.0, 0.0, 0.0],
+                    field: w,
+                }]
+            })
+            .collect(),
+    };
     let t0 = Instant::now();
     for s in 0..n {
         let t = s as f32 * dt;
-        let deps: Vec<Deposit> = (0..worlds).flat_map(|w| (0..robots).map(move |r| (w, r))).map(|(w, r)| Deposit { field: w, kernel, a: pos(w, r, t - dt), b: pos(w, r, t), amount: 3.0 * dt }).collect();
+        let deps: Vec<Deposit> = (0..worlds)
+            .flat_map(|w| (0..robots).map(move |r| (w, r)))
+            .map(|(w, r)| Deposit {
+                field: w,
+                kernel,
+                a: pos(w, r, t - dt),
+                b: pos(w, r, t),
+                amount: 3.0 * dt,
+            })
+            .collect();
         gpu.deposit(&deps).unwrap();
         gpu.step(dt).unwrap();
-        let queries: Vec<SensorQuery> = (0..worlds).flat_map(|w| sensors_of(w, t).into_iter().map(move |c| (w, c))).map(|(w, c)| SensorQuery { world: w as u32, points: sensor.sample_points(c) }).collect();
+        let queries: Vec<SensorQuery> = (0..worlds)
+            .flat_map(|w| sensors_of(w, t).into_iter().map(move |c| (w, c)))
+            .map(|(w, c)| SensorQuery {
+                world: w as u32,
+                points: sensor.sample_points(c),
+            })
+            .collect();
         let sums = gs.sense(Some(&gpu), &scene, &screen, &queries).unwrap();
         std::hint::black_box(sums);
     }
@@ -132,7 +194,11 @@ fn bench_batch(ctx: &std::sync::Arc<GpuContext>, worlds: usize) {
                     f.deposit_segment(&kernel, pos(w, r, t - dt), pos(w, r, t), 3.0 * dt);
                 }
                 f.step(dt);
-                let ph = [Pheromone { name: "trail".into(), colour: [255.0, 0.0, 0.0], model: FieldModel::Grid(f) }];
+                let ph = [Pheromone {
+                    name: "trail".into(),
+                    colour: [255.0, 0.0, 0.0],
+                    model: FieldModel::Grid(f),
+                }];
                 let mut acc = 0.0;
                 for c in sensors_of(w, t) {
                     acc += sensor.screen_levels(&ph, &screen, c)[0];
@@ -176,6 +242,9 @@ fn main() {
     println!("adapter: {}", ctx.describe());
     bench_4k(&ctx, 1e-6, "explicit");
     bench_4k(&ctx, 2e-6, "implicit");
-    let worlds = std::env::var("COLCOS_BENCH_WORLDS").ok().and_then(|s| s.parse().ok()).unwrap_or(1024);
+    let worlds = std::env::var("COLCOS_BENCH_WORLDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1024);
     bench_batch(&ctx, worlds);
 }

@@ -6,7 +6,9 @@
 //! transfers cost more than the step itself for small grids; the batched API ([`crate::GpuGrids`] with
 //! [`crate::GpuGrids::deposit`] and [`crate::screen::GpuScreen::sense`]) keeps the fields on the GPU.
 use crate::{AdapterPolicy, GpuContext, GpuError, GpuGrids, Result};
-use colcos_sim::field::{BackendChoice, FieldBackend, FieldModel, GridField, GridParams, Pheromone};
+use colcos_sim::field::{
+    BackendChoice, FieldBackend, FieldModel, GridField, GridParams, Pheromone,
+};
 use colcos_sim::world::World;
 use std::sync::Arc;
 
@@ -36,7 +38,10 @@ pub fn context_for(choice: BackendChoice) -> Result<(Option<Arc<GpuContext>>, St
         BackendChoice::Gpu => GpuContext::new(AdapterPolicy::Any).map(|c| (Some(c), String::new())),
         BackendChoice::Auto => match GpuContext::new(AdapterPolicy::HardwareOnly) {
             Ok(c) => Ok((Some(c), String::new())),
-            Err(GpuError::SoftwareOnly(a)) => Ok((None, format!("auto: only a software adapter, {a}, which is slower than the CPU"))),
+            Err(GpuError::SoftwareOnly(a)) => Ok((
+                None,
+                format!("auto: only a software adapter, {a}, which is slower than the CPU"),
+            )),
             Err(GpuError::NoAdapter(_)) => Ok((None, "auto: no GPU adapter".into())),
             Err(e) => Ok((None, format!("auto: the GPU could not be opened: {e}"))),
         },
@@ -58,7 +63,9 @@ pub fn install(world: &mut World, choice: BackendChoice) -> Result<BackendSelect
         }
         None => {
             world.set_field_backend(None);
-            Ok(BackendSelection::Cpu { reason: "no grid pheromones to step".into() })
+            Ok(BackendSelection::Cpu {
+                reason: "no grid pheromones to step".into(),
+            })
         }
     }
 }
@@ -93,8 +100,18 @@ impl GpuWorldBackend {
         }
         let grids = GpuGrids::from_fields(ctx.clone(), &fields)?;
         let params = fields.iter().map(|f| *f.params()).collect();
-        let injection = fields.iter().map(|f| f.static_injection().map(|j| j.to_vec())).collect();
-        Ok(Some(GpuWorldBackend { ctx, grids, map, params, injection, failed: false }))
+        let injection = fields
+            .iter()
+            .map(|f| f.static_injection().map(|j| j.to_vec()))
+            .collect();
+        Ok(Some(GpuWorldBackend {
+            ctx,
+            grids,
+            map,
+            params,
+            injection,
+            failed: false,
+        }))
     }
 
     pub fn grids(&self) -> &GpuGrids {
@@ -106,7 +123,9 @@ impl GpuWorldBackend {
             return Err(GpuError::Invalid("the world's pheromones changed".into()));
         }
         for (p, m) in pheromones.iter().zip(&self.map) {
-            let (FieldModel::Grid(g), Some(f)) = (&p.model, m) else { continue };
+            let (FieldModel::Grid(g), Some(f)) = (&p.model, m) else {
+                continue;
+            };
             let f = *f;
             self.grids.write_field(f, g.values())?;
             if *g.params() != self.params[f] {
@@ -132,7 +151,11 @@ impl GpuWorldBackend {
 
 impl FieldBackend for GpuWorldBackend {
     fn describe(&self) -> String {
-        if self.failed { format!("cpu (the GPU {} failed)", self.ctx.describe()) } else { format!("gpu: {}", self.ctx.describe()) }
+        if self.failed {
+            format!("cpu (the GPU {} failed)", self.ctx.describe())
+        } else {
+            format!("gpu: {}", self.ctx.describe())
+        }
     }
 
     fn step(&mut self, pheromones: &mut [Pheromone], dt: f32) {

@@ -53,6 +53,13 @@ struct Dep {
 @group(0) @binding(4) var<storage, read> coef: array<f32>;
 @group(0) @binding(5) var<storage, read> deps: array<Dep>;
 
+// The GPU compilers fuse a multiply feeding an add into one FMA (one rounding instead of two), which
+// the CPU does not do; a select on a uniform that is always false hides the product from that fusion,
+// so the arithmetic stays that of the CPU.
+fn exact(x: f32) -> f32 {
+    return select(x, 0.0, P._pad != 0u);
+}
+
 fn linear_id(wg: vec3<u32>, lid: u32) -> u32 {
     return (wg.x + wg.y * P.groups_x) * 256u + lid;
 }
@@ -61,9 +68,18 @@ fn entry(f: u32) -> PF {
     return plan[P.index * P.nfields + f];
 }
 
-// a Phi + b J at cell k of the source slot (the CPU's psi).
+// a Phi + b J (or a Phi without a map) at cell k of the source slot (the CPU's psi).
 fn psi(e: PF, s: u32, k: u32) -> f32 {
-    return e.a * vals[s + k] + e.b * inj[u32(e.inj) + k];
+    if (e.inj >= 0) {
+        return exact(e.a * vals[s + k]) + exact(e.b * inj[u32(e.inj) + k]);
+    }
+    return e.a * vals[s + k];
+}
+
+// Values at or below 1e-30, negative values and NaN become 0 after every pass, as on the CPU
+// (`FLUSH_BELOW` in sim/src/field/grid.rs: no subnormals).
+fn flush(v: f32) -> f32 {
+    return select(0.0, v, v > 1e-30);
 }
 
 // Phi <- a Phi + b J, in place.
@@ -77,15 +93,14 @@ fn evaporate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
     if (e.on == 0u) { return; }
     let s = (2u * f + e.src) * n;
     if (e.inj >= 0) {
-        vals[s + k] = psi(e, s, k);
+        vals[s + k] = flush(psi(e, s, k));
     } else {
-        vals[s + k] = vals[s + k] * e.a;
+        vals[s + k] = flush(vals[s + k] * e.a);
     }
 }
 
-// One explicit step of the symmetric 5-point Laplacian, dst = scale (w c + r ((l + r) + (up + dn))),
-// walls count as the cell itself (no flux). With an injection map the stencil acts on psi (scale 1),
-// otherwise on the values with scale a.
+// One explicit step of the symmetric 5-point Laplacian on psi = a Phi + b J,
+// dst = w c + r ((l + r) + (up + dn)); walls count as the cell itself (no flux).
 @compute @workgroup_size(256)
 fn explicit_step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let nx = P.nx;
@@ -100,37 +115,17 @@ fn explicit_step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation
     let d = (2u * f + 1u - e.src) * n;
     let x = k % nx;
     let y = k / nx;
-    let w = 1.0 - 4.0 * e.r;
-    var c: f32;
-    var l: f32;
-    var rt: f32;
-    var up: f32;
-    var dn: f32;
-    var scale: f32;
-    if (e.inj >= 0) {
-        c = psi(e, s, k);
-        l = c;
-        rt = c;
-        up = c;
-        dn = c;
-        if (x > 0u) { l = psi(e, s, k - 1u); }
-        if (x + 1u < nx) { rt = psi(e, s, k + 1u); }
-        if (y + 1u < ny) { up = psi(e, s, k + nx); }
-        if (y > 0u) { dn = psi(e, s, k - nx); }
-        scale = 1.0;
-    } else {
-        c = vals[s + k];
-        l = c;
-        rt = c;
-        up = c;
-        dn = c;
-        if (x > 0u) { l = vals[s + k - 1u]; }
-        if (x + 1u < nx) { rt = vals[s + k + 1u]; }
-        if (y + 1u < ny) { up = vals[s + k + nx]; }
-        if (y > 0u) { dn = vals[s + k - nx]; }
-        scale = e.a;
-    }
-    vals[d + k] = scale * (w * c + e.r * ((l + rt) + (up + dn)));
+    let w = 1.0 - exact(4.0 * e.r);
+    let c = psi(e, s, k);
+    var l = c;
+    var rt = c;
+    var up = c;
+    var dn = c;
+    if (x > 0u) { l = psi(e, s, k - 1u); }
+    if (x + 1u < nx) { rt = psi(e, s, k + 1u); }
+    if (y + 1u < ny) { up = psi(e, s, k + nx); }
+    if (y > 0u) { dn = psi(e, s, k - nx); }
+    vals[d + k] = flush(exact(w * c) + exact(e.r * (exact(l + rt) + exact(up + dn))));
 }
 
 // The paper's one-sided scheme, eq. (4), conservative reading: each cell sends s/2 right and s/2 up.
@@ -153,10 +148,10 @@ fn one_sided(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
     if (y + 1u < ny) { keep_v = half; }
     var keep_h = 0.0;
     if (x + 1u < nx) { keep_h = half; }
-    var v = vals[s + k] * (1.0 - keep_h - keep_v);
-    if (x > 0u) { v = v + half * vals[s + k - 1u]; }
-    if (y > 0u) { v = v + half * vals[s + k - nx]; }
-    vals[d + k] = v;
+    var v = exact(vals[s + k] * (exact(1.0 - keep_h) - keep_v));
+    if (x > 0u) { v = v + exact(half * vals[s + k - 1u]); }
+    if (y > 0u) { v = v + exact(half * vals[s + k - nx]); }
+    vals[d + k] = flush(v);
 }
 
 // Backward-Euler x-solve, one thread per row (Thomas), fused with evaporation and injection.
@@ -178,11 +173,11 @@ fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var i = 0u; i < nx; i = i + 1u) {
         var fv: f32;
         if (e.inj >= 0) {
-            fv = e.a * vals[s + i] + e.b * inj[u32(e.inj) + row * nx + i];
+            fv = exact(e.a * vals[s + i]) + exact(e.b * inj[u32(e.inj) + row * nx + i]);
         } else {
-            fv = e.a * vals[s + i];
+            fv = exact(e.a * vals[s + i]);
         }
-        let v = (fv + e.r * prev) * coef[m + i];
+        let v = flush((fv + exact(e.r * prev)) * coef[m + i]);
         vals[d + i] = v;
         prev = v;
     }
@@ -190,7 +185,7 @@ fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
         var i = nx - 1u;
         loop {
             i = i - 1u;
-            vals[d + i] = vals[d + i] + coef[cp + i] * vals[d + i + 1u];
+            vals[d + i] = flush(vals[d + i] + exact(coef[cp + i] * vals[d + i + 1u]));
             if (i == 0u) { break; }
         }
     }
@@ -211,15 +206,15 @@ fn ysolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let d = (2u * f + 1u - e.src) * n + col;
     let m = e.coef + 2u * nx;
     let cp = m + ny;
-    vals[d] = vals[s] * coef[m];
+    vals[d] = flush(vals[s] * coef[m]);
     for (var j = 1u; j < ny; j = j + 1u) {
-        vals[d + j * nx] = (vals[s + j * nx] + e.r * vals[d + (j - 1u) * nx]) * coef[m + j];
+        vals[d + j * nx] = flush((vals[s + j * nx] + exact(e.r * vals[d + (j - 1u) * nx])) * coef[m + j]);
     }
     if (ny < 2u) { return; }
     var j = ny - 1u;
     loop {
         j = j - 1u;
-        vals[d + j * nx] = vals[d + j * nx] + coef[cp + j] * vals[d + (j + 1u) * nx];
+        vals[d + j * nx] = flush(vals[d + j * nx] + exact(coef[cp + j] * vals[d + (j + 1u) * nx]));
         if (j == 0u) { break; }
     }
 }
@@ -242,23 +237,23 @@ fn advect_x(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
     var v: f32;
     if (c > 0.0) {
         if (x == nx - 1u) {
-            v = old + c * vals[s + k - 1u];
+            v = old + exact(c * vals[s + k - 1u]);
         } else if (x == 0u) {
             v = old * (1.0 - c);
         } else {
-            v = old * (1.0 - c) + c * vals[s + k - 1u];
+            v = exact(old * (1.0 - c)) + exact(c * vals[s + k - 1u]);
         }
     } else {
         let ca = -c;
         if (x == 0u) {
-            v = old + ca * vals[s + k + 1u];
+            v = old + exact(ca * vals[s + k + 1u]);
         } else if (x == nx - 1u) {
             v = old * (1.0 - ca);
         } else {
-            v = old * (1.0 - ca) + ca * vals[s + k + 1u];
+            v = exact(old * (1.0 - ca)) + exact(ca * vals[s + k + 1u]);
         }
     }
-    vals[d + k] = v;
+    vals[d + k] = flush(v);
 }
 
 // Upwind advection along y.
@@ -280,24 +275,26 @@ fn advect_y(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
     var v: f32;
     if (c > 0.0) {
         if (y == ny - 1u) {
-            v = old * 1.0 + c * vals[s + k - nx];
+            v = old + exact(c * vals[s + k - nx]);
         } else if (y == 0u) {
             v = old * (1.0 - c);
         } else {
-            v = old * (1.0 - c) + c * vals[s + k - nx];
+            v = exact(old * (1.0 - c)) + exact(c * vals[s + k - nx]);
         }
     } else {
         let ca = -c;
         if (y == 0u) {
-            v = old * 1.0 + ca * vals[s + k + nx];
+            v = old + exact(ca * vals[s + k + nx]);
         } else if (y == ny - 1u) {
             v = old * (1.0 - ca);
         } else {
-            v = old * (1.0 - ca) + ca * vals[s + k + nx];
+            v = exact(old * (1.0 - ca)) + exact(ca * vals[s + k + nx]);
         }
     }
-    vals[d + k] = v;
+    vals[d + k] = flush(v);
 }
+
+//KEXP//
 
 fn kernel_weight(kind: u32, param: f32, dist: f32) -> f32 {
     let d = abs(dist);
@@ -310,7 +307,7 @@ fn kernel_weight(kind: u32, param: f32, dist: f32) -> f32 {
         return 0.0;
     }
     if (d <= 3.0 * param && param > 0.0) {
-        return exp(-d * d / (2.0 * param * param));
+        return kexp(-d * d / (2.0 * param * param));
     }
     if (d == 0.0) { return 1.0; }
     return 0.0;
@@ -332,16 +329,16 @@ fn deposit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
     let py = (f32(j) + 0.5) * P.cell;
     var t = 0.0;
     if (dp.len2 > 0.0) {
-        t = clamp(((px - dp.ax) * dp.abx + (py - dp.ay) * dp.aby) / dp.len2, 0.0, 1.0);
+        t = clamp((exact((px - dp.ax) * dp.abx) + exact((py - dp.ay) * dp.aby)) / dp.len2, 0.0, 1.0);
     }
-    let qx = px - (dp.ax + dp.abx * t);
-    let qy = py - (dp.ay + dp.aby * t);
-    let dist = sqrt(qx * qx + qy * qy);
+    let qx = px - (dp.ax + exact(dp.abx * t));
+    let qy = py - (dp.ay + exact(dp.aby * t));
+    let dist = sqrt(exact(qx * qx) + exact(qy * qy));
     if (dist <= dp.support) {
         let w = kernel_weight(dp.kind, dp.param, dist);
         if (w != 0.0) {
             let idx = (2u * dp.field + dp.slot) * n + j * P.nx + i;
-            vals[idx] = vals[idx] + dp.amount * w;
+            vals[idx] = vals[idx] + exact(dp.amount * w);
         }
     }
 }

@@ -1,6 +1,6 @@
 //! A batch of grid fields on the GPU: the same model, scheme and f32 arithmetic as
 //! [`colcos_sim::field::GridField`], many fields per dispatch.
-use crate::{check_size, storage, GpuContext, GpuError, Result};
+use crate::{GpuContext, GpuError, Result, check_size, storage};
 use bytemuck::{Pod, Zeroable};
 use colcos_sim::field::{DiffusionScheme, GridField, GridParams, GridSpec, Kernel};
 use glam::Vec2;
@@ -163,7 +163,11 @@ fn thomas(n: usize, r: f32) -> (Vec<f32>, Vec<f32>) {
 }
 
 fn substeps(x: f32, max: f32) -> usize {
-    if x <= max { 1 } else { ((x / max).ceil() as usize).max(1) }
+    if x <= max {
+        1
+    } else {
+        ((x / max).ceil() as usize).max(1)
+    }
 }
 
 /// Index range `[lo, hi)` of the cells whose centres may lie within `[lo_m, hi_m]` (as the CPU's).
@@ -180,31 +184,58 @@ fn groups(items: usize, per: usize) -> (u32, u32) {
     (gx as u32, g.div_ceil(gx) as u32)
 }
 
+/// The field shader; with f64 the Gaussian deposit kernel's `exp` is computed in f64 and rounded, which
+/// matches the CPU's `expf` (nearly always bit for bit), otherwise the GPU's f32 `exp` (within 1e-6).
+fn field_source(f64: bool) -> String {
+    let kexp = if f64 {
+        format!(
+            "{}\nfn kexp(x: f32) -> f32 {{ return f32(exp64(f64(x))); }}",
+            crate::screen::EXP64
+        )
+    } else {
+        "fn kexp(x: f32) -> f32 { return exp(x); }".to_string()
+    };
+    include_str!("field.wgsl").replace("//KEXP//", &kexp)
+}
+
 impl GpuGrids {
     /// `params.len()` fields of `spec`, all zero, no injection maps.
     pub fn new(ctx: Arc<GpuContext>, spec: GridSpec, params: &[GridParams]) -> Result<Self> {
         let n = spec.len() as u64;
         let bytes = 2 * n * params.len() as u64 * 4;
-        check_size(&ctx, "field values (2 slots x fields x cells x 4 bytes)", bytes)?;
+        check_size(
+            &ctx,
+            "field values (2 slots x fields x cells x 4 bytes)",
+            bytes,
+        )?;
         if spec.nx == 0 || spec.ny == 0 {
             return Err(GpuError::Invalid("empty grid".into()));
         }
         let device = &ctx.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("colcos field.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("field.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(field_source(ctx.f64).into()),
         });
-        let entry = |binding: u32, ty: wgpu::BufferBindingType, dynamic: bool| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: dynamic, min_binding_size: None },
-            count: None,
-        };
+        let entry =
+            |binding: u32, ty: wgpu::BufferBindingType, dynamic: bool| wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty,
+                    has_dynamic_offset: dynamic,
+                    min_binding_size: None,
+                },
+                count: None,
+            };
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("colcos field layout"),
             entries: &[
-                entry(0, wgpu::BufferBindingType::Storage { read_only: false }, false),
+                entry(
+                    0,
+                    wgpu::BufferBindingType::Storage { read_only: false },
+                    false,
+                ),
                 entry(1, ro, false),
                 entry(2, wgpu::BufferBindingType::Uniform, true),
                 entry(3, ro, false),
@@ -238,27 +269,80 @@ impl GpuGrids {
             deposit: pipe("deposit"),
         };
         let nf = params.len().max(1) as u64;
-        let vals = storage(&ctx, "colcos field values", bytes, wgpu::BufferUsages::empty());
-        let coef = storage(&ctx, "colcos thomas coefficients", nf * 2 * (spec.nx + spec.ny) as u64 * 4, wgpu::BufferUsages::empty());
-        let inj = storage(&ctx, "colcos injection maps", 16, wgpu::BufferUsages::empty());
-        let plan = storage(&ctx, "colcos plan", nf * 8 * 32, wgpu::BufferUsages::empty());
-        let deps = storage(&ctx, "colcos deposits", 64 * 64, wgpu::BufferUsages::empty());
+        let vals = storage(
+            &ctx,
+            "colcos field values",
+            bytes,
+            wgpu::BufferUsages::empty(),
+        );
+        let coef = storage(
+            &ctx,
+            "colcos thomas coefficients",
+            nf * 2 * (spec.nx + spec.ny) as u64 * 4,
+            wgpu::BufferUsages::empty(),
+        );
+        let inj = storage(
+            &ctx,
+            "colcos injection maps",
+            16,
+            wgpu::BufferUsages::empty(),
+        );
+        let plan = storage(
+            &ctx,
+            "colcos plan",
+            nf * 8 * 32,
+            wgpu::BufferUsages::empty(),
+        );
+        let deps = storage(
+            &ctx,
+            "colcos deposits",
+            64 * 64,
+            wgpu::BufferUsages::empty(),
+        );
         let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("colcos pass uniforms"),
             size: UNIFORM_STRIDE * 16,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let fields = params.iter().map(|&p| FieldState { params: p, decay_carry: 0.0, inj_offset: None, coef_r: None, slot: 0 }).collect();
-        Ok(GpuGrids { ctx, spec, fields, layout, pipes, vals, inj, inj_len: 0, inj_data: Vec::new(), coef, plan, uniforms, deps, bind: None })
+        let fields = params
+            .iter()
+            .map(|&p| FieldState {
+                params: p,
+                decay_carry: 0.0,
+                inj_offset: None,
+                coef_r: None,
+                slot: 0,
+            })
+            .collect();
+        Ok(GpuGrids {
+            ctx,
+            spec,
+            fields,
+            layout,
+            pipes,
+            vals,
+            inj,
+            inj_len: 0,
+            inj_data: Vec::new(),
+            coef,
+            plan,
+            uniforms,
+            deps,
+            bind: None,
+        })
     }
 
     /// A batch holding copies of CPU grid fields (values, parameters, static injection), all of one spec.
     pub fn from_fields(ctx: Arc<GpuContext>, fields: &[&GridField]) -> Result<Self> {
-        let Some(first) = fields.first() else { return Err(GpuError::Invalid("no fields".into())) };
+        let Some(first) = fields.first() else {
+            return Err(GpuError::Invalid("no fields".into()));
+        };
         let spec = *first.spec();
         if fields.iter().any(|f| *f.spec() != spec) {
-            return Err(GpuError::Invalid("all fields of a batch must share one grid spec".into()));
+            return Err(GpuError::Invalid(
+                "all fields of a batch must share one grid spec".into(),
+            ));
         }
         let params: Vec<GridParams> = fields.iter().map(|f| *f.params()).collect();
         let mut g = Self::new(ctx, spec, &params)?;
@@ -299,9 +383,17 @@ impl GpuGrids {
     /// Overwrites the values of `field`.
     pub fn write_field(&mut self, field: usize, values: &[f32]) -> Result<()> {
         if values.len() != self.spec.len() {
-            return Err(GpuError::Invalid(format!("field {field}: {} values for {} cells", values.len(), self.spec.len())));
+            return Err(GpuError::Invalid(format!(
+                "field {field}: {} values for {} cells",
+                values.len(),
+                self.spec.len()
+            )));
         }
-        self.ctx.queue.write_buffer(&self.vals, self.field_offset(field) * 4, bytemuck::cast_slice(values));
+        self.ctx.queue.write_buffer(
+            &self.vals,
+            self.field_offset(field) * 4,
+            bytemuck::cast_slice(values),
+        );
         Ok(())
     }
 
@@ -315,16 +407,25 @@ impl GpuGrids {
     /// Reads the values of `field` back (blocking).
     pub fn read_field(&self, field: usize) -> Result<Vec<f32>> {
         let n = self.spec.len() as u64;
-        let bytes = self.ctx.read_buffer(&self.vals, self.field_offset(field) * 4, n * 4)?;
+        let bytes = self
+            .ctx
+            .read_buffer(&self.vals, self.field_offset(field) * 4, n * 4)?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
     /// Reads every field back (blocking), one `Vec` per field.
     pub fn read_all(&self) -> Result<Vec<Vec<f32>>> {
         let n = self.spec.len();
-        let bytes = self.ctx.read_buffer(&self.vals, 0, 2 * n as u64 * self.fields.len() as u64 * 4)?;
+        let bytes =
+            self.ctx
+                .read_buffer(&self.vals, 0, 2 * n as u64 * self.fields.len() as u64 * 4)?;
         let all: &[f32] = bytemuck::cast_slice(&bytes);
-        Ok(self.fields.iter().enumerate().map(|(f, st)| all[(2 * f + st.slot as usize) * n..][..n].to_vec()).collect())
+        Ok(self
+            .fields
+            .iter()
+            .enumerate()
+            .map(|(f, st)| all[(2 * f + st.slot as usize) * n..][..n].to_vec())
+            .collect())
     }
 
     /// Sets (or removes) the static injection map `J` of `field`.
@@ -334,7 +435,10 @@ impl GpuGrids {
             None => self.fields[field].inj_offset = None,
             Some(j) => {
                 if j.len() != n {
-                    return Err(GpuError::Invalid(format!("injection map of field {field}: {} values for {n} cells", j.len())));
+                    return Err(GpuError::Invalid(format!(
+                        "injection map of field {field}: {} values for {n} cells",
+                        j.len()
+                    )));
                 }
                 let off = match self.fields[field].inj_offset {
                     Some(o) => o as usize,
@@ -349,12 +453,21 @@ impl GpuGrids {
                 let bytes = self.inj_data.len() as u64 * 4;
                 check_size(&self.ctx, "static injection maps", bytes)?;
                 if self.inj_data.len() as u32 > self.inj_len {
-                    self.inj = storage(&self.ctx, "colcos injection maps", bytes, wgpu::BufferUsages::empty());
+                    self.inj = storage(
+                        &self.ctx,
+                        "colcos injection maps",
+                        bytes,
+                        wgpu::BufferUsages::empty(),
+                    );
                     self.inj_len = self.inj_data.len() as u32;
                     self.bind = None;
-                    self.ctx.queue.write_buffer(&self.inj, 0, bytemuck::cast_slice(&self.inj_data));
+                    self.ctx
+                        .queue
+                        .write_buffer(&self.inj, 0, bytemuck::cast_slice(&self.inj_data));
                 } else {
-                    self.ctx.queue.write_buffer(&self.inj, off as u64 * 4, bytemuck::cast_slice(j));
+                    self.ctx
+                        .queue
+                        .write_buffer(&self.inj, off as u64 * 4, bytemuck::cast_slice(j));
                 }
             }
         }
@@ -379,7 +492,12 @@ impl GpuGrids {
                 mapped_at_creation: false,
             })
         } else {
-            storage(&self.ctx, "colcos plan/deposits", size, wgpu::BufferUsages::empty())
+            storage(
+                &self.ctx,
+                "colcos plan/deposits",
+                size,
+                wgpu::BufferUsages::empty(),
+            )
         };
         self.bind = None;
     }
@@ -389,23 +507,33 @@ impl GpuGrids {
             return b.clone();
         }
         fn whole(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
+            wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }
         }
-        let b = self.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("colcos field bind group"),
-            layout: &self.layout,
-            entries: &[
-                whole(0, &self.vals),
-                whole(1, &self.plan),
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer: &self.uniforms, offset: 0, size: std::num::NonZeroU64::new(32) }),
-                },
-                whole(3, &self.inj),
-                whole(4, &self.coef),
-                whole(5, &self.deps),
-            ],
-        });
+        let b = self
+            .ctx
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("colcos field bind group"),
+                layout: &self.layout,
+                entries: &[
+                    whole(0, &self.vals),
+                    whole(1, &self.plan),
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &self.uniforms,
+                            offset: 0,
+                            size: std::num::NonZeroU64::new(32),
+                        }),
+                    },
+                    whole(3, &self.inj),
+                    whole(4, &self.coef),
+                    whole(5, &self.deps),
+                ],
+            });
         self.bind = Some(b.clone());
         b
     }
@@ -428,16 +556,35 @@ impl GpuGrids {
                 Kind::YSolve => groups(nx, 64),
                 _ => groups(nx * ny, 256),
             };
-            let u = PassUniform { index: p as u32, nfields: nf as u32, nx: nx as u32, ny: ny as u32, groups_x: gx, count: 0, cell: self.spec.cell, _pad: 0 };
+            let u = PassUniform {
+                index: p as u32,
+                nfields: nf as u32,
+                nx: nx as u32,
+                ny: ny as u32,
+                groups_x: gx,
+                count: 0,
+                cell: self.spec.cell,
+                _pad: 0,
+            };
             uniforms[p * UNIFORM_STRIDE as usize..][..32].copy_from_slice(bytemuck::bytes_of(&u));
             shapes.push((gx, gy));
         }
-        self.ctx.queue.write_buffer(&self.plan, 0, bytemuck::cast_slice(&plan));
+        self.ctx
+            .queue
+            .write_buffer(&self.plan, 0, bytemuck::cast_slice(&plan));
         self.ctx.queue.write_buffer(&self.uniforms, 0, &uniforms);
         let bind = self.bind_group();
-        let mut enc = self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("colcos field step") });
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("colcos field step"),
+            });
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("colcos field step"), timestamp_writes: None });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("colcos field step"),
+                timestamp_writes: None,
+            });
             for (p, (kind, _)) in passes.iter().enumerate() {
                 let pipe = match kind {
                     Kind::Evaporate => &self.pipes.evaporate,
@@ -492,14 +639,20 @@ impl GpuGrids {
                 (1.0, dt)
             };
             let d = st.params.diffusion.max(0.0);
-            let r = if d.is_finite() { d * dt / (cell * cell) } else { f32::INFINITY };
+            let r = if d.is_finite() {
+                d * dt / (cell * cell)
+            } else {
+                f32::INFINITY
+            };
             let has_diffusion = r > 0.0 && (nx > 1 || ny > 1);
             let (mut diff, mut evap_first, mut mean) = (None, false, false);
             if !has_diffusion {
                 evap_first = true;
             } else {
                 match st.params.scheme {
-                    DiffusionScheme::Auto if r <= EXPLICIT_MAX_R => diff = Some((Kind::Explicit, 1, r)),
+                    DiffusionScheme::Auto if r <= EXPLICIT_MAX_R => {
+                        diff = Some((Kind::Explicit, 1, r))
+                    }
                     DiffusionScheme::Auto | DiffusionScheme::Implicit => {
                         if r.is_finite() {
                             diff = Some((Kind::XSolve, 1, r));
@@ -538,64 +691,114 @@ impl GpuGrids {
             } else {
                 None
             };
-            decs.push(Dec { a, b, diff, evap_first, mean, wind });
+            decs.push(Dec {
+                a,
+                b,
+                diff,
+                evap_first,
+                mean,
+                wind,
+            });
         }
         for (fi, c) in coef_updates {
-            self.ctx.queue.write_buffer(&self.coef, (fi * coef_stride) as u64 * 4, bytemuck::cast_slice(&c));
+            self.ctx.queue.write_buffer(
+                &self.coef,
+                (fi * coef_stride) as u64 * 4,
+                bytemuck::cast_slice(&c),
+            );
         }
 
         // Build the passes; `slots` tracks each field's current slot as the passes flip them.
         let mut slots: Vec<u32> = self.fields.iter().map(|s| s.slot).collect();
-        let inj: Vec<i32> = self.fields.iter().map(|s| s.inj_offset.map_or(-1, |o| o as i32)).collect();
+        let inj: Vec<i32> = self
+            .fields
+            .iter()
+            .map(|s| s.inj_offset.map_or(-1, |o| o as i32))
+            .collect();
         let mut passes: Vec<(Kind, Vec<PlanEntry>)> = Vec::new();
-        let mut add = |kind: Kind, slots: &mut Vec<u32>, make: &dyn Fn(usize) -> Option<PlanEntry>| {
-            let mut any = false;
-            let entries: Vec<PlanEntry> = (0..nf)
-                .map(|f| match make(f) {
-                    Some(mut e) => {
-                        any = true;
-                        e.on = 1;
-                        e.src = slots[f];
-                        e.coef = (f * coef_stride) as u32;
-                        if kind.flips() {
-                            slots[f] ^= 1;
+        let mut add =
+            |kind: Kind, slots: &mut Vec<u32>, make: &dyn Fn(usize) -> Option<PlanEntry>| {
+                let mut any = false;
+                let entries: Vec<PlanEntry> = (0..nf)
+                    .map(|f| match make(f) {
+                        Some(mut e) => {
+                            any = true;
+                            e.on = 1;
+                            e.src = slots[f];
+                            e.coef = (f * coef_stride) as u32;
+                            if kind.flips() {
+                                slots[f] ^= 1;
+                            }
+                            e
                         }
-                        e
-                    }
-                    None => PlanEntry::default(),
-                })
-                .collect();
-            if any {
-                passes.push((kind, entries));
-            }
-        };
+                        None => PlanEntry::default(),
+                    })
+                    .collect();
+                if any {
+                    passes.push((kind, entries));
+                }
+            };
         add(Kind::Evaporate, &mut slots, &|f| {
             let d = &decs[f];
-            d.evap_first.then_some(PlanEntry { inj: inj[f], a: d.a, b: d.b, ..Default::default() })
+            // Without a map and with a = 1 the CPU leaves the values as they are (no flush either).
+            (d.evap_first && (inj[f] >= 0 || d.a != 1.0)).then_some(PlanEntry {
+                inj: inj[f],
+                a: d.a,
+                b: d.b,
+                ..Default::default()
+            })
         });
-        let max_sub = decs.iter().filter_map(|d| d.diff.map(|x| x.1)).max().unwrap_or(0);
+        let max_sub = decs
+            .iter()
+            .filter_map(|d| d.diff.map(|x| x.1))
+            .max()
+            .unwrap_or(0);
         for k in 0..max_sub {
             add(Kind::Explicit, &mut slots, &|f| match decs[f].diff {
                 Some((Kind::Explicit, n, r)) if k < n => {
-                    let (a, b, i) = if k == 0 { (decs[f].a, decs[f].b, inj[f]) } else { (1.0, 0.0, -1) };
-                    Some(PlanEntry { inj: i, a, b, r, ..Default::default() })
+                    let (a, b, i) = if k == 0 {
+                        (decs[f].a, decs[f].b, inj[f])
+                    } else {
+                        (1.0, 0.0, -1)
+                    };
+                    Some(PlanEntry {
+                        inj: i,
+                        a,
+                        b,
+                        r,
+                        ..Default::default()
+                    })
                 }
                 _ => None,
             });
         }
         for k in 0..max_sub {
             add(Kind::OneSided, &mut slots, &|f| match decs[f].diff {
-                Some((Kind::OneSided, n, s)) if k < n => Some(PlanEntry { inj: -1, r: s, ..Default::default() }),
+                Some((Kind::OneSided, n, s)) if k < n => Some(PlanEntry {
+                    inj: -1,
+                    r: s,
+                    ..Default::default()
+                }),
                 _ => None,
             });
         }
         add(Kind::XSolve, &mut slots, &|f| match decs[f].diff {
-            Some((Kind::XSolve, _, r)) => Some(PlanEntry { inj: inj[f], a: decs[f].a, b: decs[f].b, r, ..Default::default() }),
+            Some((Kind::XSolve, _, r)) => Some(PlanEntry {
+                inj: inj[f],
+                a: decs[f].a,
+                b: decs[f].b,
+                r,
+                ..Default::default()
+            }),
             _ => None,
         });
         if ny > 1 {
             add(Kind::YSolve, &mut slots, &|f| match decs[f].diff {
-                Some((Kind::XSolve, _, r)) => Some(PlanEntry { inj: -1, r, ..Default::default() }),
+                Some((Kind::XSolve, _, r)) => Some(PlanEntry {
+                    inj: -1,
+                    r,
+                    ..Default::default()
+                }),
                 _ => None,
             });
         }
@@ -614,33 +817,46 @@ impl GpuGrids {
                 }
             }
         }
-        let max_wind = decs.iter().filter_map(|d| d.wind.map(|w| w.0)).max().unwrap_or(0);
+        let max_wind = decs
+            .iter()
+            .filter_map(|d| d.wind.map(|w| w.0))
+            .max()
+            .unwrap_or(0);
         {
-            let mut add_w = |kind: Kind, slots: &mut Vec<u32>, make: &dyn Fn(usize) -> Option<PlanEntry>| {
-                let mut any = false;
-                let entries: Vec<PlanEntry> = (0..nf)
-                    .map(|f| match make(f) {
-                        Some(mut e) => {
-                            any = true;
-                            e.on = 1;
-                            e.src = slots[f];
-                            slots[f] ^= 1;
-                            e
-                        }
-                        None => PlanEntry::default(),
-                    })
-                    .collect();
-                if any {
-                    wind_passes.push((kind, entries));
-                }
-            };
+            let mut add_w =
+                |kind: Kind, slots: &mut Vec<u32>, make: &dyn Fn(usize) -> Option<PlanEntry>| {
+                    let mut any = false;
+                    let entries: Vec<PlanEntry> = (0..nf)
+                        .map(|f| match make(f) {
+                            Some(mut e) => {
+                                any = true;
+                                e.on = 1;
+                                e.src = slots[f];
+                                slots[f] ^= 1;
+                                e
+                            }
+                            None => PlanEntry::default(),
+                        })
+                        .collect();
+                    if any {
+                        wind_passes.push((kind, entries));
+                    }
+                };
             for k in 0..max_wind {
                 add_w(Kind::AdvectX, &mut slots, &|f| match decs[f].wind {
-                    Some((n, cx, _)) if k < n && cx != 0.0 && nx > 1 => Some(PlanEntry { inj: -1, c: cx, ..Default::default() }),
+                    Some((n, cx, _)) if k < n && cx != 0.0 && nx > 1 => Some(PlanEntry {
+                        inj: -1,
+                        c: cx,
+                        ..Default::default()
+                    }),
                     _ => None,
                 });
                 add_w(Kind::AdvectY, &mut slots, &|f| match decs[f].wind {
-                    Some((n, _, cy)) if k < n && cy != 0.0 && ny > 1 => Some(PlanEntry { inj: -1, c: cy, ..Default::default() }),
+                    Some((n, _, cy)) if k < n && cy != 0.0 && ny > 1 => Some(PlanEntry {
+                        inj: -1,
+                        c: cy,
+                        ..Default::default()
+                    }),
                     _ => None,
                 });
             }
@@ -661,7 +877,11 @@ impl GpuGrids {
         let mut rounds: Vec<Vec<DepRecord>> = Vec::new();
         for d in deposits {
             if d.field >= self.fields.len() {
-                return Err(GpuError::Invalid(format!("deposit on field {} of {}", d.field, self.fields.len())));
+                return Err(GpuError::Invalid(format!(
+                    "deposit on field {} of {}",
+                    d.field,
+                    self.fields.len()
+                )));
             }
             let support = d.kernel.support();
             if !(support >= 0.0) || !d.a.is_finite() || !d.b.is_finite() {
@@ -714,19 +934,42 @@ impl GpuGrids {
         let mut shapes = Vec::new();
         let mut first = 0u32;
         for (k, round) in rounds.iter().enumerate() {
-            let cells = round.iter().map(|r| (r.w * r.h) as usize).max().unwrap_or(0);
+            let cells = round
+                .iter()
+                .map(|r| (r.w * r.h) as usize)
+                .max()
+                .unwrap_or(0);
             let (gx, gy) = groups(cells, 256);
-            let u = PassUniform { index: first, nfields: self.fields.len() as u32, nx: nx as u32, ny: ny as u32, groups_x: gx, count: round.len() as u32, cell, _pad: 0 };
+            let u = PassUniform {
+                index: first,
+                nfields: self.fields.len() as u32,
+                nx: nx as u32,
+                ny: ny as u32,
+                groups_x: gx,
+                count: round.len() as u32,
+                cell,
+                _pad: 0,
+            };
             uniforms[k * UNIFORM_STRIDE as usize..][..32].copy_from_slice(bytemuck::bytes_of(&u));
             shapes.push((gx, gy, round.len() as u32));
             first += round.len() as u32;
         }
-        self.ctx.queue.write_buffer(&self.deps, 0, bytemuck::cast_slice(&recs));
+        self.ctx
+            .queue
+            .write_buffer(&self.deps, 0, bytemuck::cast_slice(&recs));
         self.ctx.queue.write_buffer(&self.uniforms, 0, &uniforms);
         let bind = self.bind_group();
-        let mut enc = self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("colcos deposits") });
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("colcos deposits"),
+            });
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("colcos deposits"), timestamp_writes: None });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("colcos deposits"),
+                timestamp_writes: None,
+            });
             pass.set_pipeline(&self.pipes.deposit);
             for (k, &(gx, gy, count)) in shapes.iter().enumerate() {
                 pass.set_bind_group(0, &bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);

@@ -15,23 +15,29 @@ pub mod backend;
 mod grids;
 pub mod screen;
 
-pub use backend::{install, BackendSelection, GpuWorldBackend};
+pub use backend::{BackendSelection, GpuWorldBackend, install};
 pub use grids::{Deposit, GpuGrids};
-pub use screen::{mean_levels, GpuScreen, ScreenLayer, ScreenScene, SensorQuery};
+pub use screen::{GpuScreen, ScreenLayer, ScreenScene, SensorQuery, mean_levels};
 
 use std::sync::Arc;
 
 /// Errors of the GPU backend.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
-    #[error("no GPU adapter found (wgpu found no Vulkan/Metal/DX12/GL device{0}); use --backend cpu, or install a driver (for a software one on Debian: apt-get install mesa-vulkan-drivers libvulkan1)")]
+    #[error(
+        "no GPU adapter found (wgpu found no Vulkan/Metal/DX12/GL device{0}); use --backend cpu, or install a driver (for a software one on Debian: apt-get install mesa-vulkan-drivers libvulkan1)"
+    )]
     NoAdapter(String),
     #[error("only a software adapter is present ({0}); `auto` prefers the CPU backend over it")]
     SoftwareOnly(String),
     #[error("could not open the GPU device {adapter}: {message}")]
     Device { adapter: String, message: String },
     #[error("GPU buffer too large: {what} needs {bytes} bytes, the adapter allows {limit}")]
-    TooLarge { what: String, bytes: u64, limit: u64 },
+    TooLarge {
+        what: String,
+        bytes: u64,
+        limit: u64,
+    },
     #[error("GPU read-back failed: {0}")]
     Readback(String),
     #[error("invalid input: {0}")]
@@ -74,8 +80,15 @@ pub fn is_software(info: &wgpu::AdapterInfo) -> bool {
 /// One line describing an adapter: name, type, backend, driver.
 pub fn describe(info: &wgpu::AdapterInfo) -> String {
     let soft = if is_software(info) { ", software" } else { "" };
-    let driver = if info.driver.is_empty() { String::new() } else { format!(", driver {} {}", info.driver, info.driver_info) };
-    format!("{} ({:?}, {:?}{soft}{driver})", info.name, info.device_type, info.backend)
+    let driver = if info.driver.is_empty() {
+        String::new()
+    } else {
+        format!(", driver {} {}", info.driver, info.driver_info)
+    };
+    format!(
+        "{} ({:?}, {:?}{soft}{driver})",
+        info.name, info.device_type, info.backend
+    )
 }
 
 fn instance() -> wgpu::Instance {
@@ -85,7 +98,10 @@ fn instance() -> wgpu::Instance {
 /// Every adapter wgpu can see, best first (discrete, integrated, virtual, other, software).
 pub fn adapters() -> Vec<wgpu::AdapterInfo> {
     let inst = instance();
-    let mut v: Vec<_> = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all())).iter().map(|a| a.get_info()).collect();
+    let mut v: Vec<_> = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()))
+        .iter()
+        .map(|a| a.get_info())
+        .collect();
     v.sort_by_key(rank);
     v
 }
@@ -125,20 +141,35 @@ impl GpuContext {
         let info = adapter.get_info();
         let limits = adapter.limits();
         let f64 = adapter.features().contains(wgpu::Features::SHADER_F64);
-        let required_features = if f64 { wgpu::Features::SHADER_F64 } else { wgpu::Features::empty() };
+        let required_features = if f64 {
+            wgpu::Features::SHADER_F64
+        } else {
+            wgpu::Features::empty()
+        };
         let desc = wgpu::DeviceDescriptor {
             label: Some("colcos-gpu"),
             required_features,
             required_limits: limits.clone(),
             ..Default::default()
         };
-        let (device, queue) = pollster::block_on(adapter.request_device(&desc)).map_err(|e| GpuError::Device { adapter: describe(&info), message: e.to_string() })?;
-        Ok(Arc::new(GpuContext { device, queue, info, limits, f64 }))
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&desc)).map_err(|e| GpuError::Device {
+                adapter: describe(&info),
+                message: e.to_string(),
+            })?;
+        Ok(Arc::new(GpuContext {
+            device,
+            queue,
+            info,
+            limits,
+            f64,
+        }))
     }
 
     /// One line describing the adapter in use.
     pub fn describe(&self) -> String {
-        describe(&self.info)
+        let f64 = if self.f64 { "" } else { " [no SHADER_F64]" };
+        format!("{}{f64}", describe(&self.info))
     }
 
     pub fn is_software(&self) -> bool {
@@ -151,7 +182,12 @@ impl GpuContext {
     }
 
     /// Copies `bytes` bytes of `src` from `offset` into CPU memory (blocking).
-    pub(crate) fn read_buffer(&self, src: &wgpu::Buffer, offset: u64, bytes: u64) -> Result<Vec<u8>> {
+    pub(crate) fn read_buffer(
+        &self,
+        src: &wgpu::Buffer,
+        offset: u64,
+        bytes: u64,
+    ) -> Result<Vec<u8>> {
         if bytes == 0 {
             return Ok(Vec::new());
         }
@@ -161,21 +197,29 @@ impl GpuContext {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+        let mut enc = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("readback"),
+            });
         enc.copy_buffer_to_buffer(src, offset, &staging, 0, bytes);
         self.queue.submit([enc.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |r| {
             let _ = tx.send(r);
         });
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
         match rx.recv() {
             Ok(Ok(())) => {}
             Ok(Err(e)) => return Err(GpuError::Readback(e.to_string())),
             Err(e) => return Err(GpuError::Readback(e.to_string())),
         }
         let out = {
-            let view = staging.get_mapped_range(..).map_err(|e| GpuError::Readback(format!("{e:?}")))?;
+            let view = staging
+                .get_mapped_range(..)
+                .map_err(|e| GpuError::Readback(format!("{e:?}")))?;
             view.to_vec()
         };
         staging.unmap();
@@ -184,23 +228,38 @@ impl GpuContext {
 
     /// Blocks until the queue is idle.
     pub fn wait(&self) -> Result<()> {
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| GpuError::Readback(e.to_string()))
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Readback(e.to_string()))
     }
 }
 
 /// A storage buffer of at least `bytes` bytes (wgpu rejects empty bindings).
-pub(crate) fn storage(ctx: &GpuContext, label: &str, bytes: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
+pub(crate) fn storage(
+    ctx: &GpuContext,
+    label: &str,
+    bytes: u64,
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
     ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: bytes.max(256).next_multiple_of(4),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC | extra,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC
+            | extra,
         mapped_at_creation: false,
     })
 }
 
 pub(crate) fn check_size(ctx: &GpuContext, what: &str, bytes: u64) -> Result<()> {
     if bytes > ctx.max_binding() {
-        return Err(GpuError::TooLarge { what: what.to_string(), bytes, limit: ctx.max_binding() });
+        return Err(GpuError::TooLarge {
+            what: what.to_string(),
+            bytes,
+            limit: ctx.max_binding(),
+        });
     }
     Ok(())
 }

@@ -9,7 +9,7 @@
 //! Gaussian sources are evaluated in f64 as on the CPU when the device has `SHADER_F64` (lavapipe and
 //! NVIDIA do), with an f64 `exp` of our own (WGSL has none); without it, in f32, which can differ from
 //! the CPU by one level where a pixel's sum lies within a few ulps of a rounding boundary.
-use crate::{storage, GpuContext, GpuGrids, Result};
+use crate::{GpuContext, GpuGrids, Result, storage};
 use bytemuck::{Pod, Zeroable};
 use colcos_sim::field::{FieldModel, GaussianSource, Pheromone};
 use colcos_sim::screen::ScreenSpec;
@@ -29,7 +29,11 @@ pub enum ScreenLayer {
     /// Field `field` of the [`GpuGrids`] batch.
     Grid { colour: [f32; 3], field: usize },
     /// Gaussian sources at clock `time`.
-    Gaussian { colour: [f32; 3], sources: Vec<GaussianSource>, time: f32 },
+    Gaussian {
+        colour: [f32; 3],
+        sources: Vec<GaussianSource>,
+        time: f32,
+    },
 }
 
 /// The layers of every world of a batch (each world the same number of layers).
@@ -40,13 +44,23 @@ pub struct ScreenScene {
 
 impl ScreenScene {
     /// The layers of one world's pheromones; `field_of(j)` gives the batch field of grid pheromone `j`.
-    pub fn world_layers(pheromones: &[Pheromone], field_of: impl Fn(usize) -> Option<usize>) -> Vec<ScreenLayer> {
+    pub fn world_layers(
+        pheromones: &[Pheromone],
+        field_of: impl Fn(usize) -> Option<usize>,
+    ) -> Vec<ScreenLayer> {
         pheromones
             .iter()
             .enumerate()
             .map(|(j, p)| match &p.model {
-                FieldModel::Grid(_) => ScreenLayer::Grid { colour: p.colour, field: field_of(j).expect("a batch field for every grid pheromone") },
-                FieldModel::Gaussian(g) => ScreenLayer::Gaussian { colour: p.colour, sources: g.sources.clone(), time: g.time },
+                FieldModel::Grid(_) => ScreenLayer::Grid {
+                    colour: p.colour,
+                    field: field_of(j).expect("a batch field for every grid pheromone"),
+                },
+                FieldModel::Gaussian(g) => ScreenLayer::Gaussian {
+                    colour: p.colour,
+                    sources: g.sources.clone(),
+                    time: g.time,
+                },
             })
             .collect()
     }
@@ -107,13 +121,13 @@ struct Uni {
     _pad: u32,
 }
 
-const GAUSS_F64: &str = r#"
+/// exp in f64 arithmetic (WGSL's `exp` is f32/f16 only): Cody-Waite reduction, Taylor series to r^14;
+/// within a few f64 ulps, so rounded to f32 it is the correctly rounded `expf` (as glibc's, nearly always).
+pub(crate) const EXP64: &str = r#"
 const LN2_HI: f64 = 6.93147180369123816490e-01;
 const LN2_LO: f64 = 1.90821492927058770002e-10;
 const INV_LN2: f64 = 1.44269504088896338700e+00;
-const PI64: f64 = 3.141592653589793;
 
-// exp in f64 arithmetic (WGSL's exp is f32/f16 only): Cody-Waite reduction, Taylor series to r^14.
 fn exp64(x: f64) -> f64 {
     if (x < f64(-746.0)) { return f64(0.0); }
     let k = floor(x * INV_LN2 + f64(0.5));
@@ -124,6 +138,14 @@ fn exp64(x: f64) -> f64 {
     }
     return ldexp(p, i32(k));
 }
+"#;
+
+const GAUSS_F64: &str = r#"
+const PI64: f64 = 3.141592653589793;
+
+fn exact64(x: f64) -> f64 {
+    return select(x, f64(0.0), u._pad != 0u);
+}
 
 fn gauss(s: Src, x: f32, y: f32, t: f32) -> f32 {
     if (!(t >= s.start)) { return 0.0; }
@@ -131,7 +153,7 @@ fn gauss(s: Src, x: f32, y: f32, t: f32) -> f32 {
     let sx = f64(s.sx);
     let sy = f64(s.sy);
     let rho = f64(s.rho);
-    let om = f64(1.0) - rho * rho;
+    let om = f64(1.0) - exact64(rho * rho);
     let dx = f64(x - s.cx);
     let dy = f64(y - s.cy);
     var decay = f64(1.0);
@@ -176,13 +198,27 @@ fn groups(items: usize, per: usize) -> (u32, u32) {
 
 impl GpuScreen {
     pub fn new(ctx: Arc<GpuContext>) -> Self {
-        let src = include_str!("screen.wgsl").replace("//GAUSS//", if ctx.f64 { GAUSS_F64 } else { GAUSS_F32 });
+        let src = include_str!("screen.wgsl").replace(
+            "//GAUSS//",
+            &if ctx.f64 {
+                format!("{EXP64}{GAUSS_F64}")
+            } else {
+                GAUSS_F32.to_string()
+            },
+        );
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("colcos screen.wgsl"), source: wgpu::ShaderSource::Wgsl(src.into()) });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("colcos screen.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(src.into()),
+        });
         let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
             count: None,
         };
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
@@ -198,7 +234,11 @@ impl GpuScreen {
                 entry(6, ro),
             ],
         });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: None,
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
         let pipe = |name: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(name),
@@ -212,7 +252,14 @@ impl GpuScreen {
         let render = pipe("render");
         let sense = pipe("sense");
         let dummy = storage(&ctx, "colcos dummy", 16, wgpu::BufferUsages::empty());
-        GpuScreen { ctx, layout, render, sense, dummy, image: None }
+        GpuScreen {
+            ctx,
+            layout,
+            render,
+            sense,
+            dummy,
+            image: None,
+        }
     }
 
     pub fn context(&self) -> &Arc<GpuContext> {
@@ -220,10 +267,15 @@ impl GpuScreen {
     }
 
     /// Layer and source records of the scene; every world must have the same number of layers.
-    fn records(grids: Option<&GpuGrids>, scene: &ScreenScene) -> Result<(Vec<LayerRec>, Vec<SrcRec>, u32)> {
+    fn records(
+        grids: Option<&GpuGrids>,
+        scene: &ScreenScene,
+    ) -> Result<(Vec<LayerRec>, Vec<SrcRec>, u32)> {
         let nl = scene.worlds.first().map_or(0, |w| w.len());
         if scene.worlds.iter().any(|w| w.len() != nl) {
-            return Err(crate::GpuError::Invalid("every world of a scene needs the same number of layers".into()));
+            return Err(crate::GpuError::Invalid(
+                "every world of a scene needs the same number of layers".into(),
+            ));
         }
         let mut layers = Vec::new();
         let mut srcs = Vec::new();
@@ -231,27 +283,54 @@ impl GpuScreen {
             for l in w {
                 layers.push(match l {
                     ScreenLayer::Grid { colour, field } => {
-                        let g = grids.ok_or_else(|| crate::GpuError::Invalid("a grid layer needs a GpuGrids batch".into()))?;
+                        let g = grids.ok_or_else(|| {
+                            crate::GpuError::Invalid("a grid layer needs a GpuGrids batch".into())
+                        })?;
                         if *field >= g.len() {
-                            return Err(crate::GpuError::Invalid(format!("layer field {field} of {}", g.len())));
+                            return Err(crate::GpuError::Invalid(format!(
+                                "layer field {field} of {}",
+                                g.len()
+                            )));
                         }
-                        LayerRec { kind: 0, offset: g.field_offset(*field) as u32, count: 0, _pad: 0, k: *colour, time: 0.0 }
+                        LayerRec {
+                            kind: 0,
+                            offset: g.field_offset(*field) as u32,
+                            count: 0,
+                            _pad: 0,
+                            k: *colour,
+                            time: 0.0,
+                        }
                     }
-                    ScreenLayer::Gaussian { colour, sources, time } => {
+                    ScreenLayer::Gaussian {
+                        colour,
+                        sources,
+                        time,
+                    } => {
                         let first = srcs.len() as u32;
                         srcs.extend(sources.iter().map(|s| SrcRec {
                             k: s.k,
                             sx: s.sigma_x,
                             sy: s.sigma_y,
                             rho: s.rho,
-                            e: if s.evaporation.is_finite() { s.evaporation } else { 1.0 },
+                            e: if s.evaporation.is_finite() {
+                                s.evaporation
+                            } else {
+                                1.0
+                            },
                             cx: s.centre.x,
                             cy: s.centre.y,
                             start: s.start,
                             e_inf: u32::from(s.evaporation.is_infinite()),
                             _p: [0; 3],
                         }));
-                        LayerRec { kind: 1, offset: first, count: sources.len() as u32, _pad: 0, k: *colour, time: *time }
+                        LayerRec {
+                            kind: 1,
+                            offset: first,
+                            count: sources.len() as u32,
+                            _pad: 0,
+                            k: *colour,
+                            time: *time,
+                        }
                     }
                 });
             }
@@ -260,7 +339,12 @@ impl GpuScreen {
     }
 
     fn buffer_init(&self, label: &str, data: &[u8]) -> wgpu::Buffer {
-        let b = storage(&self.ctx, label, data.len() as u64, wgpu::BufferUsages::empty());
+        let b = storage(
+            &self.ctx,
+            label,
+            data.len() as u64,
+            wgpu::BufferUsages::empty(),
+        );
         if !data.is_empty() {
             self.ctx.queue.write_buffer(&b, 0, data);
         }
@@ -291,16 +375,32 @@ impl GpuScreen {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        self.ctx.queue.write_buffer(&ub, 0, bytemuck::bytes_of(&uni));
+        self.ctx
+            .queue
+            .write_buffer(&ub, 0, bytemuck::bytes_of(&uni));
         let vals = grids.map_or(&self.dummy, |g| g.values_buffer());
         fn e(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
+            wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            }
         }
-        let bind = self.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("colcos screen bind group"),
-            layout: &self.layout,
-            entries: &[e(0, vals), e(1, &lb), e(2, &sb), e(3, &ub), e(4, out), e(5, &pb), e(6, &qb)],
-        });
+        let bind = self
+            .ctx
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("colcos screen bind group"),
+                layout: &self.layout,
+                entries: &[
+                    e(0, vals),
+                    e(1, &lb),
+                    e(2, &sb),
+                    e(3, &ub),
+                    e(4, out),
+                    e(5, &pb),
+                    e(6, &qb),
+                ],
+            });
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -314,12 +414,25 @@ impl GpuScreen {
 
     /// Composes world `world`'s screen at `width x height` into a GPU buffer of packed RGBA8 pixels
     /// (row 0 at the top), kept in [`GpuScreen::image_buffer`]; nothing is read back.
-    pub fn render_to_buffer(&mut self, grids: Option<&GpuGrids>, scene: &ScreenScene, world: usize, screen: &ScreenSpec, width: u32, height: u32) -> Result<&wgpu::Buffer> {
+    pub fn render_to_buffer(
+        &mut self,
+        grids: Option<&GpuGrids>,
+        scene: &ScreenScene,
+        world: usize,
+        screen: &ScreenSpec,
+        width: u32,
+        height: u32,
+    ) -> Result<&wgpu::Buffer> {
         let pixels = width as u64 * height as u64;
         crate::check_size(&self.ctx, "screen image", pixels * 4)?;
         let reuse = matches!(&self.image, Some((_, w, h)) if *w == width && *h == height);
         if !reuse {
-            let b = storage(&self.ctx, "colcos screen image", pixels * 4, wgpu::BufferUsages::empty());
+            let b = storage(
+                &self.ctx,
+                "colcos screen image",
+                pixels * 4,
+                wgpu::BufferUsages::empty(),
+            );
             self.image = Some((b, width, height));
         }
         let (gx, gy) = groups(pixels as usize, 256);
@@ -350,7 +463,15 @@ impl GpuScreen {
 
     /// Eq. (1) for world `world` at `width x height`, read back as an image (the same pixels as
     /// [`colcos_sim::screen::render`]).
-    pub fn render(&mut self, grids: Option<&GpuGrids>, scene: &ScreenScene, world: usize, screen: &ScreenSpec, width: u32, height: u32) -> Result<image::RgbImage> {
+    pub fn render(
+        &mut self,
+        grids: Option<&GpuGrids>,
+        scene: &ScreenScene,
+        world: usize,
+        screen: &ScreenSpec,
+        width: u32,
+        height: u32,
+    ) -> Result<image::RgbImage> {
         self.render_to_buffer(grids, scene, world, screen, width, height)?;
         let mut img = image::RgbImage::new(width, height);
         let pixels = width as u64 * height as u64;
@@ -368,17 +489,33 @@ impl GpuScreen {
     /// Sums of the 8-bit screen levels (r, g, b) over each query's points; the mean level that
     /// [`colcos_sim::sensors::ColourSensor::screen_levels`] returns is `sum / POINTS_PER_SENSOR`
     /// (see [`mean_levels`]). One dispatch for every sensor of every world; only the sums come back.
-    pub fn sense(&self, grids: Option<&GpuGrids>, scene: &ScreenScene, screen: &ScreenSpec, queries: &[SensorQuery]) -> Result<Vec<[u32; 3]>> {
+    pub fn sense(
+        &self,
+        grids: Option<&GpuGrids>,
+        scene: &ScreenScene,
+        screen: &ScreenSpec,
+        queries: &[SensorQuery],
+    ) -> Result<Vec<[u32; 3]>> {
         if queries.is_empty() {
             return Ok(Vec::new());
         }
         let n = queries.len();
-        let points: Vec<[f32; 2]> = queries.iter().flat_map(|q| q.points.iter().map(|p| [p.x, p.y])).collect();
+        let points: Vec<[f32; 2]> = queries
+            .iter()
+            .flat_map(|q| q.points.iter().map(|p| [p.x, p.y]))
+            .collect();
         let worlds: Vec<u32> = queries.iter().map(|q| q.world).collect();
         if worlds.iter().any(|&w| w as usize >= scene.worlds.len()) {
-            return Err(crate::GpuError::Invalid("sensor query for a world the scene does not have".into()));
+            return Err(crate::GpuError::Invalid(
+                "sensor query for a world the scene does not have".into(),
+            ));
         }
-        let out = storage(&self.ctx, "colcos sensor sums", n as u64 * 12, wgpu::BufferUsages::empty());
+        let out = storage(
+            &self.ctx,
+            "colcos sensor sums",
+            n as u64 * 12,
+            wgpu::BufferUsages::empty(),
+        );
         let (gx, gy) = groups(n, 64);
         let spec = grids.map(|g| *g.spec());
         let ps = screen.pixel_size();
@@ -395,7 +532,16 @@ impl GpuScreen {
             res_y: screen.resolution[1],
             ..Default::default()
         };
-        self.dispatch(grids, scene, uni, &self.sense, &out, bytemuck::cast_slice(&points), bytemuck::cast_slice(&worlds), (gx, gy))?;
+        self.dispatch(
+            grids,
+            scene,
+            uni,
+            &self.sense,
+            &out,
+            bytemuck::cast_slice(&points),
+            bytemuck::cast_slice(&worlds),
+            (gx, gy),
+        )?;
         let bytes = self.ctx.read_buffer(&out, 0, n as u64 * 12)?;
         let sums: &[u32] = bytemuck::cast_slice(&bytes);
         Ok(sums.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())

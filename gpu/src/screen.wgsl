@@ -55,6 +55,13 @@ struct U {
 @group(0) @binding(5) var<storage, read> points: array<vec2<f32>>;
 @group(0) @binding(6) var<storage, read> qworld: array<u32>;
 
+// The GPU compilers fuse a multiply feeding an add into one FMA (one rounding instead of two), which
+// the CPU does not do; a select on a uniform that is always false hides the product from that fusion,
+// so the arithmetic stays that of the CPU.
+fn exact(x: f32) -> f32 {
+    return select(x, 0.0, u._pad != 0u);
+}
+
 // (i0, i1, t) for linear interpolation at fractional index f on n samples, clamped (CPU `lerp_index`).
 struct Lerp {
     i0: u32,
@@ -76,9 +83,9 @@ fn grid_value(off: u32, x: f32, y: f32) -> f32 {
     let ly = lerp_index(y / u.cell - 0.5, u.ny);
     let r0 = off + ly.i0 * nx;
     let r1 = off + ly.i1 * nx;
-    let lo = vals[r0 + lx.i0] + (vals[r0 + lx.i1] - vals[r0 + lx.i0]) * lx.t;
-    let hi = vals[r1 + lx.i0] + (vals[r1 + lx.i1] - vals[r1 + lx.i0]) * lx.t;
-    return lo + (hi - lo) * ly.t;
+    let lo = vals[r0 + lx.i0] + exact((vals[r0 + lx.i1] - vals[r0 + lx.i0]) * lx.t);
+    let hi = vals[r1 + lx.i0] + exact((vals[r1 + lx.i1] - vals[r1 + lx.i0]) * lx.t);
+    return lo + exact((hi - lo) * ly.t);
 }
 
 //GAUSS//
@@ -109,9 +116,9 @@ fn compose(first: u32, x: f32, y: f32) -> vec3<u32> {
     for (var j = 0u; j < u.nlayers; j = j + 1u) {
         let l = layers[first + j];
         let v = layer_value(l, x, y);
-        a0 = a0 + l.k0 * v;
-        a1 = a1 + l.k1 * v;
-        a2 = a2 + l.k2 * v;
+        a0 = a0 + exact(l.k0 * v);
+        a1 = a1 + exact(l.k1 * v);
+        a2 = a2 + exact(l.k2 * v);
     }
     return vec3<u32>(to_level(a0), to_level(a1), to_level(a2));
 }
@@ -124,7 +131,7 @@ fn render(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     let col = k % u.width;
     let row = k / u.width;
     let x = (f32(col) + 0.5) * u.px;
-    let y = f32(u.height - 1u - row) * u.py + 0.5 * u.py;
+    let y = exact(f32(u.height - 1u - row) * u.py) + exact(0.5 * u.py);
     let c = compose(u.world * u.nlayers, x, y);
     outp[k] = c.x | (c.y << 8u) | (c.z << 16u) | (255u << 24u);
 }

@@ -1,9 +1,9 @@
 //! The GPU grid backend against the CPU one: every scheme and option, hundreds of steps, 1e-5 relative.
 mod common;
 use colcos_gpu::{Deposit, GpuGrids};
-use colcos_sim::field::{DiffusionScheme, GridField, GridParams, GridSpec, Kernel};
 use colcos_sim::Vec2;
-use common::{compare, ctx, Lcg};
+use colcos_sim::field::{DiffusionScheme, GridField, GridParams, GridSpec, Kernel};
+use common::{Lcg, compare, ctx};
 
 const TOL: f64 = 1e-5;
 
@@ -13,35 +13,65 @@ fn random_field(spec: GridSpec, params: GridParams, seed: u64, with_injection: b
     // A smooth part plus spikes, so that diffusion and wind have something to move.
     for j in 0..spec.ny {
         for i in 0..spec.nx {
-            let spike = if rng.next() < 0.02 { 5.0 * rng.next() } else { 0.0 };
+            let spike = if rng.next() < 0.02 {
+                5.0 * rng.next()
+            } else {
+                0.0
+            };
             f.values_mut()[j * spec.nx + i] = (i as f32 * 0.1).sin().abs() + spike;
         }
     }
     if with_injection {
-        let j: Vec<f32> = (0..spec.len()).map(|_| if rng.next() < 0.1 { rng.next() } else { 0.0 }).collect();
+        let j: Vec<f32> = (0..spec.len())
+            .map(|_| if rng.next() < 0.1 { rng.next() } else { 0.0 })
+            .collect();
         f.set_static_injection(j);
     }
     f
 }
 
 /// Steps `cases` on the CPU and, together in one batch, on the GPU; checks every `check` steps.
-fn run_cases(name: &str, spec: GridSpec, cases: &[(GridParams, bool)], dt: f32, steps: usize, deposits: bool) {
+fn run_cases(
+    name: &str,
+    spec: GridSpec,
+    cases: &[(GridParams, bool)],
+    dt: f32,
+    steps: usize,
+    deposits: bool,
+) {
     let Some(ctx) = ctx() else { return };
-    let mut cpu: Vec<GridField> = cases.iter().enumerate().map(|(k, &(p, inj))| random_field(spec, p, 7 + k as u64, inj)).collect();
+    let mut cpu: Vec<GridField> = cases
+        .iter()
+        .enumerate()
+        .map(|(k, &(p, inj))| random_field(spec, p, 7 + k as u64, inj))
+        .collect();
     let refs: Vec<&GridField> = cpu.iter().collect();
     let mut gpu = GpuGrids::from_fields(ctx, &refs).expect("gpu grids");
     let mut rng = Lcg(99);
-    let kernels = [Kernel::Disc { radius: 0.012 }, Kernel::Cone { radius: 0.02 }, Kernel::Gaussian { sigma: 0.006 }];
+    let kernels = [
+        Kernel::Disc { radius: 0.012 },
+        Kernel::Cone { radius: 0.02 },
+        Kernel::Gaussian { sigma: 0.006 },
+    ];
     let size = spec.size();
-    let mut pos: Vec<Vec2> = (0..cases.len() * 2).map(|_| Vec2::new(rng.next() * size.x, rng.next() * size.y)).collect();
+    let mut pos: Vec<Vec2> = (0..cases.len() * 2)
+        .map(|_| Vec2::new(rng.next() * size.x, rng.next() * size.y))
+        .collect();
     let mut bit_same = 0usize;
     for step in 1..=steps {
         if deposits {
             let mut deps = Vec::new();
             for (k, p) in pos.iter_mut().enumerate() {
                 let field = k % cases.len();
-                let to = (*p + Vec2::new(rng.next() - 0.5, rng.next() - 0.5) * 0.03).clamp(Vec2::ZERO, size);
-                let d = Deposit { field, kernel: kernels[k % 3], a: *p, b: to, amount: 0.05 };
+                let to = (*p + Vec2::new(rng.next() - 0.5, rng.next() - 0.5) * 0.03)
+                    .clamp(Vec2::ZERO, size);
+                let d = Deposit {
+                    field,
+                    kernel: kernels[k % 3],
+                    a: *p,
+                    b: to,
+                    amount: 0.05,
+                };
                 cpu[field].deposit_segment(&d.kernel, d.a, d.b, d.amount);
                 deps.push(d);
                 *p = to;
@@ -57,19 +87,35 @@ fn run_cases(name: &str, spec: GridSpec, cases: &[(GridParams, bool)], dt: f32, 
             for (k, (g, c)) in all.iter().zip(&cpu).enumerate() {
                 let (err, same) = compare(g, c.values());
                 bit_same = same;
-                assert!(err <= TOL, "{name}, case {k} ({:?}), step {step}: relative error {err:e}", cases[k].0);
+                assert!(
+                    err <= TOL,
+                    "{name}, case {k} ({:?}), step {step}: relative error {err:e}",
+                    cases[k].0
+                );
             }
         }
     }
-    eprintln!("{name}: {steps} steps within {TOL:e}; bit-identical cells in the last field: {bit_same} of {}", spec.len());
+    eprintln!(
+        "{name}: {steps} steps within {TOL:e}; bit-identical cells in the last field: {bit_same} of {}",
+        spec.len()
+    );
 }
 
 fn spec() -> GridSpec {
-    GridSpec { nx: 97, ny: 61, cell: 0.005 }
+    GridSpec {
+        nx: 97,
+        ny: 61,
+        cell: 0.005,
+    }
 }
 
 fn p(e: f32, d: f32, scheme: DiffusionScheme, wind: [f32; 2]) -> GridParams {
-    GridParams { evaporation: e, diffusion: d, scheme, wind: Vec2::from(wind) }
+    GridParams {
+        evaporation: e,
+        diffusion: d,
+        scheme,
+        wind: Vec2::from(wind),
+    }
 }
 
 #[test]
@@ -113,7 +159,10 @@ fn implicit_diffusion() {
 #[test]
 fn one_sided_diffusion() {
     use DiffusionScheme::*;
-    let cases = [(p(20.0, 2e-4, OneSided, [0.0, 0.0]), true), (p(f32::INFINITY, 4e-3, OneSided, [0.0, 0.0]), false)];
+    let cases = [
+        (p(20.0, 2e-4, OneSided, [0.0, 0.0]), true),
+        (p(f32::INFINITY, 4e-3, OneSided, [0.0, 0.0]), false),
+    ];
     run_cases("one-sided", spec(), &cases, 0.02, 300, false);
 }
 
@@ -134,7 +183,11 @@ fn wind() {
 #[test]
 fn trail_deposits_along_segments() {
     use DiffusionScheme::*;
-    let cases = [(p(20.0, 2e-6, Auto, [0.0, 0.0]), false), (p(20.0, 2e-3, Auto, [0.0, 0.0]), true), (p(30.0, 0.0, Auto, [0.02, 0.0]), false)];
+    let cases = [
+        (p(20.0, 2e-6, Auto, [0.0, 0.0]), false),
+        (p(20.0, 2e-3, Auto, [0.0, 0.0]), true),
+        (p(30.0, 0.0, Auto, [0.02, 0.0]), false),
+    ];
     run_cases("deposits", spec(), &cases, 0.02, 200, true);
 }
 
@@ -148,21 +201,46 @@ fn odd_shapes() {
         (p(20.0, 2e-3, Explicit, [0.0, 0.0]), true),
     ];
     for (nx, ny) in [(1, 40), (40, 1), (2, 2), (3, 257), (300, 7)] {
-        run_cases(&format!("{nx}x{ny}"), GridSpec { nx, ny, cell: 0.005 }, &all, 0.02, 100, nx > 1 && ny > 1);
+        run_cases(
+            &format!("{nx}x{ny}"),
+            GridSpec {
+                nx,
+                ny,
+                cell: 0.005,
+            },
+            &all,
+            0.02,
+            100,
+            nx > 1 && ny > 1,
+        );
     }
 }
 
 #[test]
 fn infinite_diffusion_is_uniform() {
     use DiffusionScheme::*;
-    run_cases("infinite diffusion", spec(), &[(p(20.0, f32::INFINITY, Auto, [0.0, 0.0]), true), (p(20.0, 2e-4, Auto, [0.0, 0.0]), false)], 0.02, 20, false);
+    run_cases(
+        "infinite diffusion",
+        spec(),
+        &[
+            (p(20.0, f32::INFINITY, Auto, [0.0, 0.0]), true),
+            (p(20.0, 2e-4, Auto, [0.0, 0.0]), false),
+        ],
+        0.02,
+        20,
+        false,
+    );
 }
 
 #[test]
 fn many_worlds_in_one_batch() {
     use DiffusionScheme::*;
     // 64 worlds x 3 pheromones of a 5 mm grid of a small arena, mixed parameters, in one batch.
-    let spec = GridSpec { nx: 60, ny: 40, cell: 0.005 };
+    let spec = GridSpec {
+        nx: 60,
+        ny: 40,
+        cell: 0.005,
+    };
     let cases: Vec<(GridParams, bool)> = (0..192)
         .map(|k| match k % 3 {
             0 => (p(20.0, 2e-6, Auto, [0.0, 0.0]), false),

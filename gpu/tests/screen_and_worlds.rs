@@ -1,12 +1,12 @@
 //! Screen images, sensor readings and whole worlds: GPU against CPU on the paper's two case studies
 //! (case I: static pheromone maps on the grid; case II: Gaussian sources that follow or are refreshed).
 mod common;
-use colcos_gpu::screen::{mean_levels, GpuScreen, ScreenScene, SensorQuery};
 use colcos_gpu::GpuGrids;
+use colcos_gpu::screen::{GpuScreen, ScreenScene, SensorQuery, mean_levels};
 use colcos_sim::field::{BackendChoice, FieldModel, GridField};
 use colcos_sim::prelude::*;
 use colcos_sim::screen;
-use colcos_sim::sensors::{sensor_positions, SENSOR_RADIUS};
+use colcos_sim::sensors::{SENSOR_RADIUS, sensor_positions};
 use common::{compare, ctx};
 
 /// Case I of the paper: static maps of three pheromones drawn on the grid (d = 0, steady state e J),
@@ -93,7 +93,10 @@ fn scenario(text: &str) -> Scenario {
 }
 
 /// Uploads a world's grid pheromones into a batch and its layers into a one-world scene.
-fn upload(ctx: std::sync::Arc<colcos_gpu::GpuContext>, world: &World) -> (Option<GpuGrids>, ScreenScene) {
+fn upload(
+    ctx: std::sync::Arc<colcos_gpu::GpuContext>,
+    world: &World,
+) -> (Option<GpuGrids>, ScreenScene) {
     let mut index = vec![None; world.pheromones().len()];
     let mut fields: Vec<&GridField> = Vec::new();
     for (j, p) in world.pheromones().iter().enumerate() {
@@ -103,7 +106,9 @@ fn upload(ctx: std::sync::Arc<colcos_gpu::GpuContext>, world: &World) -> (Option
         }
     }
     let grids = (!fields.is_empty()).then(|| GpuGrids::from_fields(ctx, &fields).unwrap());
-    let scene = ScreenScene { worlds: vec![ScreenScene::world_layers(world.pheromones(), |j| index[j])] };
+    let scene = ScreenScene {
+        worlds: vec![ScreenScene::world_layers(world.pheromones(), |j| index[j])],
+    };
     (grids, scene)
 }
 
@@ -118,11 +123,25 @@ fn check_screen_and_sensors(name: &str, text: &str, steps: usize, sizes: &[(u32,
     let mut gs = GpuScreen::new(ctx.clone());
     for &(w, h) in sizes {
         let cpu = screen::render(world.pheromones(), world.screen(), w, h);
-        let gpu = gs.render(grids.as_ref(), &scene, 0, world.screen(), w, h).unwrap();
-        let differ = cpu.pixels().zip(gpu.pixels()).filter(|(a, b)| a != b).count();
+        let gpu = gs
+            .render(grids.as_ref(), &scene, 0, world.screen(), w, h)
+            .unwrap();
+        let differ = cpu
+            .pixels()
+            .zip(gpu.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
         let lit = cpu.pixels().filter(|p| p.0 != [0, 0, 0]).count();
-        assert_eq!(differ, 0, "{name}: {differ} of {} pixels differ at {w}x{h} ({lit} lit)", w * h);
-        assert!(lit > 100, "{name}: the screen is almost black ({lit} lit pixels): a weak test");
+        assert_eq!(
+            differ,
+            0,
+            "{name}: {differ} of {} pixels differ at {w}x{h} ({lit} lit)",
+            w * h
+        );
+        assert!(
+            lit > 100,
+            "{name}: the screen is almost black ({lit} lit pixels): a weak test"
+        );
         eprintln!("{name}: {w}x{h} screen identical ({lit} lit pixels)");
     }
     // Sensors: every robot's four footprints, plus a grid of probes over the arena.
@@ -134,27 +153,49 @@ fn check_screen_and_sensors(name: &str, text: &str, steps: usize, sizes: &[(u32,
     let a = world.arena();
     for j in 0..40 {
         for i in 0..70 {
-            centres.push(Vec2::new((i as f32 + 0.37) / 70.0 * a.x, (j as f32 + 0.61) / 40.0 * a.y));
+            centres.push(Vec2::new(
+                (i as f32 + 0.37) / 70.0 * a.x,
+                (j as f32 + 0.61) / 40.0 * a.y,
+            ));
         }
     }
-    let queries: Vec<SensorQuery> = centres.iter().map(|&c| SensorQuery { world: 0, points: sensor.sample_points(c) }).collect();
-    let sums = gs.sense(grids.as_ref(), &scene, world.screen(), &queries).unwrap();
+    let queries: Vec<SensorQuery> = centres
+        .iter()
+        .map(|&c| SensorQuery {
+            world: 0,
+            points: sensor.sample_points(c),
+        })
+        .collect();
+    let sums = gs
+        .sense(grids.as_ref(), &scene, world.screen(), &queries)
+        .unwrap();
     let mut nonzero = 0;
     for (c, s) in centres.iter().zip(&sums) {
         let cpu = sensor.screen_levels(world.pheromones(), world.screen(), *c);
         let gpu = mean_levels(*s);
-        assert_eq!(cpu, gpu, "{name}: sensor at {c} reads {cpu:?} on the CPU, {gpu:?} on the GPU");
+        assert_eq!(
+            cpu, gpu,
+            "{name}: sensor at {c} reads {cpu:?} on the CPU, {gpu:?} on the GPU"
+        );
         if cpu != [0.0; 3] {
             nonzero += 1;
         }
     }
     assert!(nonzero > 20, "{name}: only {nonzero} sensors see anything");
-    eprintln!("{name}: {} sensor readings identical ({nonzero} non-zero)", centres.len());
+    eprintln!(
+        "{name}: {} sensor readings identical ({nonzero} non-zero)",
+        centres.len()
+    );
 }
 
 #[test]
 fn case_i_screen_and_sensors_match() {
-    check_screen_and_sensors("case I", CASE_I, 150, &[(3840, 2160), (480, 270), (333, 199)]);
+    check_screen_and_sensors(
+        "case I",
+        CASE_I,
+        150,
+        &[(3840, 2160), (480, 270), (333, 199)],
+    );
 }
 
 #[test]
@@ -179,10 +220,18 @@ fn check_world(name: &str, text: &str, steps: usize) {
         for (k, (pc, pg)) in cpu.pheromones().iter().zip(gpu.pheromones()).enumerate() {
             if let (FieldModel::Grid(c), FieldModel::Grid(g)) = (&pc.model, &pg.model) {
                 let (err, _) = compare(g.values(), c.values());
-                assert!(err <= 1e-5, "{name}: pheromone {k}, step {step}: relative error {err:e}");
+                assert!(
+                    err <= 1e-5,
+                    "{name}: pheromone {k}, step {step}: relative error {err:e}"
+                );
             }
         }
-        if cpu.observations().iter().zip(gpu.observations()).all(|(a, b)| a.counts == b.counts) {
+        if cpu
+            .observations()
+            .iter()
+            .zip(gpu.observations())
+            .all(|(a, b)| a.counts == b.counts)
+        {
             same_obs += 1;
         }
     }
@@ -215,7 +264,10 @@ fn backend_choice_cpu_and_auto() {
     eprintln!("auto chose {sel}");
     if let Some(c) = ctx() {
         if c.is_software() {
-            assert!(matches!(sel, colcos_gpu::BackendSelection::Cpu { .. }), "auto took a software adapter");
+            assert!(
+                matches!(sel, colcos_gpu::BackendSelection::Cpu { .. }),
+                "auto took a software adapter"
+            );
         }
     }
 }

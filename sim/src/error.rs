@@ -26,7 +26,11 @@ pub enum SimError {
 }
 
 impl SimError {
-    pub fn invalid(key: impl Into<String>, value: impl std::fmt::Display, reason: impl Into<String>) -> Self {
+    pub fn invalid(
+        key: impl Into<String>,
+        value: impl std::fmt::Display,
+        reason: impl Into<String>,
+    ) -> Self {
         SimError::Invalid {
             key: key.into(),
             value: value.to_string(),

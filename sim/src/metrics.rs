@@ -45,7 +45,10 @@ pub struct ArrivalCounts {
 impl ArrivalCounts {
     /// Tallies `outcomes` over `points` end points.
     pub fn tally(outcomes: &[TrialOutcome], points: usize) -> Self {
-        let mut c = ArrivalCounts { per_point: vec![0; points], timeouts: 0 };
+        let mut c = ArrivalCounts {
+            per_point: vec![0; points],
+            timeouts: 0,
+        };
         for o in outcomes {
             match *o {
                 TrialOutcome::Arrived { point, .. } if point < points => c.per_point[point] += 1,
@@ -103,7 +106,11 @@ pub fn phases(times: &[f32], alarm: &[bool]) -> Vec<Phase> {
     let n = times.len().min(alarm.len());
     let mut out: Vec<Phase> = Vec::new();
     for k in 0..n {
-        let kind = if alarm[k] { PhaseKind::Dispersion } else { PhaseKind::Aggregation };
+        let kind = if alarm[k] {
+            PhaseKind::Dispersion
+        } else {
+            PhaseKind::Aggregation
+        };
         match out.last_mut() {
             Some(p) if p.kind == kind => {
                 p.last = k;
@@ -113,7 +120,13 @@ pub fn phases(times: &[f32], alarm: &[bool]) -> Vec<Phase> {
                 if let Some(p) = out.last_mut() {
                     p.end = times[k];
                 }
-                out.push(Phase { kind, start: times[k], end: times[k], first: k, last: k });
+                out.push(Phase {
+                    kind,
+                    start: times[k],
+                    end: times[k],
+                    first: k,
+                    last: k,
+                });
             }
         }
     }
@@ -123,9 +136,11 @@ pub fn phases(times: &[f32], alarm: &[bool]) -> Vec<Phase> {
 /// Relative fall of `s` over samples `first..=last`: `1 - min / s[first]` (0 for an empty range or a
 /// zero start).
 pub fn relative_fall(s: &[f32], first: usize, last: usize) -> f32 {
-    let Some(range) = s.get(first..=last.min(s.len().saturating_sub(1))) else { return 0.0 };
+    let Some(range) = s.get(first..=last.min(s.len().saturating_sub(1))) else {
+        return 0.0;
+    };
     let start = range.first().copied().unwrap_or(0.0);
-    if !(start > 0.0) {
+    if start.is_nan() || start <= 0.0 {
         return 0.0;
     }
     let min = range.iter().copied().fold(f32::INFINITY, f32::min);
@@ -135,9 +150,11 @@ pub fn relative_fall(s: &[f32], first: usize, last: usize) -> f32 {
 /// Relative rise of `s` over samples `first..=last`: `max / s[first] - 1` (0 for an empty range or a
 /// zero start).
 pub fn relative_rise(s: &[f32], first: usize, last: usize) -> f32 {
-    let Some(range) = s.get(first..=last.min(s.len().saturating_sub(1))) else { return 0.0 };
+    let Some(range) = s.get(first..=last.min(s.len().saturating_sub(1))) else {
+        return 0.0;
+    };
     let start = range.first().copied().unwrap_or(0.0);
-    if !(start > 0.0) {
+    if start.is_nan() || start <= 0.0 {
         return 0.0;
     }
     let max = range.iter().copied().fold(f32::NEG_INFINITY, f32::max);

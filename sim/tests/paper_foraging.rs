@@ -12,7 +12,11 @@ const MAGENTA: [f32; 3] = [1.0, 0.0, 1.0];
 
 /// Sensors in the paper's order: right (Y-), front (X+), left (Y+), back (X-).
 fn obs(right: [f32; 3], front: [f32; 3], left: [f32; 3], back: [f32; 3]) -> Observation {
-    Observation { intensity: [right, front, left, back], time: 1.0, ..Observation::default() }
+    Observation {
+        intensity: [right, front, left, back],
+        time: 1.0,
+        ..Observation::default()
+    }
 }
 
 fn forager() -> Foraging {
@@ -46,17 +50,29 @@ fn avoids_on_a_bumper_hit() {
 fn wanders_off_the_lap() {
     let mut f = forager();
     let mut r = rng::stream(1, 0, 0);
-    assert_eq!(f.decide(&obs(OFF, OFF, OFF, OFF), &mut r), ForagingDecision::Wander);
+    assert_eq!(
+        f.decide(&obs(OFF, OFF, OFF, OFF), &mut r),
+        ForagingDecision::Wander
+    );
     // Green alone (no blue) is not a trail.
-    assert_eq!(f.decide(&obs(OFF, [0.0, 1.0, 0.0], OFF, OFF), &mut r), ForagingDecision::Wander);
+    assert_eq!(
+        f.decide(&obs(OFF, [0.0, 1.0, 0.0], OFF, OFF), &mut r),
+        ForagingDecision::Wander
+    );
 }
 
 #[test]
 fn follows_the_lap_and_prefers_cyan() {
     let mut f = forager();
     let mut r = rng::stream(1, 0, 0);
-    assert_eq!(f.decide(&obs(BLUE_, BLUE_, BLUE_, BLUE_), &mut r), ForagingDecision::FollowLap);
-    assert_eq!(f.decide(&obs(CYAN, CYAN, CYAN, CYAN), &mut r), ForagingDecision::FollowCyan);
+    assert_eq!(
+        f.decide(&obs(BLUE_, BLUE_, BLUE_, BLUE_), &mut r),
+        ForagingDecision::FollowLap
+    );
+    assert_eq!(
+        f.decide(&obs(CYAN, CYAN, CYAN, CYAN), &mut r),
+        ForagingDecision::FollowCyan
+    );
     // On the cyan trail it steers on green: cyan on the left only turns it left.
     let c = f.steer(&obs(BLUE_, CYAN, CYAN, CYAN), Trail::Cyan);
     assert!(c.right > c.left, "{c:?}");
@@ -66,13 +82,28 @@ fn follows_the_lap_and_prefers_cyan() {
 fn detects_bifurcations() {
     let th = 0.3;
     // Front off the trail, both sides on it: the wedge between two branches.
-    assert_eq!(detect_bifurcation(&obs(BLUE_, OFF, BLUE_, BLUE_), th), Some(BifurcationKind::Plain));
+    assert_eq!(
+        detect_bifurcation(&obs(BLUE_, OFF, BLUE_, BLUE_), th),
+        Some(BifurcationKind::Plain)
+    );
     // Different colours left and right.
-    assert_eq!(detect_bifurcation(&obs(BLUE_, CYAN, CYAN, CYAN), th), Some(BifurcationKind::CyanBlue));
-    assert_eq!(detect_bifurcation(&obs(CYAN, CYAN, BLUE_, CYAN), th), Some(BifurcationKind::CyanBlue));
-    assert_eq!(detect_bifurcation(&obs(MAGENTA, CYAN, CYAN, CYAN), th), Some(BifurcationKind::Magenta));
+    assert_eq!(
+        detect_bifurcation(&obs(BLUE_, CYAN, CYAN, CYAN), th),
+        Some(BifurcationKind::CyanBlue)
+    );
+    assert_eq!(
+        detect_bifurcation(&obs(CYAN, CYAN, BLUE_, CYAN), th),
+        Some(BifurcationKind::CyanBlue)
+    );
+    assert_eq!(
+        detect_bifurcation(&obs(MAGENTA, CYAN, CYAN, CYAN), th),
+        Some(BifurcationKind::Magenta)
+    );
     // A plain trail, or a robot at the edge of one, is not a bifurcation.
-    assert_eq!(detect_bifurcation(&obs(BLUE_, BLUE_, BLUE_, BLUE_), th), None);
+    assert_eq!(
+        detect_bifurcation(&obs(BLUE_, BLUE_, BLUE_, BLUE_), th),
+        None
+    );
     assert_eq!(detect_bifurcation(&obs(OFF, BLUE_, BLUE_, BLUE_), th), None);
     assert_eq!(detect_bifurcation(&obs(OFF, OFF, BLUE_, BLUE_), th), None);
 }
@@ -84,7 +115,10 @@ fn choices(o: &Observation, n: usize) -> (usize, Vec<ForagingDecision>) {
         let mut f = forager();
         let mut r = rng::stream(7, k as u64, 0);
         let d = f.decide(o, &mut r);
-        if let ForagingDecision::Bifurcation { side: Side::Left, .. } = d {
+        if let ForagingDecision::Bifurcation {
+            side: Side::Left, ..
+        } = d
+        {
             left += 1;
         }
         all.push(d);
@@ -98,7 +132,14 @@ fn magenta_bifurcation_always_takes_the_cyan_side() {
     assert_eq!(left, 500, "{:?}", &all[..3]);
     let (left, _) = choices(&obs(CYAN, OFF, MAGENTA, CYAN), 500);
     assert_eq!(left, 0);
-    assert!(matches!(all[0], ForagingDecision::Bifurcation { kind: BifurcationKind::Magenta, trail: Trail::Cyan, .. }));
+    assert!(matches!(
+        all[0],
+        ForagingDecision::Bifurcation {
+            kind: BifurcationKind::Magenta,
+            trail: Trail::Cyan,
+            ..
+        }
+    ));
 }
 
 #[test]
@@ -108,7 +149,14 @@ fn cyan_blue_bifurcation_takes_cyan_seven_times_in_ten() {
     let share = left as f64 / n as f64;
     assert!((share - 0.7).abs() < 0.03, "cyan share {share}");
     // The blue branch is followed on blue-but-not-green.
-    assert!(all.iter().any(|d| matches!(d, ForagingDecision::Bifurcation { side: Side::Right, trail: Trail::BlueOnly, .. })));
+    assert!(all.iter().any(|d| matches!(
+        d,
+        ForagingDecision::Bifurcation {
+            side: Side::Right,
+            trail: Trail::BlueOnly,
+            ..
+        }
+    )));
 }
 
 #[test]
@@ -124,20 +172,61 @@ fn commits_to_the_chosen_branch() {
     let p = ForagingParams::default();
     let mut f = Foraging::new(p.clone());
     let mut r = rng::stream(1, 0, 0);
-    let fork = obs(BLUE_, OFF, CYAN, CYAN);
+    let fork = obs(BLUE_, OFF, BLUE_, BLUE_);
     let d = f.decide(&fork, &mut r);
-    let ForagingDecision::Bifurcation { side, .. } = d else { panic!("{d:?}") };
+    let ForagingDecision::Bifurcation { side, .. } = d else {
+        panic!("{d:?}")
+    };
     // First the turn into the branch, toward the chosen side...
     let mut o = fork;
     o.time += 0.05;
-    assert!(matches!(f.decide(&o, &mut r), ForagingDecision::TurnInto { .. }));
+    assert!(matches!(
+        f.decide(&o, &mut r),
+        ForagingDecision::TurnInto { .. }
+    ));
     let c = f.turn_into(side, 0.026);
     assert_eq!(c.right > c.left, side == Side::Left, "{c:?}");
     // ...then following it; the same fork pattern does not trigger a new decision while committed.
     o.time = fork.time + p.turn_angle.to_radians() / p.turn_rate + 0.05;
-    assert!(matches!(f.decide(&o, &mut r), ForagingDecision::Committed { .. }));
+    assert!(matches!(
+        f.decide(&o, &mut r),
+        ForagingDecision::Committed { .. }
+    ));
     o.time = fork.time + p.commit_time + 0.05;
-    assert!(matches!(f.decide(&o, &mut r), ForagingDecision::Bifurcation { .. }));
+    assert!(matches!(
+        f.decide(&o, &mut r),
+        ForagingDecision::Bifurcation { .. }
+    ));
+}
+
+#[test]
+fn staying_on_cyan_needs_no_turn() {
+    // A cyan/blue bifurcation where the robot keeps to cyan: it goes on following at once.
+    for k in 0..50 {
+        let mut f = forager();
+        let mut r = rng::stream(3, k, 0);
+        let fork = obs(BLUE_, CYAN, CYAN, CYAN);
+        let d = f.decide(&fork, &mut r);
+        let mut o = fork;
+        o.time += 0.02;
+        let next = f.decide(&o, &mut r);
+        match d {
+            ForagingDecision::Bifurcation {
+                trail: Trail::Cyan, ..
+            } => assert!(
+                matches!(next, ForagingDecision::Committed { .. }),
+                "{next:?}"
+            ),
+            ForagingDecision::Bifurcation {
+                trail: Trail::BlueOnly,
+                ..
+            } => assert!(
+                matches!(next, ForagingDecision::TurnInto { .. }),
+                "{next:?}"
+            ),
+            other => panic!("{other:?}"),
+        }
+    }
 }
 
 #[test]
@@ -157,7 +246,9 @@ fn params_are_checked() {
     assert!(colcos_sim::behaviour::registry::build("forage", &bad, "robots[0]").is_err());
     let unknown: toml::Table = toml::from_str("speeed = 0.1").unwrap();
     assert!(colcos_sim::behaviour::registry::build("forage", &unknown, "robots[0]").is_err());
-    assert!(colcos_sim::behaviour::registry::build("forage", &toml::Table::new(), "robots[0]").is_ok());
+    assert!(
+        colcos_sim::behaviour::registry::build("forage", &toml::Table::new(), "robots[0]").is_ok()
+    );
 }
 
 /// A robot placed 2 cm beside a straight blue trail, heading 20 degrees toward it, ends up on it and
@@ -194,7 +285,10 @@ fn converges_onto_a_straight_trail() {
     for p in w.pheromones_mut() {
         if let colcos_sim::field::FieldModel::Grid(g) = &mut p.model {
             let j = g.static_injection().unwrap().to_vec();
-            g.values_mut().iter_mut().zip(j).for_each(|(v, j)| *v = 50.0 * j);
+            g.values_mut()
+                .iter_mut()
+                .zip(j)
+                .for_each(|(v, j)| *v = 50.0 * j);
         }
     }
     let mut worst_late = 0.0f32;
@@ -205,6 +299,9 @@ fn converges_onto_a_straight_trail() {
         }
     }
     let p = w.poses()[0];
-    assert!(worst_late < 0.025, "lateral offset after 3 s up to {worst_late} m");
+    assert!(
+        worst_late < 0.025,
+        "lateral offset after 3 s up to {worst_late} m"
+    );
     assert!(p.pos.x > 0.4, "it moved along the trail: {p:?}");
 }

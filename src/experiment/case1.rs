@@ -11,12 +11,16 @@ use super::layout::TrailLayout;
 use anyhow::Result;
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::field::FieldModel;
-use colcos_sim::metrics::{arrival, ArrivalCounts, TrialOutcome};
+use colcos_sim::metrics::{ArrivalCounts, TrialOutcome, arrival};
 use colcos_sim::prelude::*;
 use rayon::prelude::*;
 
 /// The three groups: name and pheromones.
-pub const GROUPS: [(&str, &[&str]); 3] = [("G1", &["LAP"]), ("G2", &["LAP", "SAP"]), ("G3", &["LAP", "SAP", "SRP"])];
+pub const GROUPS: [(&str, &[&str]); 3] = [
+    ("G1", &["LAP"]),
+    ("G2", &["LAP", "SAP"]),
+    ("G3", &["LAP", "SAP", "SRP"]),
+];
 
 #[derive(Clone, Debug)]
 pub struct Case1Config {
@@ -40,12 +44,24 @@ pub struct Case1Config {
 impl Case1Config {
     pub fn new(layout: TrailLayout, trials: usize, seed: u64) -> Self {
         let foods = layout.default_foods();
-        Case1Config { layout, foods, trials, seed, timeout: 60.0, arrival_radius: 0.03, cell: 0.005, trajectory_every: 5, forage: toml::Table::new() }
+        Case1Config {
+            layout,
+            foods,
+            trials,
+            seed,
+            timeout: 60.0,
+            arrival_radius: 0.03,
+            cell: 0.005,
+            trajectory_every: 5,
+            forage: toml::Table::new(),
+        }
     }
 
     /// The scenario of group `g` (0, 1, 2 for G1, G2, G3).
     pub fn scenario(&self, g: usize) -> Result<Scenario> {
-        let mut spec = self.layout.scenario_spec(&self.foods, GROUPS[g].1, self.seed, self.timeout, self.cell);
+        let mut spec =
+            self.layout
+                .scenario_spec(&self.foods, GROUPS[g].1, self.seed, self.timeout, self.cell);
         spec.robots[0].params = self.forage.clone();
         Ok(Scenario::from_spec(spec, ".")?)
     }
@@ -90,7 +106,9 @@ pub fn preload_steady_state(world: &mut World) {
             if params.diffusion != 0.0 || params.wind != Vec2::ZERO || !(e.is_finite() && e > 0.0) {
                 continue;
             }
-            let Some(j) = g.static_injection().map(|j| j.to_vec()) else { continue };
+            let Some(j) = g.static_injection().map(|j| j.to_vec()) else {
+                continue;
+            };
             for (v, j) in g.values_mut().iter_mut().zip(j) {
                 *v = e * j;
             }
@@ -102,7 +120,13 @@ pub fn preload_steady_state(world: &mut World) {
 }
 
 /// Runs one trial of `scenario` (world index `trial`).
-pub fn run_trial(scenario: &Scenario, trial: usize, ends: &[Vec2], radius: f32, every: u64) -> Result<Trial> {
+pub fn run_trial(
+    scenario: &Scenario,
+    trial: usize,
+    ends: &[Vec2],
+    radius: f32,
+    every: u64,
+) -> Result<Trial> {
     let mut world = World::with_index(scenario, trial as u64)?;
     preload_steady_state(&mut world);
     // One still step so that the first observation the robot acts on sees the loaded trails.
@@ -113,15 +137,24 @@ pub fn run_trial(scenario: &Scenario, trial: usize, ends: &[Vec2], radius: f32, 
     for k in 1..=steps {
         world.step();
         let p = world.poses()[0].pos;
-        if k % every == 0 {
+        if k.is_multiple_of(every) {
             path.push(p);
         }
         if let Some(point) = arrival(p, ends, radius) {
             path.push(p);
-            return Ok(Trial { outcome: TrialOutcome::Arrived { point, time: world.time() }, path });
+            return Ok(Trial {
+                outcome: TrialOutcome::Arrived {
+                    point,
+                    time: world.time(),
+                },
+                path,
+            });
         }
     }
-    Ok(Trial { outcome: TrialOutcome::TimedOut, path })
+    Ok(Trial {
+        outcome: TrialOutcome::TimedOut,
+        path,
+    })
 }
 
 /// The (group, trial) tasks of case I, for a shared progress count.
@@ -133,20 +166,35 @@ pub fn task_count(cfg: &Case1Config) -> usize {
 /// they do not depend on the thread count. `tick` is called once per finished trial.
 pub fn run(cfg: &Case1Config, tick: &(dyn Fn() + Sync)) -> Result<Case1Result> {
     let started = std::time::Instant::now();
-    let scenarios: Vec<Scenario> = (0..GROUPS.len()).map(|g| cfg.scenario(g)).collect::<Result<_>>()?;
+    let scenarios: Vec<Scenario> = (0..GROUPS.len())
+        .map(|g| cfg.scenario(g))
+        .collect::<Result<_>>()?;
     let ends = cfg.layout.end_points();
-    let tasks: Vec<(usize, usize)> = (0..GROUPS.len()).flat_map(|g| (0..cfg.trials).map(move |t| (g, t))).collect();
+    let tasks: Vec<(usize, usize)> = (0..GROUPS.len())
+        .flat_map(|g| (0..cfg.trials).map(move |t| (g, t)))
+        .collect();
     let results: Vec<Result<Trial>> = tasks
         .par_iter()
         .map(|&(g, t)| {
-            let r = run_trial(&scenarios[g], t, &ends, cfg.arrival_radius, cfg.trajectory_every);
+            let r = run_trial(
+                &scenarios[g],
+                t,
+                &ends,
+                cfg.arrival_radius,
+                cfg.trajectory_every,
+            );
             tick();
             r
         })
         .collect();
     let mut groups: Vec<GroupResult> = GROUPS
         .iter()
-        .map(|(name, ph)| GroupResult { name: name.to_string(), pheromones: ph.iter().map(|s| s.to_string()).collect(), trials: Vec::new(), counts: ArrivalCounts::default() })
+        .map(|(name, ph)| GroupResult {
+            name: name.to_string(),
+            pheromones: ph.iter().map(|s| s.to_string()).collect(),
+            trials: Vec::new(),
+            counts: ArrivalCounts::default(),
+        })
         .collect();
     for (&(g, _), r) in tasks.iter().zip(results) {
         groups[g].trials.push(r?);
@@ -155,7 +203,11 @@ pub fn run(cfg: &Case1Config, tick: &(dyn Fn() + Sync)) -> Result<Case1Result> {
         let outcomes: Vec<TrialOutcome> = g.trials.iter().map(|t| t.outcome).collect();
         g.counts = ArrivalCounts::tally(&outcomes, ends.len());
     }
-    Ok(Case1Result { config: cfg.clone(), groups, wall_seconds: started.elapsed().as_secs_f64() })
+    Ok(Case1Result {
+        config: cfg.clone(),
+        groups,
+        wall_seconds: started.elapsed().as_secs_f64(),
+    })
 }
 
 /// `group,end_point,food,arrivals` rows, then one `group,timeout,,n` row per group.
@@ -165,9 +217,19 @@ pub fn arrivals_csv(r: &Case1Result) -> String {
         let ph = g.pheromones.join("+");
         for (k, n) in g.counts.per_point.iter().enumerate() {
             let food = r.config.foods.contains(&(k + 1));
-            s.push_str(&format!("{},{},{},{},{}\n", g.name, ph, k + 1, food as u8, n));
+            s.push_str(&format!(
+                "{},{},{},{},{}\n",
+                g.name,
+                ph,
+                k + 1,
+                food as u8,
+                n
+            ));
         }
-        s.push_str(&format!("{},{},timeout,0,{}\n", g.name, ph, g.counts.timeouts));
+        s.push_str(&format!(
+            "{},{},timeout,0,{}\n",
+            g.name, ph, g.counts.timeouts
+        ));
     }
     s
 }
@@ -180,9 +242,18 @@ pub fn trials_csv(r: &Case1Result) -> String {
             match trial.outcome {
                 TrialOutcome::Arrived { point, time } => {
                     let food = r.config.foods.contains(&(point + 1));
-                    s.push_str(&format!("{},{},{},{},{:.2}\n", g.name, t, point + 1, food as u8, time));
+                    s.push_str(&format!(
+                        "{},{},{},{},{:.2}\n",
+                        g.name,
+                        t,
+                        point + 1,
+                        food as u8,
+                        time
+                    ));
                 }
-                TrialOutcome::TimedOut => s.push_str(&format!("{},{},,0,{:.2}\n", g.name, t, r.config.timeout)),
+                TrialOutcome::TimedOut => {
+                    s.push_str(&format!("{},{},,0,{:.2}\n", g.name, t, r.config.timeout))
+                }
             }
         }
     }

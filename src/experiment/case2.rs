@@ -4,7 +4,9 @@
 //! dispersion phases), every robot's position, and a screen snapshot every `snapshot_every` seconds.
 use anyhow::{Context, Result};
 use colcos_sim::behaviour::paper::RED;
-use colcos_sim::metrics::{phases, relative_fall, relative_rise, sum_distance_of, Phase, PhaseKind};
+use colcos_sim::metrics::{
+    Phase, PhaseKind, phases, relative_fall, relative_rise, sum_distance_of,
+};
 use colcos_sim::output::draw;
 use colcos_sim::prelude::*;
 use colcos_sim::screen;
@@ -30,8 +32,17 @@ pub struct Case2Config {
 impl Case2Config {
     /// `runs` runs of the paper's scenario with `seed`.
     pub fn paper(runs: usize, seed: u64) -> Result<Self> {
-        let scenario = Scenario::from_toml_str(SCENARIO_TOML, ".").context("scenarios/case2_alarm.toml")?.with_overrides(Some(seed), None)?;
-        Ok(Case2Config { scenario, runs, sample_every: 0.1, snapshot_every: 5.0, snapshot_width: 480, alarm_threshold: 0.05 })
+        let scenario = Scenario::from_toml_str(SCENARIO_TOML, ".")
+            .context("scenarios/case2_alarm.toml")?
+            .with_overrides(Some(seed), None)?;
+        Ok(Case2Config {
+            scenario,
+            runs,
+            sample_every: 0.1,
+            snapshot_every: 5.0,
+            snapshot_width: 480,
+            alarm_threshold: 0.05,
+        })
     }
 }
 
@@ -75,8 +86,16 @@ fn snapshot(world: &World, width: u32) -> image::RgbImage {
     let s = world.screen();
     let height = ((width as f32 * s.size[1] / s.size[0]).round() as u32).max(1);
     let mut img = screen::render(world.pheromones(), s, width, height);
-    let colours: Vec<image::Rgb<u8>> = (0..world.robot_count()).map(|i| role_colour(world.role(i))).collect();
-    draw::robots(&mut img, s, world.poses(), world.robot_params().radius, &colours);
+    let colours: Vec<image::Rgb<u8>> = (0..world.robot_count())
+        .map(|i| role_colour(world.role(i)))
+        .collect();
+    draw::robots(
+        &mut img,
+        s,
+        world.poses(),
+        world.robot_params().radius,
+        &colours,
+    );
     img
 }
 
@@ -85,7 +104,10 @@ pub fn run_one(cfg: &Case2Config, index: usize) -> Result<Case2Run> {
     let mut world = World::with_index(&cfg.scenario, index as u64)?;
     let n = world.robot_count();
     let roles: Vec<String> = (0..n).map(|i| world.role(i).to_string()).collect();
-    let leader = roles.iter().position(|r| r == "leader").context("case II needs a robot with role \"leader\"")?;
+    let leader = roles
+        .iter()
+        .position(|r| r == "leader")
+        .context("case II needs a robot with role \"leader\"")?;
     let followers: Vec<usize> = (0..n).filter(|&i| roles[i] == "follower").collect();
     let prey: Vec<usize> = (0..n).filter(|&i| roles[i] != "predator").collect();
     let dt = world.dt();
@@ -101,25 +123,46 @@ pub fn run_one(cfg: &Case2Config, index: usize) -> Result<Case2Run> {
         times.push(world.time());
         s.push(sum_distance_of(&positions, leader, &followers));
         let obs = world.observations();
-        alarm.push(prey.iter().any(|&i| obs[i].strength(RED) > cfg.alarm_threshold));
+        alarm.push(
+            prey.iter()
+                .any(|&i| obs[i].strength(RED) > cfg.alarm_threshold),
+        );
         for (p, q) in paths.iter_mut().zip(&positions) {
             p.push(*q);
         }
-        if world.tick() % snap_every == 0 {
+        if world.tick().is_multiple_of(snap_every) {
             snapshots.push((world.time(), snapshot(world, cfg.snapshot_width)));
         }
     };
     record(&world, &mut snapshots);
     while !world.is_finished() {
         world.step();
-        if world.tick() % every == 0 {
+        if world.tick().is_multiple_of(every) {
             record(&world, &mut snapshots);
         }
     }
     let phases = phases(&times, &alarm);
-    let aggregation_fall = phases.iter().filter(|p| p.kind == PhaseKind::Aggregation).map(|p| relative_fall(&s, p.first, p.last)).fold(0.0, f32::max);
-    let alarm_rise = phases.iter().filter(|p| p.kind == PhaseKind::Dispersion).map(|p| relative_rise(&s, p.first, p.last)).reduce(f32::max);
-    Ok(Case2Run { times, s, alarm, phases, paths, roles, snapshots, aggregation_fall, alarm_rise })
+    let aggregation_fall = phases
+        .iter()
+        .filter(|p| p.kind == PhaseKind::Aggregation)
+        .map(|p| relative_fall(&s, p.first, p.last))
+        .fold(0.0, f32::max);
+    let alarm_rise = phases
+        .iter()
+        .filter(|p| p.kind == PhaseKind::Dispersion)
+        .map(|p| relative_rise(&s, p.first, p.last))
+        .reduce(f32::max);
+    Ok(Case2Run {
+        times,
+        s,
+        alarm,
+        phases,
+        paths,
+        roles,
+        snapshots,
+        aggregation_fall,
+        alarm_rise,
+    })
 }
 
 /// Every run in parallel, gathered by run index. `tick` is called once per finished run.
@@ -134,7 +177,11 @@ pub fn run(cfg: &Case2Config, tick: &(dyn Fn() + Sync)) -> Result<Case2Result> {
         })
         .collect();
     let runs = runs.into_iter().collect::<Result<Vec<_>>>()?;
-    Ok(Case2Result { config: cfg.clone(), runs, wall_seconds: started.elapsed().as_secs_f64() })
+    Ok(Case2Result {
+        config: cfg.clone(),
+        runs,
+        wall_seconds: started.elapsed().as_secs_f64(),
+    })
 }
 
 /// `run,time,s,alarm,phase` rows.
@@ -142,10 +189,14 @@ pub fn s_t_csv(r: &Case2Result) -> String {
     let mut out = String::from("run,time,s,alarm,phase\n");
     for (k, run) in r.runs.iter().enumerate() {
         for (j, ((t, s), a)) in run.times.iter().zip(&run.s).zip(&run.alarm).enumerate() {
-            let phase = run.phases.iter().find(|p| p.first <= j && j <= p.last).map_or("", |p| match p.kind {
-                PhaseKind::Aggregation => "aggregation",
-                PhaseKind::Dispersion => "dispersion",
-            });
+            let phase = run
+                .phases
+                .iter()
+                .find(|p| p.first <= j && j <= p.last)
+                .map_or("", |p| match p.kind {
+                    PhaseKind::Aggregation => "aggregation",
+                    PhaseKind::Dispersion => "dispersion",
+                });
             out.push_str(&format!("{k},{t:.2},{s:.4},{},{phase}\n", *a as u8));
         }
     }

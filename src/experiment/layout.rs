@@ -14,8 +14,10 @@
 //! * SAP (green): the edges on the paths from the nest to the available food points;
 //! * SRP (red): at every bifurcation on those paths whose other branch leads to no food, a short piece of
 //!   that branch from `srp_start` to `srp_end` metres along it (magenta over the blue).
-use colcos_sim::scenario::{MapSpec, ModelKind, PheromoneSpec, Placement, RobotGroupSpec, ScenarioSpec};
 use colcos_sim::Vec2;
+use colcos_sim::scenario::{
+    MapSpec, ModelKind, PheromoneSpec, Placement, RobotGroupSpec, ScenarioSpec,
+};
 
 /// One node of a trail tree.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,6 +50,9 @@ pub struct TrailLayout {
     pub srp_end: f32,
 }
 
+/// Length of the straight run at the end of every edge, m.
+pub const APPROACH: f32 = 0.08;
+
 /// The paper's 65-inch screen, m.
 pub const SCREEN: [f32; 2] = [1.439, 0.809];
 
@@ -70,7 +75,11 @@ fn banded(name: &str, bands: [Band; 4], mirror: bool) -> TrailLayout {
     let mut nodes: Vec<TrailNode> = Vec::new();
     let mut add = |x: f32, y: f32, parent: Option<usize>| -> usize {
         let (x, h) = if mirror { (w - x, 180.0) } else { (x, 0.0) };
-        nodes.push(TrailNode { pos: Vec2::new(x, y), heading_deg: h, parent });
+        nodes.push(TrailNode {
+            pos: Vec2::new(x, y),
+            heading_deg: h,
+            parent,
+        });
         nodes.len() - 1
     };
     let root_y = 0.5 * (bands[1].y + bands[2].y);
@@ -101,7 +110,7 @@ fn banded(name: &str, bands: [Band; 4], mirror: bool) -> TrailLayout {
         nodes,
         ends,
         fork_half_angle_deg: 35.0,
-        width: 0.06,
+        width: 0.04,
         arena: Vec2::from(SCREEN),
         srp_start: 0.03,
         srp_end: 0.15,
@@ -111,14 +120,40 @@ fn banded(name: &str, bands: [Band; 4], mirror: bool) -> TrailLayout {
 impl TrailLayout {
     /// The default layout: nest on the left, twelve end points (the paper's food example: 3 and 10).
     pub fn a() -> Self {
-        let b = |y, leaves, first_up| Band { y, leaves, first_up };
-        banded("A", [b(0.125, 3, true), b(0.315, 3, true), b(0.505, 3, true), b(0.695, 3, true)], false)
+        let b = |y, leaves, first_up| Band {
+            y,
+            leaves,
+            first_up,
+        };
+        banded(
+            "A",
+            [
+                b(0.125, 3, true),
+                b(0.315, 3, true),
+                b(0.505, 3, true),
+                b(0.695, 3, true),
+            ],
+            false,
+        )
     }
 
     /// The second layout: mirrored (nest on the right), eleven end points, first branches alternating.
     pub fn b() -> Self {
-        let b = |y, leaves, first_up| Band { y, leaves, first_up };
-        banded("B", [b(0.13, 3, true), b(0.33, 3, false), b(0.50, 2, true), b(0.70, 3, false)], true)
+        let b = |y, leaves, first_up| Band {
+            y,
+            leaves,
+            first_up,
+        };
+        banded(
+            "B",
+            [
+                b(0.13, 3, true),
+                b(0.33, 3, false),
+                b(0.50, 2, true),
+                b(0.70, 3, false),
+            ],
+            true,
+        )
     }
 
     /// A layout by name (`"A"` or `"B"`, case-insensitive).
@@ -145,7 +180,9 @@ impl TrailLayout {
     /// Children of node `i`, ordered counter-clockwise last (the first is on the right of the parent's
     /// heading).
     pub fn children(&self, i: usize) -> Vec<usize> {
-        let mut c: Vec<usize> = (0..self.nodes.len()).filter(|&k| self.nodes[k].parent == Some(i)).collect();
+        let mut c: Vec<usize> = (0..self.nodes.len())
+            .filter(|&k| self.nodes[k].parent == Some(i))
+            .collect();
         let n = &self.nodes[i];
         let h = Vec2::from_angle(n.heading_deg.to_radians());
         c.sort_by(|&a, &b| {
@@ -163,30 +200,44 @@ impl TrailLayout {
     /// The polyline of the edge into node `child` (from its parent), sampled every ~1 cm.
     pub fn edge(&self, child: usize) -> Vec<Vec2> {
         let c = &self.nodes[child];
-        let Some(pi) = c.parent else { return vec![c.pos] };
+        let Some(pi) = c.parent else {
+            return vec![c.pos];
+        };
         let p = &self.nodes[pi];
         let siblings = self.children(pi);
         let h0 = p.heading_deg.to_radians();
         let start = if siblings.len() >= 2 {
             let half = self.fork_half_angle_deg.to_radians();
             // The right-most child leaves to the right (-), the left-most to the left (+).
-            if siblings[0] == child { h0 - half } else { h0 + half }
+            if siblings[0] == child {
+                h0 - half
+            } else {
+                h0 + half
+            }
         } else {
             h0
         };
-        let (p0, p3) = (p.pos, c.pos);
+        // A Bezier curve, then a straight run of `APPROACH` into the child along its heading, so that a
+        // robot reaches the next bifurcation centred and aligned.
+        let end_dir = Vec2::from_angle(c.heading_deg.to_radians());
+        let (p0, p3) = (p.pos, c.pos - end_dir * APPROACH);
         let len = p0.distance(p3);
         let a = 0.3 * len;
         let p1 = p0 + Vec2::from_angle(start) * a;
-        let p2 = p3 - Vec2::from_angle(c.heading_deg.to_radians()) * a;
+        let p2 = p3 - end_dir * a;
         let n = ((len / 0.01).ceil() as usize).max(2);
-        (0..=n)
+        let mut pts: Vec<Vec2> = (0..=n)
             .map(|k| {
                 let t = k as f32 / n as f32;
                 let u = 1.0 - t;
-                p0 * (u * u * u) + p1 * (3.0 * u * u * t) + p2 * (3.0 * u * t * t) + p3 * (t * t * t)
+                p0 * (u * u * u)
+                    + p1 * (3.0 * u * u * t)
+                    + p2 * (3.0 * u * t * t)
+                    + p3 * (t * t * t)
             })
-            .collect()
+            .collect();
+        pts.push(c.pos);
+        pts
     }
 
     /// All edges as (child node, polyline).
@@ -273,15 +324,40 @@ impl TrailLayout {
     /// The scenario of one case-I group: `pheromones` is a subset of `["LAP", "SAP", "SRP"]`; one robot
     /// at the nest heading along the trunk, behaviour `forage`. Table I: e = 50 s, d = 0, J from the
     /// maps (steady state `e J = 1`, drawn at full level 255).
-    pub fn scenario_spec(&self, foods: &[usize], pheromones: &[&str], seed: u64, duration: f32, cell: f32) -> ScenarioSpec {
+    pub fn scenario_spec(
+        &self,
+        foods: &[usize],
+        pheromones: &[&str],
+        seed: u64,
+        duration: f32,
+        cell: f32,
+    ) -> ScenarioSpec {
         let rate = 1.0 / 50.0;
-        let map = |points: Vec<Vec2>, width: f32| MapSpec { polyline: Some(points.iter().map(|p| [round5(p.x), round5(p.y)]).collect()), width: Some(width), image: None, channel: None, rate };
+        let map = |points: Vec<Vec2>, width: f32| MapSpec {
+            polyline: Some(points.iter().map(|p| [round5(p.x), round5(p.y)]).collect()),
+            width: Some(width),
+            image: None,
+            channel: None,
+            rate,
+        };
         let mut ph = Vec::new();
         for &name in pheromones {
             let (colour, maps) = match name {
-                "LAP" => ([0.0, 0.0, 255.0], vec![map(self.lap_polyline(), self.width)]),
-                "SAP" => ([0.0, 255.0, 0.0], vec![map(self.sap_polyline(foods), self.width)]),
-                "SRP" => ([255.0, 0.0, 0.0], self.srp_polylines(foods).into_iter().map(|p| map(p, self.width)).collect()),
+                "LAP" => (
+                    [0.0, 0.0, 255.0],
+                    vec![map(self.lap_polyline(), self.width)],
+                ),
+                "SAP" => (
+                    [0.0, 255.0, 0.0],
+                    vec![map(self.sap_polyline(foods), self.width)],
+                ),
+                "SRP" => (
+                    [255.0, 0.0, 0.0],
+                    self.srp_polylines(foods)
+                        .into_iter()
+                        .map(|p| map(p, self.width))
+                        .collect(),
+                ),
                 other => panic!("unknown case-I pheromone {other:?}"),
             };
             ph.push(PheromoneSpec {
@@ -297,7 +373,8 @@ impl TrailLayout {
             });
         }
         let nest = self.nest();
-        let mut spec: ScenarioSpec = colcos_sim::scenario::parse_spec("duration = 1.0").expect("minimal spec");
+        let mut spec: ScenarioSpec =
+            colcos_sim::scenario::parse_spec("duration = 1.0").expect("minimal spec");
         spec.name = format!("case1_{}_{}", self.name, pheromones.join("_"));
         spec.duration = duration;
         spec.seed = seed;

@@ -12,7 +12,7 @@ pub mod layout;
 pub mod plots;
 pub mod summary;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
 /// Which case studies to run.
@@ -73,21 +73,45 @@ impl Options {
     pub fn new(which: Which, out: impl Into<PathBuf>) -> Self {
         let layout = layout::TrailLayout::a();
         let foods = layout.default_foods();
-        Options { which, trials: 20, runs: 4, out: out.into(), seed: 1, layout, foods, progress: false }
+        Options {
+            which,
+            trials: 20,
+            runs: 4,
+            out: out.into(),
+            seed: 1,
+            layout,
+            foods,
+            progress: false,
+        }
     }
 
     pub fn from_args(a: &ExperimentArgs) -> Result<Self> {
-        let Some(layout) = layout::TrailLayout::by_name(&a.layout) else { bail!("unknown layout {:?} (known: A, B)", a.layout) };
+        let Some(layout) = layout::TrailLayout::by_name(&a.layout) else {
+            bail!("unknown layout {:?} (known: A, B)", a.layout)
+        };
         let foods = a.foods.clone().unwrap_or_else(|| layout.default_foods());
         for &f in &foods {
             if f == 0 || f > layout.ends.len() {
-                bail!("food point {f} does not exist: layout {} has end points 1..={}", layout.name, layout.ends.len());
+                bail!(
+                    "food point {f} does not exist: layout {} has end points 1..={}",
+                    layout.name,
+                    layout.ends.len()
+                );
             }
         }
         if a.trials == 0 {
             bail!("--trials must be at least 1");
         }
-        Ok(Options { which: a.which, trials: a.trials, runs: a.runs.max(1), out: a.out.clone(), seed: a.seed, layout, foods, progress: !a.quiet })
+        Ok(Options {
+            which: a.which,
+            trials: a.trials,
+            runs: a.runs.max(1),
+            out: a.out.clone(),
+            seed: a.seed,
+            layout,
+            foods,
+            progress: !a.quiet,
+        })
     }
 }
 
@@ -125,12 +149,19 @@ pub fn run(opts: &Options) -> Result<Report> {
         c.foods = opts.foods.clone();
         c
     });
-    let cfg2 = if do2 { Some(case2::Case2Config::paper(opts.runs, opts.seed)?) } else { None };
+    let cfg2 = if do2 {
+        Some(case2::Case2Config::paper(opts.runs, opts.seed)?)
+    } else {
+        None
+    };
     let total = cfg1.as_ref().map_or(0, case1::task_count) + cfg2.as_ref().map_or(0, |c| c.runs);
     let bar = progress_bar(total as u64, opts.progress);
     let tick = || bar.inc(1);
     // Both cases share the pool: case II's few long runs start first, case I's trials fill the gaps.
-    let (r2, r1) = rayon::join(|| cfg2.as_ref().map(|c| case2::run(c, &tick)).transpose(), || cfg1.as_ref().map(|c| case1::run(c, &tick)).transpose());
+    let (r2, r1) = rayon::join(
+        || cfg2.as_ref().map(|c| case2::run(c, &tick)).transpose(),
+        || cfg1.as_ref().map(|c| case1::run(c, &tick)).transpose(),
+    );
     bar.finish_and_clear();
     let (r1, r2) = (r1?, r2?);
     let mut files = Vec::new();
@@ -142,17 +173,24 @@ pub fn run(opts: &Options) -> Result<Report> {
     }
     let wall = started.elapsed().as_secs_f64();
     files.extend(summary::write(out, r1.as_ref(), r2.as_ref(), wall)?);
-    Ok(Report { case1: r1, case2: r2, files, wall_seconds: wall })
+    Ok(Report {
+        case1: r1,
+        case2: r2,
+        files,
+        wall_seconds: wall,
+    })
 }
 
 fn write_case1(r: &case1::Case1Result, dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut files = Vec::new();
     let csv = dir.join("arrivals.csv");
-    std::fs::write(&csv, case1::arrivals_csv(r)).with_context(|| format!("writing {}", csv.display()))?;
+    std::fs::write(&csv, case1::arrivals_csv(r))
+        .with_context(|| format!("writing {}", csv.display()))?;
     files.push(csv);
     let trials = dir.join("trials.csv");
-    std::fs::write(&trials, case1::trials_csv(r)).with_context(|| format!("writing {}", trials.display()))?;
+    std::fs::write(&trials, case1::trials_csv(r))
+        .with_context(|| format!("writing {}", trials.display()))?;
     files.push(trials);
     let f5 = dir.join("fig5_arrivals.png");
     plots::fig5_arrivals(r, &f5)?;
@@ -170,7 +208,8 @@ fn write_case2(r: &case2::Case2Result, dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut files = Vec::new();
     let csv = dir.join("s_t.csv");
-    std::fs::write(&csv, case2::s_t_csv(r)).with_context(|| format!("writing {}", csv.display()))?;
+    std::fs::write(&csv, case2::s_t_csv(r))
+        .with_context(|| format!("writing {}", csv.display()))?;
     files.push(csv);
     let f8 = dir.join("fig8_s_t.png");
     plots::fig8_s_t(r, &f8)?;
@@ -187,7 +226,10 @@ fn write_case2(r: &case2::Case2Result, dir: &Path) -> Result<Vec<PathBuf>> {
 /// Entry point of the command line: sets up the thread pool, runs, prints where the files are.
 pub fn main(args: ExperimentArgs) -> Result<()> {
     if let Some(n) = args.threads {
-        rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting up the thread pool")?;
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("setting up the thread pool")?;
     }
     let opts = Options::from_args(&args)?;
     let report = run(&opts)?;

@@ -1,8 +1,8 @@
 //! `summary.json` (the numbers), `summary.md` (the table a person reads, beside the paper) and the
 //! console summary, plus the paper's claims as checks.
+use super::Report;
 use super::case1::Case1Result;
 use super::case2::Case2Result;
-use super::Report;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use serde_json::json;
@@ -78,7 +78,12 @@ impl Case2Claims {
 pub fn case2_claims(r: &Case2Result) -> Case2Claims {
     let falls: Vec<f32> = r.runs.iter().map(|x| x.aggregation_fall).collect();
     let rises: Vec<Option<f32>> = r.runs.iter().map(|x| x.alarm_rise).collect();
-    Case2Claims { fall_ok: falls.iter().all(|&f| f >= 0.5), rise_ok: rises.iter().all(|r| r.is_some_and(|r| r >= 0.5)), falls, rises }
+    Case2Claims {
+        fall_ok: falls.iter().all(|&f| f >= 0.5),
+        rise_ok: rises.iter().all(|r| r.is_some_and(|r| r >= 0.5)),
+        falls,
+        rises,
+    }
 }
 
 fn r3(v: f32) -> f64 {
@@ -173,7 +178,11 @@ pub fn markdown(r1: Option<&Case1Result>, r2: Option<&Case2Result>, wall: f64) -
             for v in &g.counts.per_point {
                 s.push_str(&format!(" {v} |"));
             }
-            s.push_str(&format!(" {} | {} |\n", g.counts.timeouts, g.at_food(&r.config.foods)));
+            s.push_str(&format!(
+                " {} | {} |\n",
+                g.counts.timeouts,
+                g.at_food(&r.config.foods)
+            ));
         }
         s.push_str("\n(* = available food)\n\n| claim (paper, Fig. 5) | paper | measured | holds |\n|---|---|---|---|\n");
         s.push_str(&format!(
@@ -206,31 +215,72 @@ pub fn markdown(r1: Option<&Case1Result>, r2: Option<&Case2Result>, wall: f64) -
             r.config.scenario.spec.seed
         ));
         for (k, run) in r.runs.iter().enumerate() {
-            let alarm = run.phases.iter().find(|p| p.kind == colcos_sim::metrics::PhaseKind::Dispersion).map_or("none".to_string(), |p| format!("{:.1} s", p.start));
-            let rise = run.alarm_rise.map_or("-".to_string(), |x| format!("{:.0} %", 100.0 * x));
-            let bounds: Vec<String> = run.phases.iter().skip(1).map(|p| format!("{:.1}", p.start)).collect();
-            s.push_str(&format!("| {k} | {:.0} % | {alarm} | {rise} | {} |\n", 100.0 * run.aggregation_fall, bounds.join(", ")));
+            let alarm = run
+                .phases
+                .iter()
+                .find(|p| p.kind == colcos_sim::metrics::PhaseKind::Dispersion)
+                .map_or("none".to_string(), |p| format!("{:.1} s", p.start));
+            let rise = run
+                .alarm_rise
+                .map_or("-".to_string(), |x| format!("{:.0} %", 100.0 * x));
+            let bounds: Vec<String> = run
+                .phases
+                .iter()
+                .skip(1)
+                .map(|p| format!("{:.1}", p.start))
+                .collect();
+            s.push_str(&format!(
+                "| {k} | {:.0} % | {alarm} | {rise} | {} |\n",
+                100.0 * run.aggregation_fall,
+                bounds.join(", ")
+            ));
         }
         s.push_str("\n| claim (paper, Fig. 8) | paper | measured | holds |\n|---|---|---|---|\n");
-        s.push_str(&format!("| S(t) falls by at least half during aggregation | S decays | every run: {} | {} |\n", fmt_list(&c.falls), yes(c.fall_ok)));
+        s.push_str(&format!(
+            "| S(t) falls by at least half during aggregation | S decays | every run: {} | {} |\n",
+            fmt_list(&c.falls),
+            yes(c.fall_ok)
+        ));
         let rises: Vec<f32> = c.rises.iter().map(|r| r.unwrap_or(f32::NAN)).collect();
-        s.push_str(&format!("| S(t) rises by at least half after an alarm | S increases | every run: {} | {} |\n\n", fmt_list(&rises), yes(c.rise_ok)));
+        s.push_str(&format!(
+            "| S(t) rises by at least half after an alarm | S increases | every run: {} | {} |\n\n",
+            fmt_list(&rises),
+            yes(c.rise_ok)
+        ));
     }
-    s.push_str(&format!("Wall time of the whole experiment: {wall:.2} s.\n"));
+    s.push_str(&format!(
+        "Wall time of the whole experiment: {wall:.2} s.\n"
+    ));
     s
 }
 
 fn fmt_list(v: &[f32]) -> String {
-    v.iter().map(|x| if x.is_nan() { "none".into() } else { format!("{:.0} %", 100.0 * x) }).collect::<Vec<_>>().join(", ")
+    v.iter()
+        .map(|x| {
+            if x.is_nan() {
+                "none".into()
+            } else {
+                format!("{:.0} %", 100.0 * x)
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Writes summary.json and summary.md into `out`.
-pub fn write(out: &Path, r1: Option<&Case1Result>, r2: Option<&Case2Result>, wall: f64) -> Result<Vec<PathBuf>> {
+pub fn write(
+    out: &Path,
+    r1: Option<&Case1Result>,
+    r2: Option<&Case2Result>,
+    wall: f64,
+) -> Result<Vec<PathBuf>> {
     let j = out.join("summary.json");
-    let text = serde_json::to_string_pretty(&json(r1, r2, wall)).context("serialising the summary")?;
+    let text =
+        serde_json::to_string_pretty(&json(r1, r2, wall)).context("serialising the summary")?;
     std::fs::write(&j, text + "\n").with_context(|| format!("writing {}", j.display()))?;
     let m = out.join("summary.md");
-    std::fs::write(&m, markdown(r1, r2, wall)).with_context(|| format!("writing {}", m.display()))?;
+    std::fs::write(&m, markdown(r1, r2, wall))
+        .with_context(|| format!("writing {}", m.display()))?;
     Ok(vec![j, m])
 }
 
@@ -240,14 +290,36 @@ pub fn console(report: &Report) -> String {
     if let Some(r) = &report.case1 {
         let c = case1_claims(r);
         for g in &r.groups {
-            s.push_str(&format!("case I  {}: arrivals {:?}, timeouts {}, at food {:?}: {}\n", g.name, g.counts.per_point, g.counts.timeouts, r.config.foods, g.at_food(&r.config.foods)));
+            s.push_str(&format!(
+                "case I  {}: arrivals {:?}, timeouts {}, at food {:?}: {}\n",
+                g.name,
+                g.counts.per_point,
+                g.counts.timeouts,
+                r.config.foods,
+                g.at_food(&r.config.foods)
+            ));
         }
-        s.push_str(&format!("case I  claims: G3 >= 95 % {}, G1 spread {}, G1 < G2 < G3 {}\n", c.g3_ok, c.g1_ok, c.g2_ok));
+        s.push_str(&format!(
+            "case I  claims: G3 >= 95 % {}, G1 spread {}, G1 < G2 < G3 {}\n",
+            c.g3_ok, c.g1_ok, c.g2_ok
+        ));
     }
     if let Some(r) = &report.case2 {
         let c = case2_claims(r);
-        s.push_str(&format!("case II aggregation falls {}, alarm rises {}\n", fmt_list(&c.falls), fmt_list(&c.rises.iter().map(|r| r.unwrap_or(f32::NAN)).collect::<Vec<_>>())));
-        s.push_str(&format!("case II claims: fall >= 50 % {}, rise >= 50 % {}\n", c.fall_ok, c.rise_ok));
+        s.push_str(&format!(
+            "case II aggregation falls {}, alarm rises {}\n",
+            fmt_list(&c.falls),
+            fmt_list(
+                &c.rises
+                    .iter()
+                    .map(|r| r.unwrap_or(f32::NAN))
+                    .collect::<Vec<_>>()
+            )
+        ));
+        s.push_str(&format!(
+            "case II claims: fall >= 50 % {}, rise >= 50 % {}\n",
+            c.fall_ok, c.rise_ok
+        ));
     }
     s
 }

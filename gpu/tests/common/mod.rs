@@ -28,7 +28,10 @@ pub fn ctx() -> Option<Arc<GpuContext>> {
 pub struct Lcg(pub u64);
 impl Lcg {
     pub fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 40) as f32) / (1u64 << 24) as f32
     }
 }
@@ -36,7 +39,10 @@ impl Lcg {
 /// Largest |gpu - cpu| relative to the largest |cpu| value, and the number of bit-identical cells.
 pub fn compare(gpu: &[f32], cpu: &[f32]) -> (f64, usize) {
     assert_eq!(gpu.len(), cpu.len());
-    let scale = cpu.iter().fold(0f64, |m, &v| m.max((v as f64).abs())).max(1e-30);
+    let scale = cpu
+        .iter()
+        .fold(0f64, |m, &v| m.max((v as f64).abs()))
+        .max(1e-30);
     let mut worst = 0f64;
     let mut same = 0;
     for (&g, &c) in gpu.iter().zip(cpu) {

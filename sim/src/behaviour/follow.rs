@@ -20,7 +20,12 @@ pub struct FollowParams {
 
 impl Default for FollowParams {
     fn default() -> Self {
-        FollowParams { channel: "b".into(), speed: 0.1, sensitivity: 0.6, threshold: 0.05 }
+        FollowParams {
+            channel: "b".into(),
+            speed: 0.1,
+            sensitivity: 0.6,
+            threshold: 0.05,
+        }
     }
 }
 
@@ -44,7 +49,13 @@ pub struct Follow {
 
 impl Follow {
     pub fn new(channel: usize, speed: f32, sensitivity: f32, threshold: f32) -> Self {
-        Follow { channel, speed, sensitivity, threshold, off_trail: Wander::new(speed) }
+        Follow {
+            channel,
+            speed,
+            sensitivity,
+            threshold,
+            off_trail: Wander::new(speed),
+        }
     }
 
     /// The steering rule alone: the right wheel speeds up when the left sensor (n = 2) sees more than

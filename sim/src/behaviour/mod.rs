@@ -10,8 +10,10 @@ pub mod registry;
 mod wander;
 
 pub use avoid::Avoid;
-pub use follow::{channel_index, Follow, FollowParams};
-pub use observation::{Observation, WheelCommand, BUMPER_FRONT, BUMPER_FRONT_LEFT, BUMPER_FRONT_RIGHT};
+pub use follow::{Follow, FollowParams, channel_index};
+pub use observation::{
+    BUMPER_FRONT, BUMPER_FRONT_LEFT, BUMPER_FRONT_RIGHT, Observation, WheelCommand,
+};
 pub use wander::Wander;
 
 use crate::rng::SimRng;

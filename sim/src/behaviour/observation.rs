@@ -18,7 +18,10 @@ pub struct WheelCommand {
 }
 
 impl WheelCommand {
-    pub const STOP: WheelCommand = WheelCommand { left: 0.0, right: 0.0 };
+    pub const STOP: WheelCommand = WheelCommand {
+        left: 0.0,
+        right: 0.0,
+    };
 
     pub fn new(left: f32, right: f32) -> Self {
         WheelCommand { left, right }
@@ -79,7 +82,12 @@ mod tests {
     #[test]
     fn gradient_points_to_the_stronger_side() {
         // Stronger at the front sensor (X+): direction 0.
-        assert!(obs_with(1, [0.2, 0.8, 0.2, 0.0]).gradient_direction(1).abs() < 1e-6);
+        assert!(
+            obs_with(1, [0.2, 0.8, 0.2, 0.0])
+                .gradient_direction(1)
+                .abs()
+                < 1e-6
+        );
         // Stronger at the left sensor (Y+): +pi/2.
         let left = obs_with(1, [0.0, 0.2, 0.8, 0.2]).gradient_direction(1);
         assert!((left - std::f32::consts::FRAC_PI_2).abs() < 1e-6);

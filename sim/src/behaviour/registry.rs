@@ -1,21 +1,45 @@
 //! Behaviours by name, as scenario files refer to them. Every behaviour reads its parameters from the
 //! group's `params` table and rejects unknown keys.
-use super::follow::{channel_index, FollowParams};
+use super::follow::{FollowParams, channel_index};
 use super::{Avoid, Behaviour, Follow, Wander};
 use crate::error::{Result, SimError};
-use serde::de::DeserializeOwned;
 use serde::Deserialize;
+use serde::de::DeserializeOwned;
 
 type Builder = fn(&toml::Table, &str) -> Result<Box<dyn Behaviour>>;
 
 /// Every registered behaviour: name, one-line description, builder.
 const REGISTRY: &[(&str, &str, Builder)] = &[
-    ("wander", "correlated random walk (bumps into things)", build_wander),
-    ("avoid", "random walk with a sharp turn on a bumper hit", build_avoid),
-    ("follow", "follow a colour trail (left/right sensor difference), wander off it, avoid on a bump", build_follow),
-    ("forage", "paper Algorithm 1: follow LAP/SAP trails by eq. (7), cyan 70 % at bifurcations, avoid SRP", build_forage),
-    ("aggregation_leader", "paper Algorithm 2: flee down the ALP gradient by eq. (8), else wander", build_aggregation_leader),
-    ("aggregation_follower", "paper Algorithm 3: flee the ALP, else climb the AGP gradient by eq. (8), else wander", build_aggregation_follower),
+    (
+        "wander",
+        "correlated random walk (bumps into things)",
+        build_wander,
+    ),
+    (
+        "avoid",
+        "random walk with a sharp turn on a bumper hit",
+        build_avoid,
+    ),
+    (
+        "follow",
+        "follow a colour trail (left/right sensor difference), wander off it, avoid on a bump",
+        build_follow,
+    ),
+    (
+        "forage",
+        "paper Algorithm 1: follow LAP/SAP trails by eq. (7), cyan 70 % at bifurcations, avoid SRP",
+        build_forage,
+    ),
+    (
+        "aggregation_leader",
+        "paper Algorithm 2: flee down the ALP gradient by eq. (8), else wander",
+        build_aggregation_leader,
+    ),
+    (
+        "aggregation_follower",
+        "paper Algorithm 3: flee the ALP, else climb the AGP gradient by eq. (8), else wander",
+        build_aggregation_follower,
+    ),
 ];
 
 /// Names and descriptions of all behaviours.
@@ -29,7 +53,11 @@ pub fn build(name: &str, params: &toml::Table, key: &str) -> Result<Box<dyn Beha
         Some((_, _, builder)) => builder(params, key),
         None => {
             let known: Vec<_> = REGISTRY.iter().map(|(n, _, _)| *n).collect();
-            Err(SimError::invalid(format!("{key}.behaviour"), format!("{name:?}"), format!("unknown behaviour (known: {known:?})")))
+            Err(SimError::invalid(
+                format!("{key}.behaviour"),
+                format!("{name:?}"),
+                format!("unknown behaviour (known: {known:?})"),
+            ))
         }
     }
 }
@@ -39,7 +67,11 @@ pub fn parse_params<T: DeserializeOwned>(params: &toml::Table, key: &str) -> Res
     let value = toml::Value::Table(params.clone());
     serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
-        let at = if path == "." { format!("{key}.params") } else { format!("{key}.params.{path}") };
+        let at = if path == "." {
+            format!("{key}.params")
+        } else {
+            format!("{key}.params.{path}")
+        };
         SimError::invalid(at, "(see message)", e.into_inner().to_string())
     })
 }
@@ -61,7 +93,11 @@ fn speed_checked(key: &str, speed: f32) -> Result<f32> {
     if speed.is_finite() && speed >= 0.0 {
         Ok(speed)
     } else {
-        Err(SimError::invalid(format!("{key}.params.speed"), speed, "must be a finite speed >= 0 (m/s)"))
+        Err(SimError::invalid(
+            format!("{key}.params.speed"),
+            speed,
+            "must be a finite speed >= 0 (m/s)",
+        ))
     }
 }
 
@@ -72,21 +108,41 @@ fn build_wander(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
 
 fn build_avoid(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
     let p: WanderParams = parse_params(params, key)?;
-    Ok(Box::new(Avoid::new(Wander::new(speed_checked(key, p.speed)?))))
+    Ok(Box::new(Avoid::new(Wander::new(speed_checked(
+        key, p.speed,
+    )?))))
 }
 
 fn build_follow(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
     let p: FollowParams = parse_params(params, key)?;
-    let channel = channel_index(&p.channel)
-        .ok_or_else(|| SimError::invalid(format!("{key}.params.channel"), format!("{:?}", p.channel), "must be \"r\", \"g\" or \"b\""))?;
+    let channel = channel_index(&p.channel).ok_or_else(|| {
+        SimError::invalid(
+            format!("{key}.params.channel"),
+            format!("{:?}", p.channel),
+            "must be \"r\", \"g\" or \"b\"",
+        )
+    })?;
     let speed = speed_checked(key, p.speed)?;
     if !p.sensitivity.is_finite() {
-        return Err(SimError::invalid(format!("{key}.params.sensitivity"), p.sensitivity, "must be finite"));
+        return Err(SimError::invalid(
+            format!("{key}.params.sensitivity"),
+            p.sensitivity,
+            "must be finite",
+        ));
     }
     if !(p.threshold.is_finite() && p.threshold >= 0.0) {
-        return Err(SimError::invalid(format!("{key}.params.threshold"), p.threshold, "must be >= 0"));
+        return Err(SimError::invalid(
+            format!("{key}.params.threshold"),
+            p.threshold,
+            "must be >= 0",
+        ));
     }
-    Ok(Box::new(Avoid::new(Follow::new(channel, speed, p.sensitivity, p.threshold))))
+    Ok(Box::new(Avoid::new(Follow::new(
+        channel,
+        speed,
+        p.sensitivity,
+        p.threshold,
+    ))))
 }
 
 fn build_forage(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {

@@ -8,10 +8,24 @@ use std::path::Path;
 
 /// Column names of the trajectory CSV, in order.
 pub fn header() -> String {
-    let mut cols: Vec<String> = ["tick", "time", "robot", "role", "x", "y", "heading", "tracked_x", "tracked_y", "tracked_heading", "tracked_seen", "cmd_left", "cmd_right"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let mut cols: Vec<String> = [
+        "tick",
+        "time",
+        "robot",
+        "role",
+        "x",
+        "y",
+        "heading",
+        "tracked_x",
+        "tracked_y",
+        "tracked_heading",
+        "tracked_seen",
+        "cmd_left",
+        "cmd_right",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     for n in 0..4 {
         for c in ["r", "g", "b"] {
             cols.push(format!("s{n}_{c}"));
@@ -30,8 +44,13 @@ pub struct TrajectoryLog {
 impl TrajectoryLog {
     /// Creates (truncates) the log and writes the header.
     pub fn create(path: &Path) -> Result<Self> {
-        let file = File::create(path).map_err(|e| SimError::io(format!("creating {}", path.display()), e))?;
-        let mut log = TrajectoryLog { out: BufWriter::with_capacity(1 << 20, file), path: path.display().to_string(), line: String::new() };
+        let file = File::create(path)
+            .map_err(|e| SimError::io(format!("creating {}", path.display()), e))?;
+        let mut log = TrajectoryLog {
+            out: BufWriter::with_capacity(1 << 20, file),
+            path: path.display().to_string(),
+            line: String::new(),
+        };
         let h = header();
         log.write_str(&h)?;
         log.write_str("\n")?;
@@ -40,11 +59,15 @@ impl TrajectoryLog {
     }
 
     fn write_str(&mut self, s: &str) -> Result<()> {
-        self.out.write_all(s.as_bytes()).map_err(|e| SimError::io(format!("writing {}", self.path), e))
+        self.out
+            .write_all(s.as_bytes())
+            .map_err(|e| SimError::io(format!("writing {}", self.path), e))
     }
 
     fn flush(&mut self) -> Result<()> {
-        self.out.flush().map_err(|e| SimError::io(format!("writing {}", self.path), e))
+        self.out
+            .flush()
+            .map_err(|e| SimError::io(format!("writing {}", self.path), e))
     }
 
     /// Appends one row per robot for the world's current tick and flushes them to the file.

@@ -21,10 +21,14 @@ impl Scenario {
     /// Reads, parses and validates a scenario file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| SimError::io(format!("reading scenario {}", path.display()), e))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SimError::io(format!("reading scenario {}", path.display()), e))?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Self::from_toml_str(&text, base).map_err(|e| match e {
-            SimError::Parse { message, .. } => SimError::Parse { path: path.display().to_string(), message },
+            SimError::Parse { message, .. } => SimError::Parse {
+                path: path.display().to_string(),
+                message,
+            },
             other => other,
         })
     }
@@ -37,7 +41,10 @@ impl Scenario {
 
     /// Validates an already parsed spec.
     pub fn from_spec(spec: ScenarioSpec, base_dir: impl Into<PathBuf>) -> Result<Self> {
-        let scenario = Scenario { spec, base_dir: base_dir.into() };
+        let scenario = Scenario {
+            spec,
+            base_dir: base_dir.into(),
+        };
         validate::validate(&scenario)?;
         Ok(scenario)
     }
@@ -83,11 +90,21 @@ impl Scenario {
 
 /// TOML text to spec. Errors name the key path (`robots[0].count`) and what was wrong.
 pub fn parse_spec(text: &str) -> Result<ScenarioSpec> {
-    let de = toml::de::Deserializer::parse(text).map_err(|e| SimError::Parse { path: "<text>".into(), message: e.to_string() })?;
+    let de = toml::de::Deserializer::parse(text).map_err(|e| SimError::Parse {
+        path: "<text>".into(),
+        message: e.to_string(),
+    })?;
     serde_path_to_error::deserialize(de).map_err(|e| {
         let path = e.path().to_string();
         let inner = e.into_inner().to_string();
-        let message = if path == "." || path.is_empty() { inner } else { format!("at `{path}`: {inner}") };
-        SimError::Parse { path: "<text>".into(), message }
+        let message = if path == "." || path.is_empty() {
+            inner
+        } else {
+            format!("at `{path}`: {inner}")
+        };
+        SimError::Parse {
+            path: "<text>".into(),
+            message,
+        }
     })
 }

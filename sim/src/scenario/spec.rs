@@ -82,7 +82,11 @@ pub struct FieldSpec {
 
 impl Default for FieldSpec {
     fn default() -> Self {
-        FieldSpec { cell: 0.005, inject_at: InjectAt::Tracked, backend: BackendChoice::Cpu }
+        FieldSpec {
+            cell: 0.005,
+            inject_at: InjectAt::Tracked,
+            backend: BackendChoice::Cpu,
+        }
     }
 }
 
@@ -100,7 +104,11 @@ pub struct OutputSpec {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { gif_interval: 0.2, gif_width: 480, log_every: 1 }
+        OutputSpec {
+            gif_interval: 0.2,
+            gif_width: 480,
+            log_every: 1,
+        }
     }
 }
 
@@ -249,5 +257,8 @@ pub struct EmitSpec {
 pub enum EmitWhen {
     #[default]
     Follow,
-    Near { role: String, distance: f32 },
+    Near {
+        role: String,
+        distance: f32,
+    },
 }

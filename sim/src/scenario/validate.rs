@@ -1,21 +1,33 @@
 //! Checks a parsed scenario for values that cannot be simulated, before anything runs. Every error
 //! names the key path and the bad value.
 
-use super::spec::*;
 use super::Scenario;
+use super::spec::*;
 use crate::behaviour::registry;
 use crate::error::{Result, SimError};
 
 fn positive(key: &str, v: f32) -> Result<()> {
-    if v.is_finite() && v > 0.0 { Ok(()) } else { Err(SimError::invalid(key, v, "must be a finite number > 0")) }
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(SimError::invalid(key, v, "must be a finite number > 0"))
+    }
 }
 
 fn non_negative(key: &str, v: f32) -> Result<()> {
-    if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(SimError::invalid(key, v, "must be a finite number >= 0")) }
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(SimError::invalid(key, v, "must be a finite number >= 0"))
+    }
 }
 
 fn finite(key: &str, v: f32) -> Result<()> {
-    if v.is_finite() { Ok(()) } else { Err(SimError::invalid(key, v, "must be finite")) }
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(SimError::invalid(key, v, "must be finite"))
+    }
 }
 
 pub(super) fn validate(sc: &Scenario) -> Result<()> {
@@ -23,17 +35,29 @@ pub(super) fn validate(sc: &Scenario) -> Result<()> {
     positive("duration", s.duration)?;
     positive("dt", s.dt)?;
     if s.dt > 0.5 {
-        return Err(SimError::invalid("dt", s.dt, "time step longer than 0.5 s cannot resolve robot motion"));
+        return Err(SimError::invalid(
+            "dt",
+            s.dt,
+            "time step longer than 0.5 s cannot resolve robot motion",
+        ));
     }
     if s.duration / s.dt > 1e9 {
-        return Err(SimError::invalid("duration", s.duration, "more than 1e9 steps"));
+        return Err(SimError::invalid(
+            "duration",
+            s.duration,
+            "more than 1e9 steps",
+        ));
     }
     let arena = sc.arena_size();
     positive("arena.size[0]", arena.x)?;
     positive("arena.size[1]", arena.y)?;
     for (i, r) in s.screen.resolution.iter().enumerate() {
         if *r == 0 || *r > 65536 {
-            return Err(SimError::invalid(format!("screen.resolution[{i}]"), r, "must be 1..=65536 pixels"));
+            return Err(SimError::invalid(
+                format!("screen.resolution[{i}]"),
+                r,
+                "must be 1..=65536 pixels",
+            ));
         }
     }
     positive("screen.size[0]", s.screen.size[0])?;
@@ -50,11 +74,19 @@ fn validate_field(sc: &Scenario) -> Result<()> {
     let arena = sc.arena_size();
     positive("field.cell", s.field.cell)?;
     if s.field.cell > arena.min_element() / 2.0 {
-        return Err(SimError::invalid("field.cell", s.field.cell, format!("larger than half the arena ({} m)", arena.min_element())));
+        return Err(SimError::invalid(
+            "field.cell",
+            s.field.cell,
+            format!("larger than half the arena ({} m)", arena.min_element()),
+        ));
     }
     let cells = (arena.x / s.field.cell) as f64 * (arena.y / s.field.cell) as f64;
     if cells > 2e8 {
-        return Err(SimError::invalid("field.cell", s.field.cell, format!("{cells:.0} cells per pheromone is more than 2e8")));
+        return Err(SimError::invalid(
+            "field.cell",
+            s.field.cell,
+            format!("{cells:.0} cells per pheromone is more than 2e8"),
+        ));
     }
     positive("output.gif_width", s.output.gif_width as f32)?;
     non_negative("output.gif_interval", s.output.gif_interval)?;
@@ -83,7 +115,11 @@ fn validate_robot_params(s: &ScenarioSpec) -> Result<()> {
         }
     }
     if det3(&c.crosstalk).abs() < 1e-6 {
-        return Err(SimError::invalid("sensor.crosstalk", format!("{:?}", c.crosstalk), "matrix is singular: the sensor could not be calibrated"));
+        return Err(SimError::invalid(
+            "sensor.crosstalk",
+            format!("{:?}", c.crosstalk),
+            "matrix is singular: the sensor could not be calibrated",
+        ));
     }
     non_negative("bumper.range", s.bumper.range)?;
     for (i, a) in s.bumper.angles.iter().enumerate() {
@@ -95,13 +131,18 @@ fn validate_robot_params(s: &ScenarioSpec) -> Result<()> {
     non_negative("tracker.position_noise", t.position_noise)?;
     non_negative("tracker.heading_noise", t.heading_noise)?;
     if !(0.0..1.0).contains(&t.dropout) {
-        return Err(SimError::invalid("tracker.dropout", t.dropout, "must be in [0, 1)"));
+        return Err(SimError::invalid(
+            "tracker.dropout",
+            t.dropout,
+            "must be in [0, 1)",
+        ));
     }
     Ok(())
 }
 
 fn det3(m: &[[f32; 3]; 3]) -> f32 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
@@ -112,7 +153,11 @@ fn validate_pheromones(s: &ScenarioSpec) -> Result<()> {
             return Err(SimError::invalid(k("name"), "\"\"", "must not be empty"));
         }
         if s.pheromones[..i].iter().any(|q| q.name == p.name) {
-            return Err(SimError::invalid(k("name"), format!("{:?}", p.name), "another pheromone has this name"));
+            return Err(SimError::invalid(
+                k("name"),
+                format!("{:?}", p.name),
+                "another pheromone has this name",
+            ));
         }
         for (c, v) in p.colour.iter().enumerate() {
             non_negative(&format!("pheromones[{i}].colour[{c}]"), *v)?;
@@ -126,7 +171,11 @@ fn validate_pheromones(s: &ScenarioSpec) -> Result<()> {
                 finite(&k("wind[0]"), p.wind[0])?;
                 finite(&k("wind[1]"), p.wind[1])?;
                 if !p.sources.is_empty() {
-                    return Err(SimError::invalid(k("sources"), p.sources.len(), "fixed Gaussian sources need model = \"gaussian\""));
+                    return Err(SimError::invalid(
+                        k("sources"),
+                        p.sources.len(),
+                        "fixed Gaussian sources need model = \"gaussian\"",
+                    ));
                 }
                 for (m, map) in p.maps.iter().enumerate() {
                     validate_map(&format!("pheromones[{i}].maps[{m}]"), map)?;
@@ -134,10 +183,18 @@ fn validate_pheromones(s: &ScenarioSpec) -> Result<()> {
             }
             ModelKind::Gaussian => {
                 if p.evaporation.is_none() {
-                    return Err(SimError::invalid(k("evaporation"), "missing", "the Gaussian model needs an evaporation time"));
+                    return Err(SimError::invalid(
+                        k("evaporation"),
+                        "missing",
+                        "the Gaussian model needs an evaporation time",
+                    ));
                 }
                 if p.diffusion != 0.0 || p.wind != [0.0, 0.0] || !p.maps.is_empty() {
-                    return Err(SimError::invalid(k("model"), "\"gaussian\"", "diffusion, wind and maps belong to the grid model"));
+                    return Err(SimError::invalid(
+                        k("model"),
+                        "\"gaussian\"",
+                        "diffusion, wind and maps belong to the grid model",
+                    ));
                 }
                 for (j, src) in p.sources.iter().enumerate() {
                     let key = format!("pheromones[{i}].sources[{j}]");
@@ -157,7 +214,11 @@ fn validate_map(key: &str, map: &MapSpec) -> Result<()> {
     match (&map.polyline, &map.image) {
         (Some(points), None) => {
             if points.len() < 2 {
-                return Err(SimError::invalid(format!("{key}.polyline"), points.len(), "needs at least 2 points"));
+                return Err(SimError::invalid(
+                    format!("{key}.polyline"),
+                    points.len(),
+                    "needs at least 2 points",
+                ));
             }
             for (n, pt) in points.iter().enumerate() {
                 finite(&format!("{key}.polyline[{n}][0]"), pt[0])?;
@@ -165,33 +226,67 @@ fn validate_map(key: &str, map: &MapSpec) -> Result<()> {
             }
             match map.width {
                 Some(w) => positive(&format!("{key}.width"), w)?,
-                None => return Err(SimError::invalid(format!("{key}.width"), "missing", "a polyline map needs a width")),
+                None => {
+                    return Err(SimError::invalid(
+                        format!("{key}.width"),
+                        "missing",
+                        "a polyline map needs a width",
+                    ));
+                }
             }
             if map.channel.is_some() {
-                return Err(SimError::invalid(format!("{key}.channel"), format!("{:?}", map.channel), "only image maps have a channel"));
+                return Err(SimError::invalid(
+                    format!("{key}.channel"),
+                    format!("{:?}", map.channel),
+                    "only image maps have a channel",
+                ));
             }
         }
         (None, Some(_)) => {
             if let Some(c) = &map.channel
                 && !["r", "g", "b", "luma"].contains(&c.as_str())
             {
-                return Err(SimError::invalid(format!("{key}.channel"), format!("{c:?}"), "must be \"r\", \"g\", \"b\" or \"luma\""));
+                return Err(SimError::invalid(
+                    format!("{key}.channel"),
+                    format!("{c:?}"),
+                    "must be \"r\", \"g\", \"b\" or \"luma\"",
+                ));
             }
             if map.width.is_some() {
-                return Err(SimError::invalid(format!("{key}.width"), format!("{:?}", map.width), "only polyline maps have a width"));
+                return Err(SimError::invalid(
+                    format!("{key}.width"),
+                    format!("{:?}", map.width),
+                    "only polyline maps have a width",
+                ));
             }
         }
-        _ => return Err(SimError::invalid(key, "map", "give exactly one of `polyline` or `image`")),
+        _ => {
+            return Err(SimError::invalid(
+                key,
+                "map",
+                "give exactly one of `polyline` or `image`",
+            ));
+        }
     }
     Ok(())
 }
 
-pub(super) fn validate_gaussian(key: &str, k: f32, sigma: [f32; 2], rho: f32, evaporation: f32) -> Result<()> {
+pub(super) fn validate_gaussian(
+    key: &str,
+    k: f32,
+    sigma: [f32; 2],
+    rho: f32,
+    evaporation: f32,
+) -> Result<()> {
     non_negative(&format!("{key}.k"), k)?;
     positive(&format!("{key}.sigma[0]"), sigma[0])?;
     positive(&format!("{key}.sigma[1]"), sigma[1])?;
     if !(rho.is_finite() && rho.abs() < 1.0) {
-        return Err(SimError::invalid(format!("{key}.rho"), rho, "must satisfy |rho| < 1"));
+        return Err(SimError::invalid(
+            format!("{key}.rho"),
+            rho,
+            "must satisfy |rho| < 1",
+        ));
     }
     positive(&format!("{key}.evaporation"), evaporation)
 }
@@ -201,7 +296,11 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
     let arena = sc.arena_size();
     let r = s.robot.radius;
     if 2.0 * r >= arena.min_element() {
-        return Err(SimError::invalid("robot.radius", r, "a robot does not fit in the arena"));
+        return Err(SimError::invalid(
+            "robot.radius",
+            r,
+            "a robot does not fit in the arena",
+        ));
     }
     let mut footprint = 0.0f64;
     for (g, group) in s.robots.iter().enumerate() {
@@ -211,40 +310,87 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
         for (n, v) in region.iter().enumerate() {
             finite(&format!("robots[{g}].region[{n}]"), *v)?;
         }
-        if region[0] < 0.0 || region[1] < 0.0 || region[2] > arena.x + 1e-6 || region[3] > arena.y + 1e-6 || region[2] <= region[0] || region[3] <= region[1] {
-            return Err(SimError::invalid(k("region"), format!("{region:?}"), format!("must be [x0, y0, x1, y1] with x0 < x1, y0 < y1 inside the {} x {} m arena", arena.x, arena.y)));
+        if region[0] < 0.0
+            || region[1] < 0.0
+            || region[2] > arena.x + 1e-6
+            || region[3] > arena.y + 1e-6
+            || region[2] <= region[0]
+            || region[3] <= region[1]
+        {
+            return Err(SimError::invalid(
+                k("region"),
+                format!("{region:?}"),
+                format!(
+                    "must be [x0, y0, x1, y1] with x0 < x1, y0 < y1 inside the {} x {} m arena",
+                    arena.x, arena.y
+                ),
+            ));
         }
         let (w, h) = (region[2] - region[0], region[3] - region[1]);
         if w < 2.0 * r || h < 2.0 * r {
-            return Err(SimError::invalid(k("region"), format!("{region:?}"), "smaller than one robot"));
+            return Err(SimError::invalid(
+                k("region"),
+                format!("{region:?}"),
+                "smaller than one robot",
+            ));
         }
         // Square packing of discs in the region: beyond it, random placement cannot succeed.
         let capacity = ((w / (2.0 * r)).floor() * (h / (2.0 * r)).floor()) as usize;
         if group.placement != Placement::Explicit && group.count > capacity {
-            return Err(SimError::invalid(k("count"), group.count, format!("{capacity} robots of radius {r} m at most fit in region {region:?}")));
+            return Err(SimError::invalid(
+                k("count"),
+                group.count,
+                format!("{capacity} robots of radius {r} m at most fit in region {region:?}"),
+            ));
         }
         footprint += group.count as f64 * (2.0 * r as f64).powi(2);
         if group.placement == Placement::Explicit {
             if group.poses.len() != group.count {
-                return Err(SimError::invalid(k("poses"), group.poses.len(), format!("explicit placement needs exactly `count` = {} poses", group.count)));
+                return Err(SimError::invalid(
+                    k("poses"),
+                    group.poses.len(),
+                    format!(
+                        "explicit placement needs exactly `count` = {} poses",
+                        group.count
+                    ),
+                ));
             }
             for (n, p) in group.poses.iter().enumerate() {
-                if !(p[0] >= r && p[0] <= arena.x - r && p[1] >= r && p[1] <= arena.y - r && p[2].is_finite()) {
-                    return Err(SimError::invalid(format!("robots[{g}].poses[{n}]"), format!("{p:?}"), "the robot is not inside the arena"));
+                if !(p[0] >= r
+                    && p[0] <= arena.x - r
+                    && p[1] >= r
+                    && p[1] <= arena.y - r
+                    && p[2].is_finite())
+                {
+                    return Err(SimError::invalid(
+                        format!("robots[{g}].poses[{n}]"),
+                        format!("{p:?}"),
+                        "the robot is not inside the arena",
+                    ));
                 }
             }
         } else if !group.poses.is_empty() {
-            return Err(SimError::invalid(k("poses"), group.poses.len(), "poses are only used with placement = \"explicit\""));
+            return Err(SimError::invalid(
+                k("poses"),
+                group.poses.len(),
+                "poses are only used with placement = \"explicit\"",
+            ));
         }
         for (d, dep) in group.deposits.iter().enumerate() {
             let key = format!("robots[{g}].deposits[{d}]");
             let p = find_pheromone(sc, &format!("{key}.pheromone"), &dep.pheromone)?;
             if s.pheromones[p].model != ModelKind::Grid {
-                return Err(SimError::invalid(format!("{key}.pheromone"), format!("{:?}", dep.pheromone), "trail deposits need a grid pheromone"));
+                return Err(SimError::invalid(
+                    format!("{key}.pheromone"),
+                    format!("{:?}", dep.pheromone),
+                    "trail deposits need a grid pheromone",
+                ));
             }
             non_negative(&format!("{key}.rate"), dep.rate)?;
             let size = match dep.kernel {
-                crate::field::Kernel::Disc { radius } | crate::field::Kernel::Cone { radius } => radius,
+                crate::field::Kernel::Disc { radius } | crate::field::Kernel::Cone { radius } => {
+                    radius
+                }
                 crate::field::Kernel::Gaussian { sigma } => sigma,
             };
             positive(&format!("{key}.kernel"), size)?;
@@ -253,19 +399,31 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
             let key = format!("robots[{g}].emits[{e}]");
             let p = find_pheromone(sc, &format!("{key}.pheromone"), &emit.pheromone)?;
             if s.pheromones[p].model != ModelKind::Gaussian {
-                return Err(SimError::invalid(format!("{key}.pheromone"), format!("{:?}", emit.pheromone), "emitted sources need a gaussian pheromone"));
+                return Err(SimError::invalid(
+                    format!("{key}.pheromone"),
+                    format!("{:?}", emit.pheromone),
+                    "emitted sources need a gaussian pheromone",
+                ));
             }
             validate_gaussian(&key, emit.k, emit.sigma, emit.rho, emit.evaporation)?;
             if let EmitWhen::Near { role, distance } = &emit.when {
                 positive(&format!("{key}.when.near.distance"), *distance)?;
                 if !s.robots.iter().any(|gr| &gr.role == role) {
-                    return Err(SimError::invalid(format!("{key}.when.near.role"), format!("{role:?}"), "no robot group has this role"));
+                    return Err(SimError::invalid(
+                        format!("{key}.when.near.role"),
+                        format!("{role:?}"),
+                        "no robot group has this role",
+                    ));
                 }
             }
         }
     }
     if footprint > (arena.x * arena.y) as f64 {
-        return Err(SimError::invalid("robots", sc.robot_count(), "the robots together cover more than the arena"));
+        return Err(SimError::invalid(
+            "robots",
+            sc.robot_count(),
+            "the robots together cover more than the arena",
+        ));
     }
     Ok(())
 }
@@ -273,6 +431,10 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
 fn find_pheromone(sc: &Scenario, key: &str, name: &str) -> Result<usize> {
     sc.pheromone_index(name).ok_or_else(|| {
         let known: Vec<_> = sc.spec.pheromones.iter().map(|p| p.name.as_str()).collect();
-        SimError::invalid(key, format!("{name:?}"), format!("no pheromone of that name (known: {known:?})"))
+        SimError::invalid(
+            key,
+            format!("{name:?}"),
+            format!("no pheromone of that name (known: {known:?})"),
+        )
     })
 }

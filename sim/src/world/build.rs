@@ -1,8 +1,11 @@
 //! Building a world from a scenario: fields with their static maps, robots, emitters.
 use super::{Deposit, Emitter, RobotSlot, World};
-use crate::behaviour::{registry, Observation, WheelCommand};
+use crate::behaviour::{Observation, WheelCommand, registry};
 use crate::error::Result;
-use crate::field::{image_map, polyline_map, FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec, Pheromone};
+use crate::field::{
+    FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec, Pheromone,
+    image_map, polyline_map,
+};
 use crate::rng;
 use crate::robot::{ArenaPhysics, DriveState, Pose};
 use crate::scenario::{EmitWhen, MapSpec, ModelKind, PheromoneSpec, Scenario};
@@ -27,7 +30,12 @@ impl World {
         let spec = &scenario.spec;
         let arena = scenario.arena_size();
         let grid = GridSpec::covering(arena, spec.field.cell);
-        let mut pheromones = spec.pheromones.iter().enumerate().map(|(i, p)| build_pheromone(scenario, i, p, grid)).collect::<Result<Vec<_>>>()?;
+        let mut pheromones = spec
+            .pheromones
+            .iter()
+            .enumerate()
+            .map(|(i, p)| build_pheromone(scenario, i, p, grid))
+            .collect::<Result<Vec<_>>>()?;
 
         let mut placement_rng = rng::stream(spec.seed, world_index, STREAM_PLACEMENT);
         let mut poses: Vec<Pose> = Vec::with_capacity(scenario.robot_count());
@@ -36,7 +44,14 @@ impl World {
         let mut emitters = Vec::new();
         for (g, group) in spec.robots.iter().enumerate() {
             let key = format!("robots[{g}]");
-            let placed = super::placement::place_group(group, &key, arena, spec.robot.radius, &poses, &mut placement_rng)?;
+            let placed = super::placement::place_group(
+                group,
+                &key,
+                arena,
+                spec.robot.radius,
+                &poses,
+                &mut placement_rng,
+            )?;
             for pose in placed {
                 let index = poses.len();
                 poses.push(pose);
@@ -49,17 +64,40 @@ impl World {
                 });
                 for d in &group.deposits {
                     let pheromone = scenario.pheromone_index(&d.pheromone).expect("validated");
-                    deposits.push(Deposit { robot: index, pheromone, kernel: d.kernel, rate: d.rate });
+                    deposits.push(Deposit {
+                        robot: index,
+                        pheromone,
+                        kernel: d.kernel,
+                        rate: d.rate,
+                    });
                 }
                 for e in &group.emits {
                     let pheromone = scenario.pheromone_index(&e.pheromone).expect("validated");
-                    let FieldModel::Gaussian(field) = &mut pheromones[pheromone].model else { unreachable!("validated") };
+                    let FieldModel::Gaussian(field) = &mut pheromones[pheromone].model else {
+                        unreachable!("validated")
+                    };
                     let (start, near) = match &e.when {
                         EmitWhen::Follow => (0.0, None),
-                        EmitWhen::Near { role, distance } => (f32::INFINITY, Some((robots_with_role(scenario, role, index), *distance))),
+                        EmitWhen::Near { role, distance } => (
+                            f32::INFINITY,
+                            Some((robots_with_role(scenario, role, index), *distance)),
+                        ),
                     };
-                    field.sources.push(GaussianSource { k: e.k, sigma_x: e.sigma[0], sigma_y: e.sigma[1], rho: e.rho, evaporation: e.evaporation, centre: pose.pos, start });
-                    emitters.push(Emitter { robot: index, pheromone, source: field.sources.len() - 1, near });
+                    field.sources.push(GaussianSource {
+                        k: e.k,
+                        sigma_x: e.sigma[0],
+                        sigma_y: e.sigma[1],
+                        rho: e.rho,
+                        evaporation: e.evaporation,
+                        centre: pose.pos,
+                        start,
+                    });
+                    emitters.push(Emitter {
+                        robot: index,
+                        pheromone,
+                        source: field.sources.len() - 1,
+                        near,
+                    });
                 }
             }
         }
@@ -113,7 +151,12 @@ fn robots_with_role(scenario: &Scenario, role: &str, me: usize) -> Vec<usize> {
     out
 }
 
-fn build_pheromone(scenario: &Scenario, index: usize, p: &PheromoneSpec, grid: GridSpec) -> Result<Pheromone> {
+fn build_pheromone(
+    scenario: &Scenario,
+    index: usize,
+    p: &PheromoneSpec,
+    grid: GridSpec,
+) -> Result<Pheromone> {
     let model = match p.model {
         ModelKind::Grid => {
             let params = GridParams {
@@ -126,7 +169,12 @@ fn build_pheromone(scenario: &Scenario, index: usize, p: &PheromoneSpec, grid: G
             if !p.maps.is_empty() {
                 let mut j = vec![0.0f32; grid.len()];
                 for (m, map) in p.maps.iter().enumerate() {
-                    let layer = build_map(scenario, &format!("pheromones[{index}].maps[{m}]"), map, &grid)?;
+                    let layer = build_map(
+                        scenario,
+                        &format!("pheromones[{index}].maps[{m}]"),
+                        map,
+                        &grid,
+                    )?;
                     j.iter_mut().zip(layer).for_each(|(a, b)| *a += b);
                 }
                 field.set_static_injection(j);
@@ -137,12 +185,24 @@ fn build_pheromone(scenario: &Scenario, index: usize, p: &PheromoneSpec, grid: G
             sources: p
                 .sources
                 .iter()
-                .map(|s| GaussianSource { k: s.k, sigma_x: s.sigma[0], sigma_y: s.sigma[1], rho: s.rho, evaporation: s.evaporation, centre: Vec2::from(s.centre), start: s.start })
+                .map(|s| GaussianSource {
+                    k: s.k,
+                    sigma_x: s.sigma[0],
+                    sigma_y: s.sigma[1],
+                    rho: s.rho,
+                    evaporation: s.evaporation,
+                    centre: Vec2::from(s.centre),
+                    start: s.start,
+                })
                 .collect(),
             time: 0.0,
         }),
     };
-    Ok(Pheromone { name: p.name.clone(), colour: p.colour, model })
+    Ok(Pheromone {
+        name: p.name.clone(),
+        colour: p.colour,
+        model,
+    })
 }
 
 fn build_map(scenario: &Scenario, _key: &str, map: &MapSpec, grid: &GridSpec) -> Result<Vec<f32>> {
@@ -150,7 +210,9 @@ fn build_map(scenario: &Scenario, _key: &str, map: &MapSpec, grid: &GridSpec) ->
         let pts: Vec<Vec2> = points.iter().map(|p| Vec2::from(*p)).collect();
         return Ok(polyline_map(grid, &pts, map.width.unwrap_or(0.0), map.rate));
     }
-    let path = scenario.base_dir.join(map.image.as_deref().unwrap_or_default());
+    let path = scenario
+        .base_dir
+        .join(map.image.as_deref().unwrap_or_default());
     let channel = match map.channel.as_deref() {
         Some("r") => Some(0),
         Some("g") => Some(1),

@@ -21,7 +21,9 @@ impl World {
                 let dep = &self.deposits[d];
                 (dep.robot, dep.pheromone, dep.kernel, dep.rate)
             };
-            let Some(to) = self.injection_point(robot) else { continue };
+            let Some(to) = self.injection_point(robot) else {
+                continue;
+            };
             let from = self.last_injection[robot].unwrap_or(to);
             if let FieldModel::Grid(grid) = &mut self.pheromones[pheromone].model {
                 grid.deposit_segment(&kernel, from, to, rate * dt);
@@ -32,18 +34,24 @@ impl World {
                 self.last_injection[i] = Some(p);
             }
         }
-        let time = self.time;
         for e in 0..self.emitters.len() {
-            let Some(pos) = self.injection_point(self.emitters[e].robot) else { continue };
+            let Some(pos) = self.injection_point(self.emitters[e].robot) else {
+                continue;
+            };
             let refresh = match &self.emitters[e].near {
                 None => true,
-                Some((targets, distance)) => targets.iter().any(|&t| self.injection_point(t).is_some_and(|q| q.distance(pos) <= *distance)),
+                Some((targets, distance)) => targets.iter().any(|&t| {
+                    self.injection_point(t)
+                        .is_some_and(|q| q.distance(pos) <= *distance)
+                }),
             };
             if refresh {
                 let (pheromone, source) = (self.emitters[e].pheromone, self.emitters[e].source);
                 if let FieldModel::Gaussian(g) = &mut self.pheromones[pheromone].model {
                     g.sources[source].centre = pos;
-                    g.sources[source].start = time;
+                    // The field's own clock, not the world's: the two are summed differently in f32,
+                    // and a start a hair in the future would read as "not yet emitted".
+                    g.sources[source].start = g.time;
                 }
             }
         }

@@ -1,8 +1,8 @@
 //! One step of a world: behaviours -> drive -> physics -> tracker -> fields and injection -> sensors.
 use super::World;
 use crate::behaviour::{Observation, WheelCommand};
-use crate::sensors::sensor_positions;
 use crate::sensors::SENSOR_RADIUS;
+use crate::sensors::sensor_positions;
 use rayon::prelude::*;
 
 /// Below this many robots a world steps its robots on one thread: rayon's overhead would dominate,
@@ -14,13 +14,22 @@ impl World {
     pub fn step(&mut self) {
         let mut commands = std::mem::take(&mut self.command_buffer);
         commands.resize(self.robots.len(), WheelCommand::STOP);
-        let decide = |((slot, obs), cmd): ((&mut super::RobotSlot, &Observation), &mut WheelCommand)| {
-            *cmd = slot.behaviour.act(obs, &mut slot.rng);
-        };
+        let decide =
+            |((slot, obs), cmd): ((&mut super::RobotSlot, &Observation), &mut WheelCommand)| {
+                *cmd = slot.behaviour.act(obs, &mut slot.rng);
+            };
         if self.robots.len() >= PARALLEL_ROBOTS {
-            self.robots.par_iter_mut().zip(self.observations.par_iter()).zip(commands.par_iter_mut()).for_each(decide);
+            self.robots
+                .par_iter_mut()
+                .zip(self.observations.par_iter())
+                .zip(commands.par_iter_mut())
+                .for_each(decide);
         } else {
-            self.robots.iter_mut().zip(self.observations.iter()).zip(commands.iter_mut()).for_each(decide);
+            self.robots
+                .iter_mut()
+                .zip(self.observations.iter())
+                .zip(commands.iter_mut())
+                .for_each(decide);
         }
         self.step_with_commands(&commands);
         self.command_buffer = commands;
@@ -33,19 +42,30 @@ impl World {
     /// If `commands.len()` differs from the number of robots (a programming error: the environment
     /// layers check the shape of user input before it gets here).
     pub fn step_with_commands(&mut self, commands: &[WheelCommand]) {
-        assert_eq!(commands.len(), self.robots.len(), "one wheel command per robot");
+        assert_eq!(
+            commands.len(),
+            self.robots.len(),
+            "one wheel command per robot"
+        );
         let dt = self.dt;
         self.velocities.clear();
         for (slot, cmd) in self.robots.iter_mut().zip(commands) {
-            let cmd = if cmd.left.is_finite() && cmd.right.is_finite() { *cmd } else { WheelCommand::STOP };
+            let cmd = if cmd.left.is_finite() && cmd.right.is_finite() {
+                *cmd
+            } else {
+                WheelCommand::STOP
+            };
             slot.command = cmd;
             slot.drive.update(cmd, &self.robot_params, dt);
-            self.velocities.push(slot.drive.body_velocity(&self.robot_params));
+            self.velocities
+                .push(slot.drive.body_velocity(&self.robot_params));
         }
         self.physics.step(&self.velocities, dt);
         self.tick += 1;
         self.time = self.tick as f32 * dt;
-        let tracked = self.tracker.update(self.time, self.physics.poses(), &mut self.tracker_rng);
+        let tracked = self
+            .tracker
+            .update(self.time, self.physics.poses(), &mut self.tracker_rng);
         self.tracked.copy_from_slice(tracked);
         match self.field_backend.as_mut() {
             Some(backend) => backend.step(&mut self.pheromones, dt),
@@ -62,11 +82,28 @@ impl World {
         self.positions.clear();
         self.positions.extend(poses.iter().map(|p| p.pos));
         self.neighbours.rebuild(self.arena, cell, &self.positions);
-        let (pheromones, screen, sensor, neighbours) = (&self.pheromones, &self.screen, &self.sensor, &self.neighbours);
-        let (radius, arena, bumper, time) = (self.robot_params.radius, self.arena, &self.bumper_params, self.time);
+        let (pheromones, screen, sensor, neighbours) = (
+            &self.pheromones,
+            &self.screen,
+            &self.sensor,
+            &self.neighbours,
+        );
+        let (radius, arena, bumper, time) = (
+            self.robot_params.radius,
+            self.arena,
+            &self.bumper_params,
+            self.time,
+        );
         let sense = |(i, (slot, obs)): (usize, (&mut super::RobotSlot, &mut Observation))| {
-            let mut o = Observation { time, last_command: slot.command, ..Observation::default() };
-            for (n, p) in sensor_positions(&poses[i], SENSOR_RADIUS).into_iter().enumerate() {
+            let mut o = Observation {
+                time,
+                last_command: slot.command,
+                ..Observation::default()
+            };
+            for (n, p) in sensor_positions(&poses[i], SENSOR_RADIUS)
+                .into_iter()
+                .enumerate()
+            {
                 let levels = sensor.screen_levels(pheromones, screen, p);
                 o.counts[n] = sensor.counts(levels, &mut slot.rng);
                 o.intensity[n] = sensor.intensity(o.counts[n]);
@@ -75,9 +112,17 @@ impl World {
             *obs = o;
         };
         if self.robots.len() >= PARALLEL_ROBOTS {
-            self.robots.par_iter_mut().zip(self.observations.par_iter_mut()).enumerate().for_each(sense);
+            self.robots
+                .par_iter_mut()
+                .zip(self.observations.par_iter_mut())
+                .enumerate()
+                .for_each(sense);
         } else {
-            self.robots.iter_mut().zip(self.observations.iter_mut()).enumerate().for_each(sense);
+            self.robots
+                .iter_mut()
+                .zip(self.observations.iter_mut())
+                .enumerate()
+                .for_each(sense);
         }
     }
 }

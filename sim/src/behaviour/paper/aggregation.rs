@@ -12,7 +12,7 @@
 //!
 //! Directions come from eq. (6) ([`Observation::gradient_direction`]); see the parent module for the
 //! sign of eq. (8).
-use super::{check, eq8, wrap_angle, GREEN, RED};
+use super::{GREEN, RED, check, eq8, wrap_angle};
 use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
 use crate::error::Result;
 use crate::rng::SimRng;
@@ -34,7 +34,12 @@ pub struct LeaderParams {
 
 impl Default for LeaderParams {
     fn default() -> Self {
-        LeaderParams { speed: 0.1, wander_speed: 0.03, sensitivity: 0.03, alarm_threshold: 0.05 }
+        LeaderParams {
+            speed: 0.1,
+            wander_speed: 0.03,
+            sensitivity: 0.03,
+            alarm_threshold: 0.05,
+        }
     }
 }
 
@@ -56,7 +61,13 @@ pub struct FollowerParams {
 
 impl Default for FollowerParams {
     fn default() -> Self {
-        FollowerParams { speed: 0.08, wander_speed: 0.05, sensitivity: 0.03, alarm_threshold: 0.05, attract_threshold: 0.01 }
+        FollowerParams {
+            speed: 0.08,
+            wander_speed: 0.05,
+            sensitivity: 0.03,
+            alarm_threshold: 0.05,
+            attract_threshold: 0.01,
+        }
     }
 }
 
@@ -109,9 +120,13 @@ impl FollowerParams {
 pub enum AggregationDecision {
     Avoid,
     /// ALP sensed: steer toward `direction` (egocentric rad), straight down the ALP gradient.
-    Flee { direction: f32 },
+    Flee {
+        direction: f32,
+    },
     /// AGP sensed (followers only): steer toward `direction`, up the AGP gradient.
-    Approach { direction: f32 },
+    Approach {
+        direction: f32,
+    },
     Wander,
 }
 
@@ -123,7 +138,10 @@ struct Core {
 
 impl Core {
     fn new(params: AggregationParams) -> Self {
-        Core { params, avoid: Avoid::new(Wander::new(params.wander_speed)) }
+        Core {
+            params,
+            avoid: Avoid::new(Wander::new(params.wander_speed)),
+        }
     }
 
     fn decide(&self, obs: &Observation) -> AggregationDecision {
@@ -132,18 +150,28 @@ impl Core {
         }
         if obs.strength(RED) > self.params.alarm_threshold {
             let theta_r = obs.gradient_direction(RED);
-            return AggregationDecision::Flee { direction: wrap_angle(theta_r + std::f32::consts::PI) };
+            return AggregationDecision::Flee {
+                direction: wrap_angle(theta_r + std::f32::consts::PI),
+            };
         }
         if obs.strength(GREEN) > self.params.attract_threshold {
-            return AggregationDecision::Approach { direction: obs.gradient_direction(GREEN) };
+            return AggregationDecision::Approach {
+                direction: obs.gradient_direction(GREEN),
+            };
         }
         AggregationDecision::Wander
     }
 
-    fn command(&mut self, decision: AggregationDecision, obs: &Observation, rng: &mut SimRng) -> WheelCommand {
+    fn command(
+        &mut self,
+        decision: AggregationDecision,
+        obs: &Observation,
+        rng: &mut SimRng,
+    ) -> WheelCommand {
         match decision {
             AggregationDecision::Avoid | AggregationDecision::Wander => self.avoid.act(obs, rng),
-            AggregationDecision::Flee { direction } | AggregationDecision::Approach { direction } => {
+            AggregationDecision::Flee { direction }
+            | AggregationDecision::Approach { direction } => {
                 eq8(direction, self.params.sensitivity, self.params.speed)
             }
         }
@@ -157,7 +185,12 @@ pub struct Leader {
 
 impl Leader {
     pub fn new(params: AggregationParams) -> Self {
-        Leader { core: Core::new(AggregationParams { attract_threshold: f32::INFINITY, ..params }) }
+        Leader {
+            core: Core::new(AggregationParams {
+                attract_threshold: f32::INFINITY,
+                ..params
+            }),
+        }
     }
     /// Which branch of Algorithm 2 applies to `obs`.
     pub fn decide(&self, obs: &Observation) -> AggregationDecision {
@@ -182,7 +215,9 @@ pub struct Follower {
 
 impl Follower {
     pub fn new(params: AggregationParams) -> Self {
-        Follower { core: Core::new(params) }
+        Follower {
+            core: Core::new(params),
+        }
     }
     /// Which branch of Algorithm 3 applies to `obs`.
     pub fn decide(&self, obs: &Observation) -> AggregationDecision {

@@ -9,7 +9,7 @@
 //! 2. wanders (correlated random walk) when no sensor sees the LAP;
 //! 3. at a bifurcation, picks a branch (below) and keeps to it for `commit_time` seconds;
 //! 4. otherwise follows the cyan trail (eq. 7 on the green channel) when any sensor sees cyan, else the
-//!    blue trail (eq. 7 on the blue channel).
+//!    blue trail (eq. 7 on the blue channel), with a damping term (`damping`, see [`ForagingParams`]).
 //!
 //! ## What a sensor sees
 //!
@@ -35,7 +35,10 @@
 //! * `Plain`: both sides the same colour (every bifurcation with the LAP alone): a fair coin. Algorithm 1
 //!   only says "follow the LAP" there; with one trail colour a coin is the unbiased reading.
 //!
-//! After the decision the robot commits to the chosen branch for `commit_time` seconds: first it turns
+//! After the decision the robot commits to the chosen branch for `commit_time` seconds. Keeping to the
+//! cyan trail at a cyan/blue or magenta bifurcation needs nothing more (following the green channel
+//! already keeps the robot on the cyan branch, the blue one being invisible in green). Any other choice
+//! (the blue branch, or either branch of a plain bifurcation) is made in two steps: first it turns
 //! toward the chosen side on an arc, at `turn_rate` rad/s and `commit_speed` times the base speed, for
 //! as long as it takes to turn by `turn_angle` degrees (the fork's half-angle: this points it along the
 //! chosen branch; a robot knows its own wheel commands, nothing more is needed), then it follows the
@@ -44,7 +47,7 @@
 //! trail's signal (cyan: green; blue-only: `blue - green`; LAP: blue). It goes straight while both see
 //! the trail, turns away from the chosen side when that sensor leaves the trail and toward it when the
 //! front sensor does. No new bifurcation is detected while committed.
-use super::{check, eq7, BLUE, GREEN, RED, SENSOR_FRONT, SENSOR_LEFT, SENSOR_RIGHT};
+use super::{BLUE, GREEN, RED, SENSOR_FRONT, SENSOR_LEFT, SENSOR_RIGHT, check, eq7};
 use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
 use crate::error::Result;
 use crate::rng::SimRng;
@@ -65,6 +68,11 @@ pub struct ForagingParams {
     pub cyan_probability: f32,
     /// How long the robot keeps to the branch it chose, s.
     pub commit_time: f32,
+    /// Damping time of the trail following, s: eq. (7) acts on `e + damping * de/dt` with
+    /// `e = Phi_l - Phi_r` (0: eq. 7 as printed). The left and right sensors sit on the wheel axis, so
+    /// eq. (7) alone steers on the lateral offset only and lets the robot swing across the trail; the
+    /// rate of change of `e` adds the missing damping.
+    pub damping: f32,
     /// Angle of the turn into the chosen branch, degrees.
     pub turn_angle: f32,
     /// Yaw rate of that turn, rad/s.
@@ -75,7 +83,17 @@ pub struct ForagingParams {
 
 impl Default for ForagingParams {
     fn default() -> Self {
-        ForagingParams { speed: 0.1, sensitivity: 0.03, threshold: 0.3, cyan_probability: 0.7, commit_time: 1.0, turn_angle: 35.0, turn_rate: 3.0, commit_speed: 0.5 }
+        ForagingParams {
+            speed: 0.1,
+            sensitivity: 0.03,
+            threshold: 0.3,
+            cyan_probability: 0.7,
+            commit_time: 1.0,
+            damping: 0.3,
+            turn_angle: 35.0,
+            turn_rate: 3.0,
+            commit_speed: 0.5,
+        }
     }
 }
 
@@ -86,11 +104,16 @@ impl ForagingParams {
         check(key, "sensitivity", self.sensitivity, 0.0)?;
         check(key, "threshold", self.threshold, 0.0)?;
         check(key, "commit_time", self.commit_time, 0.0)?;
+        check(key, "damping", self.damping, 0.0)?;
         check(key, "turn_angle", self.turn_angle, 0.0)?;
         check(key, "turn_rate", self.turn_rate, 1e-3)?;
         check(key, "commit_speed", self.commit_speed, 0.0)?;
         if !(0.0..=1.0).contains(&self.cyan_probability) {
-            return Err(crate::error::SimError::invalid(format!("{key}.params.cyan_probability"), self.cyan_probability, "must be a probability in [0, 1]"));
+            return Err(crate::error::SimError::invalid(
+                format!("{key}.params.cyan_probability"),
+                self.cyan_probability,
+                "must be a probability in [0, 1]",
+            ));
         }
         Ok(())
     }
@@ -112,7 +135,7 @@ pub enum TrailClass {
 impl TrailClass {
     /// Class of one sensor's `[r, g, b]` intensities.
     pub fn of(rgb: [f32; 3], threshold: f32) -> Self {
-        if !(rgb[BLUE] > threshold) {
+        if rgb[BLUE].is_nan() || rgb[BLUE] <= threshold {
             TrailClass::Off
         } else if rgb[RED] > threshold {
             TrailClass::Magenta
@@ -184,7 +207,11 @@ pub enum ForagingDecision {
     /// On the cyan trail: eq. (7) on green.
     FollowCyan,
     /// A bifurcation was detected now and `side` chosen.
-    Bifurcation { kind: BifurcationKind, side: Side, trail: Trail },
+    Bifurcation {
+        kind: BifurcationKind,
+        side: Side,
+        trail: Trail,
+    },
     /// Turning into the branch chosen at a recent bifurcation.
     TurnInto { side: Side, trail: Trail },
     /// Following the branch chosen at a recent bifurcation (no new bifurcation is detected).
@@ -207,6 +234,8 @@ pub struct Foraging {
     pub wheel_base: f32,
     avoid: Avoid<Wander>,
     commit: Option<Commit>,
+    /// (time, e) of the previous trail-following step, for the damping term.
+    last_error: Option<(f32, f32)>,
 }
 
 /// The bifurcation seen by the sensors, if any (see the module documentation).
@@ -230,7 +259,13 @@ pub fn detect_bifurcation(obs: &Observation, threshold: f32) -> Option<Bifurcati
 impl Foraging {
     pub fn new(params: ForagingParams) -> Self {
         let avoid = Avoid::new(Wander::new(params.speed));
-        Foraging { params, wheel_base: crate::robot::ColiasParams::default().wheel_base, avoid, commit: None }
+        Foraging {
+            params,
+            wheel_base: crate::robot::ColiasParams::default().wheel_base,
+            avoid,
+            commit: None,
+            last_error: None,
+        }
     }
 
     /// True while the robot keeps to a chosen branch at `time`.
@@ -239,14 +274,29 @@ impl Foraging {
     }
 
     fn coin(rng: &mut SimRng) -> Side {
-        if rng.random::<f32>() < 0.5 { Side::Left } else { Side::Right }
+        if rng.random::<f32>() < 0.5 {
+            Side::Left
+        } else {
+            Side::Right
+        }
     }
 
     /// The branch to take at a bifurcation of `kind`, and the trail to steer on.
-    pub fn choose(&self, kind: BifurcationKind, obs: &Observation, rng: &mut SimRng) -> (Side, Trail) {
+    pub fn choose(
+        &self,
+        kind: BifurcationKind,
+        obs: &Observation,
+        rng: &mut SimRng,
+    ) -> (Side, Trail) {
         let th = self.params.threshold;
         let (l, r) = (obs.intensity[SENSOR_LEFT], obs.intensity[SENSOR_RIGHT]);
-        let trail_of = |rgb: [f32; 3]| if TrailClass::of(rgb, th) == TrailClass::Cyan { Trail::Cyan } else { Trail::Lap };
+        let trail_of = |rgb: [f32; 3]| {
+            if TrailClass::of(rgb, th) == TrailClass::Cyan {
+                Trail::Cyan
+            } else {
+                Trail::Lap
+            }
+        };
         match kind {
             BifurcationKind::Magenta => {
                 let score = |rgb: [f32; 3]| rgb[GREEN] - rgb[RED];
@@ -258,11 +308,19 @@ impl Foraging {
                 (side, trail_of(if side == Side::Left { l } else { r }))
             }
             BifurcationKind::CyanBlue => {
-                let cyan_side = if TrailClass::of(l, th) == TrailClass::Cyan { Side::Left } else { Side::Right };
+                let cyan_side = if TrailClass::of(l, th) == TrailClass::Cyan {
+                    Side::Left
+                } else {
+                    Side::Right
+                };
                 if rng.random::<f32>() < self.params.cyan_probability {
                     (cyan_side, Trail::Cyan)
                 } else {
-                    let blue_side = if cyan_side == Side::Left { Side::Right } else { Side::Left };
+                    let blue_side = if cyan_side == Side::Left {
+                        Side::Right
+                    } else {
+                        Side::Left
+                    };
                     (blue_side, Trail::BlueOnly)
                 }
             }
@@ -286,38 +344,83 @@ impl Foraging {
         }
         if let Some(c) = self.commit {
             if obs.time < c.turn_until {
-                return ForagingDecision::TurnInto { side: c.side, trail: c.trail };
+                return ForagingDecision::TurnInto {
+                    side: c.side,
+                    trail: c.trail,
+                };
             }
             if obs.time < c.until {
-                return ForagingDecision::Committed { side: c.side, trail: c.trail };
+                return ForagingDecision::Committed {
+                    side: c.side,
+                    trail: c.trail,
+                };
             }
             self.commit = None;
         }
         if let Some(kind) = detect_bifurcation(obs, th) {
             let (side, trail) = self.choose(kind, obs, rng);
-            let turn = self.params.turn_angle.to_radians() / self.params.turn_rate;
-            self.commit = Some(Commit { turn_until: obs.time + turn, until: obs.time + turn.max(self.params.commit_time), side, trail });
+            // Staying on the cyan trail needs no turn: following the green channel already keeps the
+            // robot on the cyan branch. Any other choice turns into the chosen branch first.
+            let stays_cyan = trail == Trail::Cyan && kind != BifurcationKind::Plain;
+            let turn = if stays_cyan {
+                0.0
+            } else {
+                self.params.turn_angle.to_radians() / self.params.turn_rate
+            };
+            self.commit = Some(Commit {
+                turn_until: obs.time + turn,
+                until: obs.time + turn.max(self.params.commit_time),
+                side,
+                trail,
+            });
             return ForagingDecision::Bifurcation { kind, side, trail };
         }
-        if obs.intensity.iter().any(|&s| TrailClass::of(s, th) == TrailClass::Cyan) {
+        if obs
+            .intensity
+            .iter()
+            .any(|&s| TrailClass::of(s, th) == TrailClass::Cyan)
+        {
             ForagingDecision::FollowCyan
         } else {
             ForagingDecision::FollowLap
         }
     }
 
-    /// Eq. (7) on `trail`.
+    /// Eq. (7) on `trail` (without the damping term: see [`Foraging::follow`]).
     pub fn steer(&self, obs: &Observation, trail: Trail) -> WheelCommand {
         let p = &self.params;
-        let (l, r) = (trail.signal(obs.intensity[SENSOR_LEFT]), trail.signal(obs.intensity[SENSOR_RIGHT]));
+        let (l, r) = (
+            trail.signal(obs.intensity[SENSOR_LEFT]),
+            trail.signal(obs.intensity[SENSOR_RIGHT]),
+        );
         eq7(l, r, p.sensitivity, p.speed)
+    }
+
+    /// Eq. (7) on `trail` with the damping term: `e + damping * de/dt` in place of `Phi_l - Phi_r`.
+    pub fn follow(&mut self, obs: &Observation, trail: Trail) -> WheelCommand {
+        let p = &self.params;
+        let e =
+            trail.signal(obs.intensity[SENSOR_LEFT]) - trail.signal(obs.intensity[SENSOR_RIGHT]);
+        let rate = match self.last_error {
+            Some((t, e0)) if obs.time > t && obs.time - t < 0.2 => (e - e0) / (obs.time - t),
+            _ => 0.0,
+        };
+        self.last_error = Some((obs.time, e));
+        eq7(e + p.damping * rate, 0.0, p.sensitivity, p.speed)
     }
 
     /// Eq. (7) between the sensor on `side` and the front sensor (see the module documentation).
     pub fn steer_committed(&self, obs: &Observation, trail: Trail, side: Side) -> WheelCommand {
         let p = &self.params;
-        let n = if side == Side::Left { SENSOR_LEFT } else { SENSOR_RIGHT };
-        let (outer, front) = (trail.signal(obs.intensity[n]), trail.signal(obs.intensity[SENSOR_FRONT]));
+        let n = if side == Side::Left {
+            SENSOR_LEFT
+        } else {
+            SENSOR_RIGHT
+        };
+        let (outer, front) = (
+            trail.signal(obs.intensity[n]),
+            trail.signal(obs.intensity[SENSOR_FRONT]),
+        );
         match side {
             Side::Left => eq7(outer, front, p.sensitivity, p.speed),
             Side::Right => eq7(front, outer, p.sensitivity, p.speed),
@@ -341,9 +444,10 @@ impl Behaviour for Foraging {
         match self.decide(obs, rng) {
             // The avoid wrapper pivots on a bumper hit and wanders otherwise.
             ForagingDecision::Avoid | ForagingDecision::Wander => self.avoid.act(obs, rng),
-            ForagingDecision::FollowLap => self.steer(obs, Trail::Lap),
-            ForagingDecision::FollowCyan => self.steer(obs, Trail::Cyan),
-            ForagingDecision::Bifurcation { side, .. } | ForagingDecision::TurnInto { side, .. } => self.turn_into(side, self.wheel_base),
+            ForagingDecision::FollowLap => self.follow(obs, Trail::Lap),
+            ForagingDecision::FollowCyan => self.follow(obs, Trail::Cyan),
+            ForagingDecision::Bifurcation { side, .. }
+            | ForagingDecision::TurnInto { side, .. } => self.turn_into(side, self.wheel_base),
             ForagingDecision::Committed { trail, side } => self.steer_committed(obs, trail, side),
         }
     }

@@ -21,8 +21,13 @@
 pub mod aggregation;
 pub mod foraging;
 
-pub use aggregation::{AggregationDecision, AggregationParams, Follower, FollowerParams, Leader, LeaderParams};
-pub use foraging::{detect_bifurcation, BifurcationKind, Foraging, ForagingDecision, ForagingParams, Side, Trail, TrailClass};
+pub use aggregation::{
+    AggregationDecision, AggregationParams, Follower, FollowerParams, Leader, LeaderParams,
+};
+pub use foraging::{
+    BifurcationKind, Foraging, ForagingDecision, ForagingParams, Side, Trail, TrailClass,
+    detect_bifurcation,
+};
 
 use super::WheelCommand;
 
@@ -74,6 +79,10 @@ pub(crate) fn check(key: &str, name: &str, value: f32, min: f32) -> crate::error
     if value.is_finite() && value >= min {
         Ok(())
     } else {
-        Err(crate::error::SimError::invalid(format!("{key}.params.{name}"), value, format!("must be a finite number >= {min}")))
+        Err(crate::error::SimError::invalid(
+            format!("{key}.params.{name}"),
+            value,
+            format!("must be a finite number >= {min}"),
+        ))
     }
 }
