@@ -477,7 +477,10 @@ impl App {
             // The monitor's size and position too: without a window manager (a bare X server, a kiosk)
             // the fullscreen hint alone does not resize the window.
             if let Some(m) = &monitor {
-                attrs = attrs.with_inner_size(m.size()).with_position(m.position()).with_decorations(false);
+                attrs = attrs
+                    .with_inner_size(m.size())
+                    .with_position(m.position())
+                    .with_decorations(false);
             }
             attrs = attrs.with_fullscreen(Some(Fullscreen::Borderless(monitor)));
         } else {
@@ -614,12 +617,12 @@ impl ApplicationHandler for App {
     fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         match event {
             WindowEvent::CloseRequested => el.exit(),
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                if matches!(event.logical_key, Key::Named(NamedKey::Escape))
-                    || event.logical_key == Key::Character("q".into())
-                {
-                    el.exit();
-                }
+            WindowEvent::KeyboardInput { event, .. }
+                if event.state == ElementState::Pressed
+                    && (matches!(event.logical_key, Key::Named(NamedKey::Escape))
+                        || event.logical_key == Key::Character("q".into())) =>
+            {
+                el.exit();
             }
             WindowEvent::Resized(size) => {
                 if let Some(st) = self.state.as_mut() {
@@ -640,11 +643,11 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, el: &ActiveEventLoop) {
-        if let Some(limit) = self.opts.close_after {
-            if self.started.elapsed() >= limit {
-                el.exit();
-                return;
-            }
+        if let Some(limit) = self.opts.close_after
+            && self.started.elapsed() >= limit
+        {
+            el.exit();
+            return;
         }
         if let Some(st) = &self.state {
             st.window.request_redraw();

@@ -108,7 +108,11 @@ fn check(name: &str, img: image::RgbaImage, extra: &[&str], whole_screen: bool) 
         return skip(&format!("the window could not be shown: {e}"));
     }
     let shot = image::open(&shot_path).unwrap().to_rgb8();
-    let (w, h) = if whole_screen { shot.dimensions() } else { img.dimensions() };
+    let (w, h) = if whole_screen {
+        shot.dimensions()
+    } else {
+        img.dimensions()
+    };
     let headless = match render_headless(&img, (w, h)) {
         Ok(i) => i,
         Err(DisplayError::NoAdapter(e)) => return skip(&format!("no GPU adapter: {e}")),
@@ -154,5 +158,10 @@ fn windowed_screenshot_matches_headless_png() {
 /// screen must equal the headless rendering at the screen's size.
 #[test]
 fn fullscreen_screenshot_matches_headless_png() {
-    check("fullscreen", pattern(320, 180), &["--fullscreen", "--monitor", "0"], true);
+    check(
+        "fullscreen",
+        pattern(320, 180),
+        &["--fullscreen", "--monitor", "0"],
+        true,
+    );
 }

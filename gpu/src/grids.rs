@@ -79,10 +79,6 @@ impl Kind {
     fn flips(self) -> bool {
         self != Kind::Evaporate
     }
-    /// Per cell (256 per workgroup), or per row/column (64 per workgroup).
-    fn per_line(self) -> bool {
-        matches!(self, Kind::XSolve | Kind::YSolve)
-    }
 }
 
 /// One trail deposit: `amount * kernel(distance to segment a-b)` added to every cell near the segment
@@ -208,6 +204,9 @@ impl GpuGrids {
             "field values (2 slots x fields x cells x 4 bytes)",
             bytes,
         )?;
+        if params.len() > MAX_GROUPS as usize {
+            return Err(GpuError::Invalid(format!("{} fields in one batch; at most {MAX_GROUPS}", params.len())));
+        }
         if spec.nx == 0 || spec.ny == 0 {
             return Err(GpuError::Invalid("empty grid".into()));
         }
@@ -595,7 +594,6 @@ impl GpuGrids {
                     Kind::AdvectX => &self.pipes.advect_x,
                     Kind::AdvectY => &self.pipes.advect_y,
                 };
-                let _ = kind.per_line();
                 pass.set_pipeline(pipe);
                 pass.set_bind_group(0, &bind, &[(p as u64 * UNIFORM_STRIDE) as u32]);
                 let (gx, gy) = shapes[p];
@@ -608,7 +606,7 @@ impl GpuGrids {
     /// Advances every field by `dt` seconds: exact evaporation and static injection, diffusion by the
     /// field's scheme, then wind; the same passes, in the same order, as [`GridField::step`].
     pub fn step(&mut self, dt: f32) -> Result<()> {
-        if !(dt > 0.0) || self.fields.is_empty() {
+        if dt.is_nan() || dt <= 0.0 || self.fields.is_empty() {
             return Ok(());
         }
         let GridSpec { nx, ny, cell } = self.spec;
@@ -884,7 +882,7 @@ impl GpuGrids {
                 )));
             }
             let support = d.kernel.support();
-            if !(support >= 0.0) || !d.a.is_finite() || !d.b.is_finite() {
+            if support.is_nan() || support < 0.0 || !d.a.is_finite() || !d.b.is_finite() {
                 continue;
             }
             let (a, b) = (d.a, d.b);
@@ -926,6 +924,9 @@ impl GpuGrids {
         }
         if rounds.is_empty() {
             return Ok(());
+        }
+        if rounds.iter().any(|r| r.len() > MAX_GROUPS as usize) {
+            return Err(GpuError::Invalid(format!("more than {MAX_GROUPS} fields with a deposit in one call: split the call")));
         }
         let recs: Vec<DepRecord> = rounds.iter().flatten().copied().collect();
         self.ensure(2, (recs.len() * std::mem::size_of::<DepRecord>()) as u64);
@@ -973,18 +974,7 @@ impl GpuGrids {
             pass.set_pipeline(&self.pipes.deposit);
             for (k, &(gx, gy, count)) in shapes.iter().enumerate() {
                 pass.set_bind_group(0, &bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);
-                // The z dimension is limited too: split very large rounds.
-                let mut done = 0;
-                while done < count {
-                    let z = (count - done).min(MAX_GROUPS);
-                    if done > 0 {
-                        // Rounds larger than 65,535 deposits need their own uniform: rare; handled by
-                        // the caller splitting the batch.
-                        break;
-                    }
-                    pass.dispatch_workgroups(gx, gy, z);
-                    done += z;
-                }
+                pass.dispatch_workgroups(gx, gy, count);
             }
         }
         self.ctx.queue.submit([enc.finish()]);

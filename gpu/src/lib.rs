@@ -178,7 +178,9 @@ impl GpuContext {
 
     /// The largest storage buffer binding, bytes.
     pub fn max_binding(&self) -> u64 {
-        (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size)
+        self.limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size)
     }
 
     /// Copies `bytes` bytes of `src` from `offset` into CPU memory (blocking).

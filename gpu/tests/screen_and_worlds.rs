@@ -262,12 +262,12 @@ fn backend_choice_cpu_and_auto() {
     // `auto` never fails: a hardware adapter or the CPU (lavapipe counts as software).
     let sel = colcos_gpu::install(&mut w, BackendChoice::Auto).unwrap();
     eprintln!("auto chose {sel}");
-    if let Some(c) = ctx() {
-        if c.is_software() {
-            assert!(
-                matches!(sel, colcos_gpu::BackendSelection::Cpu { .. }),
-                "auto took a software adapter"
-            );
-        }
+    if let Some(c) = ctx()
+        && c.is_software()
+    {
+        assert!(
+            matches!(sel, colcos_gpu::BackendSelection::Cpu { .. }),
+            "auto took a software adapter"
+        );
     }
 }
