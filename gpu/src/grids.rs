@@ -205,7 +205,10 @@ impl GpuGrids {
             bytes,
         )?;
         if params.len() > MAX_GROUPS as usize {
-            return Err(GpuError::Invalid(format!("{} fields in one batch; at most {MAX_GROUPS}", params.len())));
+            return Err(GpuError::Invalid(format!(
+                "{} fields in one batch; at most {MAX_GROUPS}",
+                params.len()
+            )));
         }
         if spec.nx == 0 || spec.ny == 0 {
             return Err(GpuError::Invalid("empty grid".into()));
@@ -926,7 +929,9 @@ impl GpuGrids {
             return Ok(());
         }
         if rounds.iter().any(|r| r.len() > MAX_GROUPS as usize) {
-            return Err(GpuError::Invalid(format!("more than {MAX_GROUPS} fields with a deposit in one call: split the call")));
+            return Err(GpuError::Invalid(format!(
+                "more than {MAX_GROUPS} fields with a deposit in one call: split the call"
+            )));
         }
         let recs: Vec<DepRecord> = rounds.iter().flatten().copied().collect();
         self.ensure(2, (recs.len() * std::mem::size_of::<DepRecord>()) as u64);
