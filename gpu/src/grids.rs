@@ -134,28 +134,9 @@ pub struct GpuGrids {
     bind: Option<wgpu::BindGroup>,
 }
 
-/// Precomputed Thomas coefficients (m, cp) for `(1 + 2r) u_i - r u_{i-1} - r u_{i+1} = f_i` with no-flux
-/// ends: the same f64 computation as the CPU backend, rounded to f32.
+/// Precomputed Thomas coefficients (m, cp): exactly the CPU backend's.
 fn thomas(n: usize, r: f32) -> (Vec<f32>, Vec<f32>) {
-    let rr = r as f64;
-    let mut m = vec![0f32; n];
-    let mut cp = vec![0f32; n];
-    let mut prev_cp = 0f64;
-    for i in 0..n {
-        let diag = if n == 1 {
-            1.0
-        } else if i == 0 || i == n - 1 {
-            1.0 + rr
-        } else {
-            1.0 + 2.0 * rr
-        };
-        let mi = 1.0 / (diag - rr * prev_cp);
-        let cpi = if i + 1 < n { rr * mi } else { 0.0 };
-        m[i] = mi as f32;
-        cp[i] = cpi as f32;
-        prev_cp = cpi;
-    }
-    (m, cp)
+    colcos_sim::field::thomas_coefficients(n, r)
 }
 
 fn substeps(x: f32, max: f32) -> usize {

@@ -11,7 +11,9 @@ mod static_map;
 pub use backend::{BackendChoice, FieldBackend};
 pub use gaussian::{GaussianField, GaussianSource};
 pub(crate) use grid::lerp_index;
-pub use grid::{DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS};
+pub use grid::{
+    DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS, thomas_coefficients,
+};
 pub use kernel::Kernel;
 pub use pheromone::{FieldModel, Pheromone};
 pub use static_map::{image_map, polyline_map};
