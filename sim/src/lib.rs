@@ -13,6 +13,7 @@ pub mod error;
 pub mod field;
 pub mod metrics;
 pub mod output;
+mod prefetch;
 pub mod rng;
 pub mod robot;
 pub mod scenario;

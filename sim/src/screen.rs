@@ -1,6 +1,6 @@
 //! The screen, eq. (1): I(x, y, c) = clip(sum_j k_j Phi_j(x, y)) as 8-bit RGB at the panel's resolution.
 use crate::error::{Result, SimError};
-use crate::field::{FieldModel, Pheromone};
+use crate::field::{BLOCK, Bilinear, FieldModel, GridSpec, Pheromone, bilinear_mix};
 use glam::Vec2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -37,13 +37,21 @@ impl ScreenSpec {
     /// Centre of the pixel that shows point `p` (the screen is pixelated: a sensor sees pixels).
     /// Points outside the panel map to the nearest edge pixel.
     pub fn pixel_centre(&self, p: Vec2) -> Vec2 {
-        let ps = self.pixel_size();
+        self.pixel_centre_with(self.pixel_size(), p)
+    }
+
+    /// [`ScreenSpec::pixel_centre`] with the pixel size computed once by the caller.
+    #[inline]
+    pub fn pixel_centre_with(&self, ps: Vec2, p: Vec2) -> Vec2 {
         let k = |v: f32, size: f32, n: u32| -> f32 {
             let n = n.max(1);
-            let idx = if v.is_nan() {
-                0.0
+            // Truncation is floor for v >= 0, and negative (or NaN) v clamps to pixel 0 anyway; this
+            // avoids a libm `floorf` call per sample on baseline x86-64.
+            let f = v / size;
+            let idx = if f > 0.0 {
+                (f as u32).min(n - 1) as f32
             } else {
-                (v / size).floor().clamp(0.0, (n - 1) as f32)
+                0.0
             };
             (idx + 0.5) * size
         };
@@ -57,21 +65,112 @@ impl ScreenSpec {
 /// Eq. (1) for one channel: `clip(round(level), 0, 255)` (NaN gives 0).
 #[inline]
 pub fn to_level(level: f32) -> u8 {
-    // `as u8` saturates at 0 and 255 and maps NaN to 0.
-    level.round() as u8
+    // round-half-away-from-zero without a libm call: for level >= 0, truncate and look at the fraction
+    // (exact: both the truncation and the subtraction are exact in f32). NaN and negative levels clip
+    // to 0.
+    if level >= 255.0 {
+        255
+    } else if level > 0.0 {
+        let t = level as u8;
+        // Branch-free: the fraction is as good as random, a branch on it would mispredict half the time.
+        t + u8::from(level - t as f32 >= 0.5)
+    } else {
+        0
+    }
 }
 
 /// Eq. (1) at the pixel that shows `p`: 8-bit (r, g, b).
 pub fn pixel_at(pheromones: &[Pheromone], screen: &ScreenSpec, p: Vec2) -> [u8; 3] {
-    let c = screen.pixel_centre(p);
-    let mut acc = [0f32; 3];
+    pixels_at(pheromones, screen, &[p])[0]
+}
+
+/// Eq. (1) at the pixels that show each of `points` (a sensor's footprint): the pixel centres and the
+/// grids' interpolation weights are computed once per point and shared by every field on the same
+/// grid, and each Gaussian source's time factors once per call. Same values as [`pixel_at`] per point.
+pub fn pixels_at<const N: usize>(
+    pheromones: &[Pheromone],
+    screen: &ScreenSpec,
+    points: &[Vec2; N],
+) -> [[u8; 3]; N] {
+    // Plain loops rather than `[T; N]::map`: the closures of `map` were not inlined in this hot path.
+    let mut centres = [Vec2::ZERO; N];
+    let pixel = screen.pixel_size();
+    for (c, &p) in centres.iter_mut().zip(points) {
+        *c = screen.pixel_centre_with(pixel, p);
+    }
+    let mut acc = [[0f32; 3]; N];
+    let mut weights_spec: Option<GridSpec> = None;
+    let mut weights = [Bilinear::default(); N];
+    let mut block = None;
+    let mut values = [0f32; N];
     for ph in pheromones {
-        let v = ph.value_at(c);
-        for (a, k) in acc.iter_mut().zip(ph.colour) {
-            *a += k * v;
+        match &ph.model {
+            FieldModel::Grid(g) => {
+                let spec = *g.spec();
+                if spec.is_empty() {
+                    continue;
+                }
+                if weights_spec != Some(spec) {
+                    for (w, &c) in weights.iter_mut().zip(&centres) {
+                        *w = Bilinear::at(&spec, c).unwrap_or_default();
+                    }
+                    block = CellBlock::around(&weights);
+                    weights_spec = Some(spec);
+                }
+                match &block {
+                    // A footprint is smaller than a cell or two: load the few cells it touches once
+                    // (independent loads, so their cache misses overlap), then interpolate from them.
+                    Some(b) => {
+                        let cells = g.block(b.i, b.j);
+                        for (v, w) in values.iter_mut().zip(&weights) {
+                            *v = b.interpolate(&cells, w);
+                        }
+                    }
+                    None => {
+                        for (v, w) in values.iter_mut().zip(&weights) {
+                            *v = g.bilinear(w);
+                        }
+                    }
+                }
+            }
+            FieldModel::Gaussian(g) => g.values_at(&centres, &mut values),
+        }
+        for (a, &v) in acc.iter_mut().zip(&values) {
+            a[0] += ph.colour[0] * v;
+            a[1] += ph.colour[1] * v;
+            a[2] += ph.colour[2] * v;
         }
     }
-    acc.map(to_level)
+    let mut out = [[0u8; 3]; N];
+    for (o, a) in out.iter_mut().zip(&acc) {
+        *o = [to_level(a[0]), to_level(a[1]), to_level(a[2])];
+    }
+    out
+}
+
+/// The 3 x 3 cells starting at cell `(i, j)` that hold every corner of a footprint's interpolations.
+struct CellBlock {
+    i: usize,
+    j: usize,
+}
+
+impl CellBlock {
+    /// The block around the corners of `weights`, or `None` when they span more than 3 x 3 cells (a
+    /// grid much finer than the footprint) or the grid is smaller than that.
+    fn around(weights: &[Bilinear]) -> Option<CellBlock> {
+        let i = weights.iter().map(|w| w.i0).min()?;
+        let j = weights.iter().map(|w| w.j0).min()?;
+        let fits = weights.iter().all(|w| w.i1 < i + BLOCK && w.j1 < j + BLOCK);
+        fits.then_some(CellBlock { i, j })
+    }
+
+    /// [`GridField::bilinear`] from the block's cells: the same values and arithmetic, bit for bit.
+    #[inline]
+    fn interpolate(&self, cells: &[[f32; BLOCK]; BLOCK], w: &Bilinear) -> f32 {
+        let (a, b) = (w.i0 - self.i, w.i1 - self.i);
+        let (r0, r1) = (&cells[w.j0 - self.j], &cells[w.j1 - self.j]);
+        bilinear_mix(r0[a], r0[b], r1[a], r1[b], w.tx, w.ty)
+    }
 }
 
 /// The whole screen image, eq. (1), rendered at `width x height` pixels (the panel's own resolution or

@@ -341,3 +341,83 @@ fn stepping_is_bit_identical_across_thread_counts() {
         }
     }
 }
+
+/// Eq. (1) at one point the slow, obvious way: every field's own `value_at` at the pixel centre and
+/// `f32::round` (the footprint path gathers cells in blocks and rounds without libm; it must agree
+/// bit for bit).
+fn reference_pixel(pheromones: &[Pheromone], screen: &ScreenSpec, p: Vec2) -> [u8; 3] {
+    let c = screen.pixel_centre(p);
+    let mut acc = [0f32; 3];
+    for ph in pheromones {
+        let v = ph.value_at(c);
+        for (a, k) in acc.iter_mut().zip(ph.colour) {
+            *a += k * v;
+        }
+    }
+    acc.map(|a| a.round() as u8)
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+    /// Footprints of nine samples (the sensor's pattern, and wider ones that overflow the 3 x 3 cell
+    /// block) on coarse and fine grids with a Gaussian field among them, anywhere on the screen and
+    /// past its edges, read the same levels as the per-point reference.
+    #[test]
+    fn footprint_pixels_match_per_point_reference(
+        cell in proptest::sample::select(vec![0.0004f32, 0.003, 0.01, 0.2]),
+        seed in 0u64..1_000,
+        centre in (-0.05f32..1.05, -0.05f32..0.65),
+        radius in proptest::sample::select(vec![0.0f32, 0.00105, 0.004, 0.03]),
+    ) {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand::rngs::SmallRng::seed_from_u64(seed);
+        let spec = GridSpec::covering(Vec2::new(1.0, 0.6), cell);
+        let mut ps: Vec<Pheromone> = [[255.0, 0.0, 0.0], [0.0, 255.0, 40.0], [10.0, 0.0, 255.0]]
+            .into_iter()
+            .map(|colour| {
+                let mut p = grid_pheromone(colour, spec);
+                if let FieldModel::Grid(g) = &mut p.model {
+                    g.values_mut().iter_mut().for_each(|v| *v = rng.random_range(0.0..1.2));
+                }
+                p
+            })
+            .collect();
+        ps.insert(1, Pheromone {
+            name: "g".into(),
+            colour: [60.0, 0.0, 90.0],
+            model: FieldModel::Gaussian(GaussianField {
+                sources: vec![GaussianSource {
+                    k: 0.05, sigma_x: 0.1, sigma_y: 0.2, rho: 0.3, evaporation: 9.0,
+                    centre: Vec2::new(0.4, 0.3), start: 0.0,
+                }],
+                time: 1.5,
+            }),
+        });
+        let screen = ScreenSpec { resolution: [2667, 1600], size: [1.0, 0.6] };
+        let c = Vec2::new(centre.0, centre.1);
+        let points: [Vec2; 9] = std::array::from_fn(|k| {
+            if k == 0 { c } else { c + radius * Vec2::from_angle(k as f32 * std::f32::consts::FRAC_PI_4) }
+        });
+        let got = colcos_sim::screen::pixels_at(&ps, &screen, &points);
+        for (p, g) in points.iter().zip(got) {
+            proptest::prop_assert_eq!(g, reference_pixel(&ps, &screen, *p), "at {}", p);
+        }
+    }
+}
+
+#[test]
+fn levels_round_half_away_from_zero_and_clip() {
+    use colcos_sim::screen::to_level;
+    for x in [
+        0.0f32, 0.49999997, 0.5, 1.5, 2.5, 254.49998, 254.5, 254.99, 255.0, 1e9, -0.4, -3.0,
+    ] {
+        assert_eq!(to_level(x), x.round().clamp(0.0, 255.0) as u8, "level {x}");
+    }
+    assert_eq!(to_level(f32::NAN), 0);
+    assert_eq!(to_level(f32::INFINITY), 255);
+    let mut x = 0.0f32;
+    while x < 256.0 {
+        assert_eq!(to_level(x), x.round().min(255.0) as u8, "level {x}");
+        x += 0.013;
+    }
+}

@@ -234,16 +234,64 @@ impl GridField {
 
     /// Bilinear value at `p` (m); clamped at the walls.
     pub fn value_at(&self, p: Vec2) -> f32 {
-        let GridSpec { nx, ny, cell } = self.spec;
-        if nx == 0 || ny == 0 {
-            return 0.0;
+        match Bilinear::at(&self.spec, p) {
+            Some(b) => self.bilinear(&b),
+            None => 0.0,
         }
-        let (i0, i1, tx) = lerp_index(p.x / cell - 0.5, nx);
-        let (j0, j1, ty) = lerp_index(p.y / cell - 0.5, ny);
+    }
+
+    /// The `BLOCK x BLOCK` cells starting at `(i, j)` (rows `j..`, columns `i..`), clamped to the grid:
+    /// rows or columns past the edge repeat the last one (never read by a caller whose corners lie
+    /// inside the grid).
+    #[inline]
+    pub fn block(&self, i: usize, j: usize) -> [[f32; BLOCK]; BLOCK] {
+        let GridSpec { nx, ny, .. } = self.spec;
+        let mut out = [[0f32; BLOCK]; BLOCK];
+        for (dj, row) in out.iter_mut().enumerate() {
+            let r = (j + dj).min(ny - 1) * nx;
+            for (di, v) in row.iter_mut().enumerate() {
+                *v = self.values[r + (i + di).min(nx - 1)];
+            }
+        }
+        out
+    }
+
+    /// Hints the processor to fetch the cells that interpolations within `radius` of `p` read, so that
+    /// their cache misses overlap with other work (sensing prefetches the next robot's cells). Only a
+    /// hint: no effect on results.
+    #[inline]
+    pub fn prefetch_around(&self, p: Vec2, radius: f32) {
+        let GridSpec { nx, ny, cell } = self.spec;
+        if nx == 0 || ny == 0 || !p.is_finite() {
+            return;
+        }
+        let index = |v: f32, n: usize| ((v / cell - 0.5).max(0.0) as usize).min(n - 1);
+        let (i0, i1) = (index(p.x - radius, nx), index(p.x + radius, nx) + 1);
+        let (j0, j1) = (
+            index(p.y - radius, ny),
+            (index(p.y + radius, ny) + 1).min(ny - 1),
+        );
+        let i1 = i1.min(nx - 1);
+        for j in j0..=j1 {
+            crate::prefetch::prefetch(&self.values[j * nx + i0]);
+            crate::prefetch::prefetch(&self.values[j * nx + i1]);
+        }
+    }
+
+    /// The value at a point whose interpolation weights were computed once for this grid's spec
+    /// (several fields on the same grid share them; see [`Bilinear`]).
+    #[inline]
+    pub fn bilinear(&self, b: &Bilinear) -> f32 {
         let v = &self.values;
-        let lo = v[j0 * nx + i0] + (v[j0 * nx + i1] - v[j0 * nx + i0]) * tx;
-        let hi = v[j1 * nx + i0] + (v[j1 * nx + i1] - v[j1 * nx + i0]) * tx;
-        lo + (hi - lo) * ty
+        let (r0, r1) = (b.j0 * self.spec.nx, b.j1 * self.spec.nx);
+        bilinear_mix(
+            v[r0 + b.i0],
+            v[r0 + b.i1],
+            v[r1 + b.i0],
+            v[r1 + b.i1],
+            b.tx,
+            b.ty,
+        )
     }
 
     /// Adds `amount * kernel.weight(distance to segment a-b)` to every cell near the segment.
@@ -510,6 +558,51 @@ fn substeps(x: f32, max: f32) -> usize {
 }
 
 /// Index pair and weight for linear interpolation at fractional index `f` on `n` samples, clamped.
+/// Side of the cell blocks that [`GridField::block`] gathers.
+pub const BLOCK: usize = 3;
+
+/// Bilinear interpolation weights of one point on a grid: corner indices and fractions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Bilinear {
+    pub i0: usize,
+    pub i1: usize,
+    pub j0: usize,
+    pub j1: usize,
+    pub tx: f32,
+    pub ty: f32,
+}
+
+/// Bilinear interpolation of corner values with [`GridField::value_at`]'s arithmetic (so that results
+/// from values gathered elsewhere are bit-identical): `v00 = (i0, j0)`, `v10 = (i1, j0)`, ...
+#[inline]
+pub fn bilinear_mix(v00: f32, v10: f32, v01: f32, v11: f32, tx: f32, ty: f32) -> f32 {
+    let lo = v00 + (v10 - v00) * tx;
+    let hi = v01 + (v11 - v01) * tx;
+    lo + (hi - lo) * ty
+}
+
+impl Bilinear {
+    /// Weights of `p` on `spec` (points outside clamp to the edge cells); `None` for an empty grid.
+    #[inline]
+    pub fn at(spec: &GridSpec, p: Vec2) -> Option<Bilinear> {
+        let GridSpec { nx, ny, cell } = *spec;
+        if nx == 0 || ny == 0 {
+            return None;
+        }
+        let (i0, i1, tx) = lerp_index(p.x / cell - 0.5, nx);
+        let (j0, j1, ty) = lerp_index(p.y / cell - 0.5, ny);
+        Some(Bilinear {
+            i0,
+            i1,
+            j0,
+            j1,
+            tx,
+            ty,
+        })
+    }
+}
+
+#[inline]
 pub(crate) fn lerp_index(f: f32, n: usize) -> (usize, usize, f32) {
     if n <= 1 || !(f > 0.0) {
         return (0, 0, 0.0);
@@ -518,8 +611,8 @@ pub(crate) fn lerp_index(f: f32, n: usize) -> (usize, usize, f32) {
     if f >= max {
         return (n - 1, n - 1, 0.0);
     }
-    let i0 = f.floor() as usize;
-    let i0 = i0.min(n - 2);
+    // f > 0 here, so truncation is floor (and avoids a libm call on baseline x86-64).
+    let i0 = (f as usize).min(n - 2);
     (i0, i0 + 1, f - i0 as f32)
 }
 

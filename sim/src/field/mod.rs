@@ -9,10 +9,11 @@ mod pheromone;
 mod static_map;
 
 pub use backend::{BackendChoice, FieldBackend};
-pub use gaussian::{GaussianField, GaussianSource};
+pub use gaussian::{FrozenSource, GaussianField, GaussianSource};
 pub(crate) use grid::lerp_index;
 pub use grid::{
-    DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS, thomas_coefficients,
+    BLOCK, Bilinear, DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,
+    bilinear_mix, thomas_coefficients,
 };
 pub use kernel::Kernel;
 pub use pheromone::{FieldModel, Pheromone};

@@ -60,7 +60,13 @@ pub struct ColourSensor {
     inverse: [[f32; 3]; 3],
     /// Sample offsets of the footprint, m, relative to the sensor centre.
     offsets: [Vec2; RING_POINTS + 1],
+    /// `light` of the mean level, indexed by the sum of the footprint's 8-bit levels (the transfer
+    /// curve costs a table lookup instead of a `powf` per channel and reading).
+    light_by_sum: Vec<f32>,
 }
+
+/// Samples in one footprint.
+const FOOTPRINT_POINTS: usize = RING_POINTS + 1;
 
 /// Inverse of a 3x3 matrix, computed in f64; `None` when (nearly) singular.
 pub fn invert3(m: &[[f32; 3]; 3]) -> Option<[[f32; 3]; 3]> {
@@ -93,16 +99,41 @@ impl ColourSensor {
         for (k, o) in offsets.iter_mut().skip(1).enumerate() {
             *o = ring * Vec2::from_angle(std::f32::consts::TAU * k as f32 / RING_POINTS as f32);
         }
-        ColourSensor {
+        let mut sensor = ColourSensor {
             params,
             inverse,
             offsets,
-        }
+            light_by_sum: Vec::new(),
+        };
+        sensor.light_by_sum = (0..=255 * FOOTPRINT_POINTS as u32)
+            .map(|sum| sensor.light([mean_level(sum); 3])[0])
+            .collect();
+        sensor
     }
 
     /// Where on the screen the sensor at `p` samples, arena coordinates: `p` and a ring around it.
     pub fn sample_points(&self, p: Vec2) -> [Vec2; RING_POINTS + 1] {
-        self.offsets.map(|o| p + o)
+        let mut points = self.offsets;
+        for q in &mut points {
+            *q += p;
+        }
+        points
+    }
+
+    /// Sum of the 8-bit screen levels (r, g, b) at the footprint's samples around `p`.
+    pub fn footprint_sum(
+        &self,
+        pheromones: &[Pheromone],
+        screen: &ScreenSpec,
+        p: Vec2,
+    ) -> [u32; 3] {
+        let mut sum = [0u32; 3];
+        for px in crate::screen::pixels_at(pheromones, screen, &self.sample_points(p)) {
+            for c in 0..3 {
+                sum[c] += px[c] as u32;
+            }
+        }
+        sum
     }
 
     /// Mean 8-bit screen level (r, g, b) over the footprint around `p`, each in [0, 255].
@@ -112,14 +143,21 @@ impl ColourSensor {
         screen: &ScreenSpec,
         p: Vec2,
     ) -> [f32; 3] {
-        let mut sum = [0u32; 3];
-        for q in self.sample_points(p) {
-            let px = crate::screen::pixel_at(pheromones, screen, q);
-            for c in 0..3 {
-                sum[c] += px[c] as u32;
-            }
-        }
-        sum.map(|s| s as f32 / (RING_POINTS + 1) as f32)
+        self.footprint_sum(pheromones, screen, p).map(mean_level)
+    }
+
+    /// What the sensor at `p` reads: the same as `counts(screen_levels(..))`, with the transfer curve
+    /// from a table.
+    pub fn read(
+        &self,
+        pheromones: &[Pheromone],
+        screen: &ScreenSpec,
+        p: Vec2,
+        rng: &mut SimRng,
+    ) -> [u16; 3] {
+        let [r, g, b] = self.footprint_sum(pheromones, screen, p);
+        let lut = &self.light_by_sum;
+        self.counts_for_light([lut[r as usize], lut[g as usize], lut[b as usize]], rng)
     }
 
     /// Light emitted per primary, in [0, 1], for 8-bit levels.
@@ -137,8 +175,11 @@ impl ColourSensor {
     /// Counts for the given mean screen levels: transfer curve, crosstalk, gain, integration, noise,
     /// saturation at 65535.
     pub fn counts(&self, levels: [f32; 3], rng: &mut SimRng) -> [u16; 3] {
+        self.counts_for_light(self.light(levels), rng)
+    }
+
+    fn counts_for_light(&self, light: [f32; 3], rng: &mut SimRng) -> [u16; 3] {
         let p = &self.params;
-        let light = self.light(levels);
         let scale = p.gain * p.integration_ms;
         let mut out = [0u16; 3];
         for (c, o) in out.iter_mut().enumerate() {
@@ -147,8 +188,7 @@ impl ColourSensor {
             if p.noise > 0.0 {
                 raw += p.noise * crate::rng::normal(rng);
             }
-            // `as` saturates and maps NaN to 0.
-            *o = raw.clamp(0.0, 65535.0).round() as u16;
+            *o = round_count(raw);
         }
         out
     }
@@ -161,13 +201,12 @@ impl ColourSensor {
     pub fn intensity(&self, counts: [u16; 3]) -> [f32; 3] {
         let p = &self.params;
         let scale = p.gain * p.integration_ms;
-        let signal = counts.map(|n| {
-            if scale > 0.0 {
-                (n as f32 - p.dark_counts) / scale
-            } else {
-                0.0
+        let mut signal = [0.0f32; 3];
+        if scale > 0.0 {
+            for (s, &n) in signal.iter_mut().zip(&counts) {
+                *s = (n as f32 - p.dark_counts) / scale;
             }
-        });
+        }
         let inv_gamma = if p.gamma > 0.0 { 1.0 / p.gamma } else { 1.0 };
         let mut out = [0.0f32; 3];
         for (c, o) in out.iter_mut().enumerate() {
@@ -184,5 +223,81 @@ impl ColourSensor {
             *o = light.powf(inv_gamma);
         }
         out
+    }
+}
+
+/// Mean level of a footprint from the sum of its samples' levels.
+fn mean_level(sum: u32) -> f32 {
+    sum as f32 / FOOTPRINT_POINTS as f32
+}
+
+/// `raw.clamp(0, 65535).round() as u16` (NaN gives 0) without a libm `roundf` call: below 2^16 the
+/// truncation and the fraction are exact in f32.
+#[inline]
+fn round_count(raw: f32) -> u16 {
+    if raw >= 65535.0 {
+        u16::MAX
+    } else if raw > 0.0 {
+        let t = raw as u16;
+        t + u16::from(raw - t as f32 >= 0.5)
+    } else {
+        0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_round_like_libm_and_saturate() {
+        for raw in [
+            -5.0f32, 0.0, 0.49999997, 0.5, 1.5, 30.49, 30.5, 65534.5, 65535.0, 1e9,
+        ] {
+            let want = raw.clamp(0.0, 65535.0).round() as u16;
+            assert_eq!(round_count(raw), want, "raw {raw}");
+        }
+        assert_eq!(round_count(f32::NAN), 0);
+        let mut raw = 0.0f32;
+        while raw < 70_000.0 {
+            assert_eq!(round_count(raw), raw.clamp(0.0, 65535.0).round() as u16);
+            raw += 0.37;
+        }
+    }
+
+    #[test]
+    fn read_equals_counts_of_screen_levels() {
+        use crate::field::{FieldModel, GridField, GridParams, GridSpec, Pheromone};
+        let spec = GridSpec {
+            nx: 40,
+            ny: 20,
+            cell: 0.025,
+        };
+        let mut g = GridField::new(spec, GridParams::default());
+        for (k, v) in g.values_mut().iter_mut().enumerate() {
+            *v = (k as f32 * 0.37).sin().abs();
+        }
+        let ph = [Pheromone {
+            name: "p".into(),
+            colour: [255.0, 90.0, 20.0],
+            model: FieldModel::Grid(g),
+        }];
+        let screen = ScreenSpec {
+            resolution: [800, 400],
+            size: [1.0, 0.5],
+        };
+        let s = ColourSensor::new(ColourSensorParams {
+            gamma: 1.8,
+            ..Default::default()
+        });
+        let (mut a, mut b) = (crate::rng::stream(3, 0, 0), crate::rng::stream(3, 0, 0));
+        let mut lit = 0;
+        for k in 0..500 {
+            let p = Vec2::new(k as f32 * 0.0019, 0.25 + 0.2 * (k as f32 * 0.1).sin());
+            let want = s.counts(s.screen_levels(&ph, &screen, p), &mut a);
+            assert_eq!(s.read(&ph, &screen, p, &mut b), want, "at {p}");
+            lit += usize::from(want[0] > 1000);
+        }
+        assert!(lit > 100, "only {lit} readings see the field");
     }
 }

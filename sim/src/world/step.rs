@@ -1,6 +1,7 @@
 //! One step of a world: behaviours -> drive -> physics -> tracker -> fields and injection -> sensors.
 use super::World;
 use crate::behaviour::{Observation, WheelCommand};
+use crate::field::FieldModel;
 use crate::sensors::SENSOR_RADIUS;
 use crate::sensors::sensor_positions;
 use rayon::prelude::*;
@@ -94,7 +95,19 @@ impl World {
             &self.bumper_params,
             self.time,
         );
+        let footprint = sensor.params.footprint_radius;
         let sense = |(i, (slot, obs)): (usize, (&mut super::RobotSlot, &mut Observation))| {
+            // The grid cells under the next robot's sensors are scattered over large fields: ask for
+            // them now so that their cache misses overlap with this robot's work.
+            if let Some(next) = poses.get(i + 1) {
+                for p in sensor_positions(next, SENSOR_RADIUS) {
+                    for ph in pheromones {
+                        if let FieldModel::Grid(g) = &ph.model {
+                            g.prefetch_around(p, footprint);
+                        }
+                    }
+                }
+            }
             let mut o = Observation {
                 time,
                 last_command: slot.command,
@@ -104,8 +117,7 @@ impl World {
                 .into_iter()
                 .enumerate()
             {
-                let levels = sensor.screen_levels(pheromones, screen, p);
-                o.counts[n] = sensor.counts(levels, &mut slot.rng);
+                o.counts[n] = sensor.read(pheromones, screen, p, &mut slot.rng);
                 o.intensity[n] = sensor.intensity(o.counts[n]);
             }
             o.bumpers = neighbours.bumpers(i, poses, radius, arena, bumper);
