@@ -74,6 +74,9 @@ pub fn ray_walls(o: Vec2, d: Vec2, arena: Vec2) -> f32 {
     t
 }
 
+/// Up to this many robots the index is a single cell: every robot is a candidate neighbour.
+const SCAN_ALL_BELOW: usize = 32;
+
 /// Uniform-grid hash of robot positions, rebuilt each step, so bumpers need no ray casts.
 ///
 /// Cell lists are built by a counting sort into flat arrays that are reused between rebuilds (no
@@ -99,10 +102,16 @@ impl NeighbourIndex {
     }
 
     pub fn rebuild(&mut self, arena: Vec2, cell: f32, positions: &[Vec2]) {
-        let cell = if cell.is_finite() && cell > 0.0 {
+        // A handful of robots (a small world of a batched environment) is faster to scan than to
+        // bucket: one cell over the whole arena. Bumper readings are a minimum over the candidates, so
+        // they do not depend on the cell size.
+        let whole_arena = arena.x.max(arena.y).max(1e-3);
+        let cell = if positions.len() <= SCAN_ALL_BELOW {
+            whole_arena
+        } else if cell.is_finite() && cell > 0.0 {
             cell
         } else {
-            arena.x.max(arena.y).max(1e-3)
+            whole_arena
         };
         // Bound the grid so a tiny cell cannot make a huge table.
         let max_cells_per_axis = 4096.0;
