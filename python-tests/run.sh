@@ -1,11 +1,17 @@
 #!/usr/bin/env bash
 # Builds the colcos wheel once (with `pip wheel ./pyo3-bindings`, the same path as the README's
-# `pip install ./pyo3-bindings`), installs it into two venvs and runs every Python suite:
+# `pip install ./pyo3-bindings`), installs it into two venvs and runs every Python suite (what CI runs):
 #   main venv  (requirements.txt):       PettingZoo suite, errors, vector env, determinism,
-#                                        SuperSuit -> SB3, TorchRL
+#                                        SuperSuit -> SB3 PPO, our SB3 adapter, TorchRL
 #   rllib venv (requirements-rllib.txt): RLlib ParallelPettingZooEnv (ray pins gymnasium 1.2.2)
+# Both requirement files are complete locks installed with --no-deps (no resolver); the main venv gets
+# PyPI's torch without its CUDA libraries, made loadable by torch_cpu_stubs.py (see requirements.txt).
+# From empty venvs (no pip cache) on the shared 2-core machine at load average ~7: wheel 825 s (cold
+# cargo build; ~4-5 min idle), main venv 129 s, rllib venv 74 s, tests 82 s: 18.5 min in all;
+# ~2.4 GB on disk, ~760 MB downloaded. A rerun reuses the venvs and the cargo target: ~2 min.
 # Usage: python-tests/run.sh [pytest args]       (from anywhere; uses python3 from PATH)
 # Env: COLCOS_PY_WORK (default: <repo>/target/python) holds the venvs, wheel and cargo target dir.
+#      COLCOS_PY_PEERS=0 runs only the core suites in a small venv (requirements-core.txt, ~1 min).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 repo="$(cd "$here/.." && pwd)"
@@ -14,6 +20,8 @@ py="${PYTHON:-python3}"
 mkdir -p "$work"
 stamp() { date +%s; }
 t0=$(stamp)
+t=$t0
+lap() { local now; now=$(stamp); echo "   $1 in $((now - t)) s"; t=$now; }
 
 echo "== building the colcos wheel (pip wheel ./pyo3-bindings)"
 [ -x "$work/build-venv/bin/python" ] || "$py" -m venv "$work/build-venv"
@@ -22,41 +30,62 @@ rm -rf "$work/wheels"
 # The bindings crate gets its own target dir: alternating with the workspace's builds would rebuild pyo3.
 (cd "$repo" && CARGO_TARGET_DIR="$work/cargo-target" "$work/build-venv/bin/pip" wheel ./pyo3-bindings --no-deps -w "$work/wheels")
 wheel="$(ls "$work/wheels"/colcos-*.whl)"
-t1=$(stamp); echo "   wheel built in $((t1 - t0)) s: $wheel"
+lap "wheel built ($wheel)"
 
-make_venv() { # name requirements
-    local v="$work/$1"
+make_venv() { # name requirements [pip install options]
+    local v="$work/$1" req="$2"
+    shift 2
     [ -x "$v/bin/python" ] || "$py" -m venv "$v"
     "$v/bin/pip" install -q --upgrade pip
-    "$v/bin/pip" install -q -r "$2"
-    "$v/bin/pip" install -q --force-reinstall --no-deps "$wheel"
+    # --no-compile: byte-compiling every module of torch and ray up front costs minutes on 2 cores;
+    # Python compiles (and caches) the modules the tests import when they first run.
+    "$v/bin/pip" install -q --no-compile "$@" -r "$req"
+    "$v/bin/pip" install -q --no-compile --force-reinstall --no-deps "$wheel"
 }
 
-peers="${COLCOS_PY_PEERS:-0}"
+# A --no-deps lock that misses a dependency fails here rather than in a test. torch's CUDA requirements
+# are deliberately left out of the main venv (the stubs stand in for them).
+check_venv() { # name
+    local out
+    out="$("$work/$1/bin/pip" check 2>&1 | grep -v -E '^torch [^ ]+ requires (nvidia-|cuda-|triton)' || true)"
+    if [ -n "$out" ] && [ "$out" != "No broken requirements found." ]; then
+        echo "$out"
+        echo "error: the $1 lock is incomplete (python-tests/requirements*.txt)"
+        exit 1
+    fi
+}
+
 cd "$here"
 status=0
-if [ "$peers" != 1 ]; then
-    echo "== core venv (PettingZoo, errors, vector env, determinism; COLCOS_PY_PEERS=1 adds the peer libraries)"
+if [ "${COLCOS_PY_PEERS:-1}" = 0 ]; then
+    echo "== core venv (PettingZoo, errors, vector env, determinism; without COLCOS_PY_PEERS=0 also the peer libraries)"
     make_venv venv-core "$here/requirements-core.txt"
-    t2=$(stamp); echo "   installed in $((t2 - t1)) s"
+    lap "installed"
     "$work/venv-core/bin/python" -m pytest -q -p no:cacheprovider \
         test_pettingzoo.py test_errors.py test_vector.py test_determinism.py "$@" || status=1
-    echo "== python part done in $(( $(stamp) - t0 )) s (status $status)"
+    lap "core suites"
+    echo "== python part done in $(($(stamp) - t0)) s (status $status)"
     exit $status
 fi
 
-echo "== main venv"
-make_venv venv-main "$here/requirements.txt"
-t2=$(stamp); echo "   installed in $((t2 - t1)) s"
-echo "== rllib venv"
-make_venv venv-rllib "$here/requirements-rllib.txt"
-t3=$(stamp); echo "   installed in $((t3 - t2)) s"
+echo "== main venv (requirements.txt, torch without its CUDA libraries)"
+make_venv venv-main "$here/requirements.txt" --no-deps --only-binary=:all:
+"$work/venv-main/bin/python" "$here/torch_cpu_stubs.py"
+check_venv venv-main
+# The peer suites importorskip their libraries: make a broken install fail here instead of skipping.
+"$work/venv-main/bin/python" -c "import torch, tensordict, torchrl, stable_baselines3, supersuit"
+lap "installed ($(du -sh "$work/venv-main" | cut -f1))"
+echo "== rllib venv (requirements-rllib.txt)"
+make_venv venv-rllib "$here/requirements-rllib.txt" --no-deps --only-binary=:all:
+check_venv venv-rllib
+"$work/venv-rllib/bin/python" -c "import ray.rllib"
+lap "installed ($(du -sh "$work/venv-rllib" | cut -f1))"
 
 echo "== pytest (main venv)"
-"$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --ignore=test_rllib.py "$@" || status=1
-t4=$(stamp); echo "   main suites in $((t4 - t3)) s"
+"$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --durations=5 --ignore=test_rllib.py "$@" || status=1
+lap "main suites"
 echo "== pytest (rllib venv)"
 "$work/venv-rllib/bin/python" -m pytest -q -p no:cacheprovider test_rllib.py "$@" || status=1
-t5=$(stamp); echo "   rllib suite in $((t5 - t4)) s"
-echo "== python part done in $((t5 - t0)) s (status $status)"
+lap "rllib suite"
+echo "== python part done in $(($(stamp) - t0)) s (status $status)"
 exit $status
