@@ -15,7 +15,7 @@ fn time(label: &str, text: &str) {
     for _ in 0..3 {
         w.step();
     }
-    let steps = 15;
+    let steps = 60;
     let cpu0 = process_cpu_seconds();
     let mut xs: Vec<f64> = (0..steps)
         .map(|_| {
@@ -43,6 +43,9 @@ fn process_cpu_seconds() -> Option<f64> {
     let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
     Some(ticks / 100.0)
 }
+
+const PHEROMONES: &str = "[[pheromones]]\nname = \"red\"\ncolour = [255, 0, 0]\nevaporation = 20.0\ndiffusion = 1e-6\n[[pheromones]]\nname = \"green\"\ncolour = [0, 255, 0]\nevaporation = 20.0\n[[pheromones]]\nname = \"blue\"\ncolour = [0, 0, 255]\nevaporation = 20.0\n";
+const DEPOSITS: &str = "deposits = [{ pheromone = \"red\", kernel = { shape = \"disc\", radius = 0.01 }, rate = 3.0 }]";
 
 fn main() {
     let base_cell = |robots: usize,
@@ -85,6 +88,13 @@ fn main() {
         "full with rapier",
         &base(10_000, "follow", true, true, "rapier"),
     );
+    let small = |physics: &str| {
+        format!(
+            "duration = 10.0\nphysics = \"{physics}\"\n[field]\ncell = 0.005\n{PHEROMONES}\n[[robots]]\ncount = 100\nbehaviour = \"follow\"\n{DEPOSITS}\n"
+        )
+    };
+    time("100 robots, 65-inch, 5 mm, rapier", &small("rapier"));
+    time("100 robots, 65-inch, 5 mm, discs", &small("discs"));
     time(
         "1,000 robots full discs",
         &base(1_000, "follow", true, true, "discs"),

@@ -27,8 +27,9 @@ echo "== building the colcos wheel (pip wheel ./pyo3-bindings)"
 [ -x "$work/build-venv/bin/python" ] || "$py" -m venv "$work/build-venv"
 "$work/build-venv/bin/pip" install -q --upgrade pip "maturin==1.16.0"
 rm -rf "$work/wheels"
-# The bindings crate gets its own target dir: alternating with the workspace's builds would rebuild pyo3.
-(cd "$repo" && CARGO_TARGET_DIR="$work/cargo-target" "$work/build-venv/bin/pip" wheel ./pyo3-bindings --no-deps -w "$work/wheels")
+# The bindings build shares the workspace target dir: the sim crates it depends on are then built once
+# for both (crates built with other features sit beside each other; nothing is rebuilt back and forth).
+(cd "$repo" && CARGO_TARGET_DIR="${COLCOS_PY_CARGO_TARGET:-$repo/target}" "$work/build-venv/bin/pip" wheel ./pyo3-bindings --no-deps -w "$work/wheels")
 wheel="$(ls "$work/wheels"/colcos-*.whl)"
 lap "wheel built ($wheel)"
 
