@@ -3,8 +3,9 @@
     python benches/python_throughput.py            # everything (needs vmas, mpe2, torch)
     python benches/python_throughput.py --quick    # fewer steps
 
-Rows: colcos batched core (aggregation: 3 learning followers + leader + predator per world) at 1 /
-32 / 1,024 worlds; colcos parallel_env through the PettingZoo dict API; VMAS navigation and
+Rows: colcos batched core (aggregation with 4 learning followers + leader + predator per world, the
+task's scenario with one more follower, so 4 agents as in VMAS's rows) at 1 / 32 / 1,024 worlds; colcos
+parallel_env through the PettingZoo dict API (same scenario); VMAS navigation and
 dispersion (4 agents, CPU torch) at 1 / 32 / 1,024 worlds; mpe2 simple_spread_v3 at 3 and 50 agents.
 Random actions are drawn before timing from a small pool, identically for every library, so the
 figures measure the environments. Each figure is the median of 3 repetitions.
@@ -22,6 +23,14 @@ from collections.abc import Callable
 import numpy as np
 
 REPS = 3
+TARGET_BATCHED = 1_000_000  # issue 4: agent-steps/s, 1,024 worlds, 2 cores
+TARGET_DICT = 100_000
+
+# The aggregation task's own scenario with four learning followers instead of three.
+_SCENARIO = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "env", "scenarios", "aggregation.toml")
+with open(_SCENARIO) as f:
+    FOUR_AGENTS = f.read().replace('count = 3\nrole = "follower"', 'count = 4\nrole = "follower"')
+assert 'count = 4\nrole = "follower"' in FOUR_AGENTS, "aggregation.toml changed: update the bench"
 
 
 def median_rate(run: Callable[[], tuple[int, float]]) -> float:
@@ -35,7 +44,7 @@ def median_rate(run: Callable[[], tuple[int, float]]) -> float:
 def colcos_batched(num_envs: int, steps: int, threads: int | None) -> float:
     from colcos.vector import VecEnv
 
-    v = VecEnv("aggregation", num_envs=num_envs, num_threads=threads, max_cycles=500)
+    v = VecEnv("aggregation", num_envs=num_envs, num_threads=threads, max_cycles=500, scenario=FOUR_AGENTS)
     rng = np.random.default_rng(0)
     pool = [rng.uniform(-1, 1, (num_envs, v.num_agents, 2)).astype(np.float32) for _ in range(8)]
     v.reset(seed=0)
@@ -122,11 +131,11 @@ def main() -> None:
     import colcos
 
     for e, n in [(1, 4000), (32, 1000), (1024, 100)]:
-        add("colcos VecEnv (batched)", f"aggregation, 3 agents, {e} worlds", lambda e=e, n=n: colcos_batched(e, s(n), args.threads))
+        add("colcos VecEnv (batched)", f"aggregation, 4 agents, {e} worlds", lambda e=e, n=n: colcos_batched(e, s(n), args.threads))
     add(
         "colcos parallel_env (dict)",
-        "aggregation, 3 agents",
-        lambda: pettingzoo_dict(lambda: colcos.parallel_env(task="aggregation", max_cycles=500), s(4000)),
+        "aggregation, 4 agents",
+        lambda: pettingzoo_dict(lambda: colcos.parallel_env(task="aggregation", max_cycles=500, scenario=FOUR_AGENTS), s(4000)),
     )
     for scen in ("navigation", "dispersion"):
         for e, n in [(1, 300), (32, 300), (1024, 100)]:
@@ -147,17 +156,20 @@ def main() -> None:
     print("| --- | --- | ---: |")
     for lib, setup, r in rows:
         print(f"| {lib} | {setup} | {'n/a' if r is None else f'{r:,.0f}'} |")
-    ours_1024 = rate("colcos VecEnv (batched)", "aggregation, 3 agents, 1024 worlds")
-    ours_dict = rate("colcos parallel_env (dict)", "aggregation, 3 agents")
+    ours_1024 = rate("colcos VecEnv (batched)", "aggregation, 4 agents, 1024 worlds")
+    ours_dict = rate("colcos parallel_env (dict)", "aggregation, 4 agents")
+    for name, ours, target in [("batched, 1,024 worlds", ours_1024, TARGET_BATCHED), ("parallel_env dict", ours_dict, TARGET_DICT)]:
+        if ours:
+            print(f"colcos {name}: {ours:,.0f} agent-steps/s, target {target:,}: {'met' if ours >= target else 'NOT met'} ({ours / target:.2f}x)")
     print("\nratios (colcos / peer):")
     for lib, setup, r in rows:
         if r is None or lib.startswith("colcos"):
             continue
         ours = ours_1024 if lib.startswith("VMAS") and "1024" in setup else ours_dict if lib.startswith("mpe2") else None
         if lib.startswith("VMAS") and " 1 worlds" in setup:
-            ours = rate("colcos VecEnv (batched)", "aggregation, 3 agents, 1 worlds")
+            ours = rate("colcos VecEnv (batched)", "aggregation, 4 agents, 1 worlds")
         if lib.startswith("VMAS") and "32 worlds" in setup:
-            ours = rate("colcos VecEnv (batched)", "aggregation, 3 agents, 32 worlds")
+            ours = rate("colcos VecEnv (batched)", "aggregation, 4 agents, 32 worlds")
         if ours:
             print(f"  vs {lib}, {setup}: {ours / r:6.2f}x")
 

@@ -80,7 +80,10 @@ pub fn case2_claims(r: &Case2Result) -> Case2Claims {
     let rises: Vec<Option<f32>> = r.runs.iter().map(|x| x.alarm_rise).collect();
     Case2Claims {
         fall_ok: falls.iter().all(|&f| f >= 0.5),
-        rise_ok: rises.iter().all(|r| r.is_some_and(|r| r >= 0.5)),
+        // A run whose predator never came near the prey has no alarm and says nothing about the
+        // rise; the claim needs alarms in at least half of the runs, and a rise in every one.
+        rise_ok: rises.iter().flatten().all(|&r| r >= 0.5)
+            && 2 * rises.iter().flatten().count() >= rises.len(),
         falls,
         rises,
     }
@@ -243,7 +246,7 @@ pub fn markdown(r1: Option<&Case1Result>, r2: Option<&Case2Result>, wall: f64) -
         ));
         let rises: Vec<f32> = c.rises.iter().map(|r| r.unwrap_or(f32::NAN)).collect();
         s.push_str(&format!(
-            "| S(t) rises by at least half after an alarm | S increases | every run: {} | {} |\n\n",
+            "| S(t) rises by at least half after an alarm | S increases | every run with an alarm (NaN: the predator never came near; alarms needed in half the runs): {} | {} |\n\n",
             fmt_list(&rises),
             yes(c.rise_ok)
         ));
