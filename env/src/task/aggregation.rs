@@ -1,18 +1,35 @@
 //! Case II of the paper: followers gather at the leader (aggregation pheromone, green, emitted by the
 //! leader) and flee the alarm (red, emitted by any prey robot near the predator).
 //!
-//! Reward per follower and step: `-distance_weight * d(leader) / arena diagonal`, minus
-//! `capture_penalty` while a predator is within `capture_distance`. No termination: episodes end by
-//! truncation.
+//! Reward per follower and step (docs/python.md, "Training"):
+//!
+//! ```text
+//! r = progress_weight * (v . g) / max_wheel_speed * (1 - strongest bumper)
+//!   - distance_weight * d(leader) / arena diagonal
+//!   - alarm_weight * A(p)
+//!   - capture_penalty * [a predator within capture_distance]
+//! ```
+//!
+//! `v` is the follower's own velocity (forward speed along its heading), `A(p)` the screen level (0..1)
+//! of the alarm channel (red) at its position, and `g` its goal direction as in Algorithm 3: straight
+//! down the alarm gradient while `A(p) > alarm_threshold` (the alarm phase: flee), else toward the
+//! leader (the aggregation phase: gather). The first term is dense and depends on the follower's own
+//! action only, which is what makes the task learnable in minutes; the others are the state's cost.
+//! No termination: episodes end by truncation.
 use super::{Task, check_non_negative, parse_params, require_role};
-use crate::error::Result;
+use crate::error::{EnvError, Result};
+use colcos_sim::behaviour::channel_index;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
+use glam::Vec2;
 use serde::Deserialize;
 
 pub const DESCRIPTION: &str =
     "case II: followers gather at the leader and flee the alarm near the predator";
 pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/aggregation.toml");
+
+/// Step of the central differences that give the alarm gradient, m.
+const GRADIENT_STEP: f32 = 0.005;
 
 #[derive(Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -25,6 +42,14 @@ struct Params {
     capture_distance: f32,
     capture_penalty: f32,
     distance_weight: f32,
+    /// Weight of the progress along the goal direction (own velocity, fraction of the top speed).
+    progress_weight: f32,
+    /// Weight of the alarm level at the follower's position.
+    alarm_weight: f32,
+    /// Alarm level (0..1) above which a follower is in the alarm phase (the followers' default).
+    alarm_threshold: f32,
+    /// Screen channel of the alarm pheromone: "r", "g" or "b".
+    alarm_channel: String,
 }
 
 impl Default for Params {
@@ -36,6 +61,10 @@ impl Default for Params {
             capture_distance: 0.1,
             capture_penalty: 1.0,
             distance_weight: 1.0,
+            progress_weight: 1.0,
+            alarm_weight: 1.0,
+            alarm_threshold: 0.05,
+            alarm_channel: "r".into(),
         }
     }
 }
@@ -47,6 +76,10 @@ pub struct Aggregation {
     capture_distance: f32,
     capture_penalty: f32,
     distance_weight: f32,
+    progress_weight: f32,
+    alarm_weight: f32,
+    alarm_threshold: f32,
+    alarm_channel: usize,
     inv_diagonal: f32,
 }
 
@@ -56,6 +89,12 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
     let leader = require_role(scenario, &p.leader_role, "aggregation.leader_role")?[0];
     // A scenario without a predator is allowed: pure aggregation.
     let predators = super::robots_with_role(scenario, &p.predator_role);
+    let alarm_channel = channel_index(&p.alarm_channel).ok_or_else(|| {
+        EnvError::param(
+            "aggregation.alarm_channel",
+            format!("{:?} is not \"r\", \"g\" or \"b\"", p.alarm_channel),
+        )
+    })?;
     Ok(Box::new(Aggregation {
         agents,
         leader,
@@ -63,8 +102,22 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
         capture_distance: check_non_negative("aggregation.capture_distance", p.capture_distance)?,
         capture_penalty: check_non_negative("aggregation.capture_penalty", p.capture_penalty)?,
         distance_weight: check_non_negative("aggregation.distance_weight", p.distance_weight)?,
+        progress_weight: check_non_negative("aggregation.progress_weight", p.progress_weight)?,
+        alarm_weight: check_non_negative("aggregation.alarm_weight", p.alarm_weight)?,
+        alarm_threshold: check_non_negative("aggregation.alarm_threshold", p.alarm_threshold)?,
+        alarm_channel,
         inv_diagonal: 1.0 / scenario.arena_size().length().max(1e-6),
     }))
+}
+
+/// Screen level (0..1, not clamped) of channel `c` at `p`: sum over pheromones of `colour_c * value`.
+fn level(world: &World, c: usize, p: Vec2) -> f32 {
+    world
+        .pheromones()
+        .iter()
+        .filter(|ph| ph.colour[c] != 0.0)
+        .map(|ph| ph.colour[c] / 255.0 * ph.value_at(p))
+        .sum()
 }
 
 impl Task for Aggregation {
@@ -76,11 +129,39 @@ impl Task for Aggregation {
     }
     fn evaluate(&self, world: &World, rewards: &mut [f32], _terminated: &mut [bool]) {
         let poses = world.poses();
+        let robots = world.robots();
+        let obs = world.observations();
+        let params = world.robot_params();
+        let inv_max_speed = if params.max_wheel_speed > 0.0 {
+            1.0 / params.max_wheel_speed
+        } else {
+            0.0
+        };
         let leader = poses[self.leader].pos;
         let c2 = self.capture_distance * self.capture_distance;
+        let c = self.alarm_channel;
         for (r, &i) in rewards.iter_mut().zip(&self.agents) {
             let p = poses[i].pos;
-            let mut reward = -self.distance_weight * p.distance(leader) * self.inv_diagonal;
+            let to_leader = leader - p;
+            let d = to_leader.length();
+            let alarm = level(world, c, p);
+            let goal = if alarm > self.alarm_threshold {
+                let (hx, hy) = (Vec2::X * GRADIENT_STEP, Vec2::Y * GRADIENT_STEP);
+                let grad = Vec2::new(
+                    level(world, c, p + hx) - level(world, c, p - hx),
+                    level(world, c, p + hy) - level(world, c, p - hy),
+                );
+                -grad.normalize_or_zero()
+            } else {
+                to_leader.normalize_or_zero()
+            };
+            let (forward, _) = robots[i].drive.body_velocity(params);
+            let velocity = Vec2::from_angle(poses[i].heading) * forward;
+            let free = (1.0 - obs[i].max_bumper()).clamp(0.0, 1.0);
+            let progress = (velocity.dot(goal) * inv_max_speed).clamp(-1.0, 1.0) * free;
+            let mut reward = self.progress_weight * progress
+                - self.distance_weight * d * self.inv_diagonal
+                - self.alarm_weight * alarm.min(1.0);
             if self
                 .predators
                 .iter()
@@ -90,5 +171,83 @@ impl Task for Aggregation {
             }
             *r = reward;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use colcos_sim::behaviour::WheelCommand;
+
+    /// Leader at (1.0, 0.4), one follower at (0.5, 0.4) with heading `heading` (degrees) driving forward
+    /// for 10 steps; with `predator`, the predator is next to the leader, which makes the leader release
+    /// the alarm pheromone, else in a far corner.
+    fn reward_after(heading: f32, predator: bool) -> f32 {
+        let mut text = format!(
+            r#"
+name = "t"
+duration = 10.0
+dt = 0.02
+seed = 0
+[screen]
+resolution = [384, 216]
+size = [1.439, 0.809]
+[[pheromones]]
+name = "agp"
+colour = [0, 255, 0]
+model = "gaussian"
+evaporation = 10.0
+[[pheromones]]
+name = "alp"
+colour = [255, 0, 0]
+model = "gaussian"
+evaporation = 5.0
+[[robots]]
+count = 1
+role = "leader"
+behaviour = "avoid"
+placement = "explicit"
+poses = [[1.0, 0.4, 0.0]]
+emits = [
+  {{ pheromone = "agp", k = 0.7884, sigma = [0.4, 0.4], evaporation = 10.0, when = "follow" }},
+  {{ pheromone = "alp", k = 1.7740, sigma = [0.6, 0.6], evaporation = 5.0, when = {{ near = {{ role = "predator", distance = 0.2 }} }} }},
+]
+[[robots]]
+count = 1
+role = "follower"
+behaviour = "avoid"
+placement = "explicit"
+poses = [[0.5, 0.4, {heading}]]
+"#
+        );
+        // Far from everyone (no alarm), or next to the leader.
+        let at = if predator { "1.1, 0.4" } else { "0.1, 0.75" };
+        text.push_str(&format!(
+            "[[robots]]\ncount = 1\nrole = \"predator\"\nbehaviour = \"avoid\"\nplacement = \"explicit\"\nposes = [[{at}, 0.0]]\n"
+        ));
+        let scenario = Scenario::from_toml_str(&text, ".").unwrap();
+        let task = build(&scenario, &serde_json::Value::Null).unwrap();
+        let mut world = World::new(&scenario).unwrap();
+        let mut commands = vec![WheelCommand::STOP; world.robot_count()];
+        commands[1] = WheelCommand::new(0.2, 0.2);
+        for _ in 0..10 {
+            world.step_with_commands(&commands);
+        }
+        let mut rewards = [0.0];
+        task.evaluate(&world, &mut rewards, &mut [false]);
+        rewards[0]
+    }
+
+    #[test]
+    fn driving_toward_the_leader_pays_when_calm() {
+        let (toward, away) = (reward_after(0.0, false), reward_after(180.0, false));
+        assert!(toward > away + 0.5, "toward {toward}, away {away}");
+    }
+
+    #[test]
+    fn driving_away_from_the_alarm_pays_in_the_alarm_phase() {
+        // The alarm source is at the leader: fleeing it now means driving away from the leader.
+        let (toward, away) = (reward_after(0.0, true), reward_after(180.0, true));
+        assert!(away > toward + 0.5, "toward {toward}, away {away}");
     }
 }
