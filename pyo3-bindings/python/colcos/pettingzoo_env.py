@@ -154,16 +154,19 @@ class ColcosParallelEnv(ParallelEnv):
                 raise ActionError(f"action of agent {name!r} must be {want}, got {a!r} ({e})") from None
         self._core.step(buf)
         v = self._views
-        rew, term, trunc = v["rewards"][0], v["terminated"][0], v["truncated"][0]
+        # One copy and one conversion per buffer rather than per agent: each agent's observation is a
+        # row of this step's own copy (never a view of the native buffer, which the next step rewrites).
+        rew, term, trunc = v["rewards"][0].tolist(), v["terminated"][0].tolist(), v["truncated"][0].tolist()
+        all_obs = v["obs"][0].copy()
+        patches = v["patch"][0].copy() if "patch" in v else None
         obs, rewards, terminations, truncations, infos = {}, {}, {}, {}, {}
         live = []
         for a in self.agents:
             i = index[a]
-            obs[a] = self._obs(i)
-            rewards[a] = float(rew[i])
-            t, u = bool(term[i]), bool(trunc[i])
-            terminations[a] = t
-            truncations[a] = u
+            obs[a] = all_obs[i] if patches is None else {"vector": all_obs[i], "patch": patches[i]}
+            rewards[a] = rew[i]
+            t = terminations[a] = term[i]
+            u = truncations[a] = trunc[i]
             infos[a] = {}
             if not (t or u):
                 live.append(a)
