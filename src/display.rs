@@ -57,6 +57,83 @@ struct WorldFrames {
     world: World,
     size: (u32, u32),
     first: bool,
+    /// The screen composed on the GPU that steps the fields (None: on the CPU).
+    gpu: Option<GpuFrames>,
+}
+
+/// Eq. (1) on the field backend's GPU, into a buffer the window copies from on the same device.
+#[cfg(feature = "display")]
+struct GpuFrames {
+    ctx: std::sync::Arc<colcos_gpu::GpuContext>,
+    screen: colcos_gpu::GpuScreen,
+    /// The world's grid fields (the backend's copies lack the step's trail deposits, which the world
+    /// adds on the CPU after the field step: the current values are uploaded before each frame).
+    grids: Option<colcos_gpu::GpuGrids>,
+    /// Batch field of each pheromone (None: not a grid).
+    map: Vec<Option<usize>>,
+}
+
+#[cfg(feature = "display")]
+impl GpuFrames {
+    fn new(ctx: std::sync::Arc<colcos_gpu::GpuContext>, world: &World) -> Result<Self> {
+        use colcos_sim::field::{FieldModel, GridField};
+        let mut map = Vec::new();
+        let mut fields: Vec<&GridField> = Vec::new();
+        for p in world.pheromones() {
+            match &p.model {
+                FieldModel::Grid(g) => {
+                    map.push(Some(fields.len()));
+                    fields.push(g);
+                }
+                FieldModel::Gaussian(_) => map.push(None),
+            }
+        }
+        let grids = if fields.is_empty() {
+            None
+        } else {
+            Some(colcos_gpu::GpuGrids::from_fields(ctx.clone(), &fields)?)
+        };
+        Ok(GpuFrames {
+            screen: colcos_gpu::GpuScreen::new(ctx.clone())?,
+            ctx,
+            grids,
+            map,
+        })
+    }
+
+    /// Uploads the world's current grid values; the screen's layers.
+    fn upload(&mut self, world: &World) -> Result<colcos_gpu::ScreenScene> {
+        use colcos_sim::field::FieldModel;
+        if let Some(grids) = self.grids.as_mut() {
+            for (p, m) in world.pheromones().iter().zip(&self.map) {
+                if let (FieldModel::Grid(g), Some(f)) = (&p.model, m) {
+                    grids.write_field(*f, g.values())?;
+                }
+            }
+        }
+        Ok(colcos_gpu::ScreenScene {
+            worlds: vec![colcos_gpu::ScreenScene::world_layers(
+                world.pheromones(),
+                |j| self.map[j],
+            )],
+        })
+    }
+
+    /// The screen, composed on the GPU into a buffer (packed RGBA8) that stays there.
+    fn render(&mut self, world: &World, size: (u32, u32)) -> Result<colcos_gpu::wgpu::Buffer> {
+        let scene = self.upload(world)?;
+        Ok(self
+            .screen
+            .render_to_buffer(
+                self.grids.as_ref(),
+                &scene,
+                0,
+                world.screen(),
+                size.0,
+                size.1,
+            )?
+            .clone())
+    }
 }
 
 #[cfg(feature = "display")]
@@ -64,7 +141,7 @@ impl colcos_display::FrameSource for WorldFrames {
     fn size(&self) -> (u32, u32) {
         self.size
     }
-    fn next_frame(&mut self) -> Option<Vec<u8>> {
+    fn next_frame(&mut self) -> Option<colcos_display::Frame> {
         if !self.first {
             if self.world.is_finished() {
                 return None;
@@ -72,13 +149,30 @@ impl colcos_display::FrameSource for WorldFrames {
             self.world.step();
         }
         self.first = false;
+        if let Some(g) = self.gpu.as_mut() {
+            match g.render(&self.world, self.size) {
+                Ok(b) => return Some(colcos_display::Frame::Buffer(b)),
+                Err(e) => {
+                    eprintln!("colcos display: the GPU screen failed ({e}); composing on the CPU");
+                    self.gpu = None;
+                }
+            }
+        }
         let s = *self.world.screen();
-        Some(rgba(screen::render(
+        Some(colcos_display::Frame::Rgba(rgba(screen::render(
             self.world.pheromones(),
             &s,
             self.size.0,
             self.size.1,
-        )))
+        ))))
+    }
+    fn device(&self) -> Option<colcos_display::SharedDevice> {
+        self.gpu.as_ref().map(|g| colcos_display::SharedDevice {
+            instance: g.ctx.instance.clone(),
+            adapter: g.ctx.adapter.clone(),
+            device: g.ctx.device.clone(),
+            queue: g.ctx.queue.clone(),
+        })
     }
 }
 
@@ -88,6 +182,15 @@ pub fn main(args: DisplayArgs) -> Result<()> {
         sc.spec.field.backend = b;
     }
     let mut world = World::new(&sc)?;
+    #[cfg(feature = "display")]
+    let (backend, gpu_ctx) = {
+        let choice = sc.spec.field.backend;
+        let shared = colcos_gpu::SharedBackend::resolve(choice)
+            .map_err(|e| anyhow::anyhow!("field backend {choice}: {e}"))?;
+        let sel = shared.install(&mut world)?;
+        (sel.to_string(), shared.context().cloned())
+    };
+    #[cfg(not(feature = "display"))]
     let backend = crate::backend::install(&mut world, sc.spec.field.backend)?;
     eprintln!("field backend: {backend}");
     let res = sc.spec.screen.resolution;
@@ -105,6 +208,18 @@ pub fn main(args: DisplayArgs) -> Result<()> {
         while world.time() + 0.5 * world.dt() < args.seconds && !world.is_finished() {
             world.step();
         }
+        #[cfg(feature = "display")]
+        let img = match &gpu_ctx {
+            // The GPU that stepped the fields composes the screen too.
+            Some(ctx) => {
+                let mut g = GpuFrames::new(ctx.clone(), &world)?;
+                let scene = g.upload(&world)?;
+                g.screen
+                    .render(g.grids.as_ref(), &scene, 0, world.screen(), size.0, size.1)?
+            }
+            None => screen::render(world.pheromones(), world.screen(), size.0, size.1),
+        };
+        #[cfg(not(feature = "display"))]
         let img = screen::render(world.pheromones(), world.screen(), size.0, size.1);
         #[cfg(feature = "display")]
         let img = {
@@ -130,12 +245,21 @@ pub fn main(args: DisplayArgs) -> Result<()> {
             close_after: args.close_after.map(std::time::Duration::from_secs_f64),
             announce_first_frame: false,
         };
+        let gpu = match gpu_ctx {
+            Some(ctx) => Some(GpuFrames::new(ctx, &world)?),
+            None => None,
+        };
+        eprintln!(
+            "screen composed on the {}",
+            if gpu.is_some() { "GPU" } else { "CPU" }
+        );
         colcos_display::run_window(
             opts,
             Box::new(WorldFrames {
                 world,
                 size,
                 first: true,
+                gpu,
             }),
         )
         .context("display window")

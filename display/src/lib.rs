@@ -37,13 +37,45 @@ pub enum DisplayError {
 
 pub type Result<T> = std::result::Result<T, DisplayError>;
 
+/// The wgpu this crate is built on (for [`SharedDevice`] and [`Frame::Buffer`]).
+pub use wgpu;
+
+mod viewer;
+pub use viewer::Viewer;
+
+/// One image to show.
+#[derive(Clone, Debug)]
+pub enum Frame {
+    /// RGBA8 bytes, row 0 at the top.
+    Rgba(Vec<u8>),
+    /// A buffer on the source's device ([`FrameSource::device`]) holding the image as packed RGBA8
+    /// (`width * height * 4` bytes, row 0 at the top, e.g. `colcos_gpu::GpuScreen::render_to_buffer`).
+    /// When the window shares that device the image goes from the buffer to the window's texture on
+    /// the GPU; otherwise it is read back and uploaded.
+    Buffer(wgpu::Buffer),
+}
+
+/// A device opened elsewhere (e.g. the GPU field backend's) that a window can present with: the
+/// surface is made from `instance`, and used when `adapter` supports it.
+#[derive(Clone, Debug)]
+pub struct SharedDevice {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+}
+
 /// Supplies the images to show.
 pub trait FrameSource {
     /// Image size, pixels.
     fn size(&self) -> (u32, u32);
-    /// The next image (RGBA8, row 0 at the top), called once per frame period; `None` keeps the last
-    /// one on screen (a finished or paused run).
-    fn next_frame(&mut self) -> Option<Vec<u8>>;
+    /// The next image, called once per frame period; `None` keeps the last one on screen (a finished
+    /// or paused run).
+    fn next_frame(&mut self) -> Option<Frame>;
+    /// The device the source renders on, for [`Frame::Buffer`]s; `None`: the window opens its own.
+    fn device(&self) -> Option<SharedDevice> {
+        None
+    }
 }
 
 /// A fixed image.
@@ -59,12 +91,12 @@ impl FrameSource for StillImage {
     fn size(&self) -> (u32, u32) {
         self.0.dimensions()
     }
-    fn next_frame(&mut self) -> Option<Vec<u8>> {
+    fn next_frame(&mut self) -> Option<Frame> {
         if self.1 {
             return None;
         }
         self.1 = true;
-        Some(self.0.as_raw().clone())
+        Some(Frame::Rgba(self.0.as_raw().clone()))
     }
 }
 
@@ -304,6 +336,54 @@ impl Presenter {
         );
     }
 
+    /// Copies an image of `size` from `buffer` (packed RGBA8, on this presenter's device) into the
+    /// texture, on the GPU.
+    pub fn upload_buffer(&mut self, buffer: &wgpu::Buffer, size: (u32, u32)) {
+        if size != self.size {
+            let (t, b) = Self::make_texture(&self.device, &self.layout, &self.uniform, size);
+            self.texture = t;
+            self.bind = b;
+            self.size = size;
+        }
+        if size.0 == 0 || size.1 == 0 {
+            return;
+        }
+        let row = 4 * size.0;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        let copy = |enc: &mut wgpu::CommandEncoder, y: u32, rows: u32| {
+            enc.copy_buffer_to_texture(
+                wgpu::TexelCopyBufferInfo {
+                    buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: y as u64 * row as u64,
+                        bytes_per_row: (rows > 1).then_some(row),
+                        rows_per_image: None,
+                    },
+                },
+                wgpu::TexelCopyTextureInfo {
+                    texture: &self.texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: 0, y, z: 0 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::Extent3d {
+                    width: size.0,
+                    height: rows,
+                    depth_or_array_layers: 1,
+                },
+            );
+        };
+        if row.is_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) {
+            copy(&mut enc, 0, size.1);
+        } else {
+            // Rows not 256-byte aligned: one copy per row (a single row needs no alignment).
+            for y in 0..size.1 {
+                copy(&mut enc, y, 1);
+            }
+        }
+        self.queue.submit([enc.finish()]);
+    }
+
     /// Draws the image onto `target` (`target_size` pixels): 1:1 when the sizes agree, else scaled to fit.
     pub fn draw(
         &self,
@@ -359,9 +439,35 @@ pub fn render_headless(img: &image::RgbaImage, size: (u32, u32)) -> Result<image
     let (device, queue) =
         pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
             .map_err(|e| DisplayError::Gpu(e.to_string()))?;
+    let dev = SharedDevice {
+        instance: inst,
+        adapter,
+        device,
+        queue,
+    };
+    render_headless_frame(
+        &dev,
+        Frame::Rgba(img.as_raw().clone()),
+        img.dimensions(),
+        size,
+    )
+}
+
+/// [`render_headless`] of a [`Frame`] of `img_size` on a given device (a [`Frame::Buffer`] must be
+/// on it): the window's pipeline, drawn into an offscreen target of `size` and read back.
+pub fn render_headless_frame(
+    dev: &SharedDevice,
+    frame: Frame,
+    img_size: (u32, u32),
+    size: (u32, u32),
+) -> Result<image::RgbImage> {
+    let (device, queue) = (&dev.device, &dev.queue);
     let format = wgpu::TextureFormat::Rgba8Unorm;
-    let mut p = Presenter::new(device.clone(), queue.clone(), format, img.dimensions());
-    p.upload(img.as_raw(), img.dimensions());
+    let mut p = Presenter::new(device.clone(), queue.clone(), format, img_size);
+    match frame {
+        Frame::Rgba(rgba) => p.upload(&rgba, img_size),
+        Frame::Buffer(b) => p.upload_buffer(&b, img_size),
+    }
     let target = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("colcos headless target"),
         size: wgpu::Extent3d {
@@ -434,117 +540,245 @@ pub fn render_headless(img: &image::RgbaImage, size: (u32, u32)) -> Result<image
     Ok(out)
 }
 
-struct WindowState {
-    window: Arc<Window>,
+pub(crate) struct WindowState {
+    pub(crate) window: Arc<Window>,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
     presenter: Presenter,
+    /// Whether the window presents with the source's device (its buffers need no read-back).
+    shared: bool,
+}
+
+/// Opens a window for `opts` showing images of `size`, and a device to present with: `shared`'s when
+/// its adapter supports the window's surface, otherwise one of the window's own.
+pub(crate) fn open_window(
+    el: &ActiveEventLoop,
+    opts: &DisplayOptions,
+    size: (u32, u32),
+    shared: Option<&SharedDevice>,
+) -> Result<WindowState> {
+    let monitors: Vec<_> = el.available_monitors().collect();
+    let names = monitors
+        .iter()
+        .enumerate()
+        .map(|(i, m)| format!("{i}: {} {:?}", m.name().unwrap_or_default(), m.size()))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let monitor = match opts.monitor {
+        Some(i) => Some(monitors.get(i).cloned().ok_or(DisplayError::NoMonitor {
+            index: i,
+            count: monitors.len(),
+            names: names.clone(),
+        })?),
+        None => el.primary_monitor().or_else(|| monitors.first().cloned()),
+    };
+    eprintln!("colcos-display: monitors [{names}]");
+    let wsize = opts.window_size.unwrap_or(size);
+    let mut attrs = Window::default_attributes().with_title(opts.title.clone());
+    if opts.fullscreen {
+        // The monitor's size and position too: without a window manager (a bare X server, a kiosk)
+        // the fullscreen hint alone does not resize the window.
+        if let Some(m) = &monitor {
+            attrs = attrs
+                .with_inner_size(m.size())
+                .with_position(m.position())
+                .with_decorations(false);
+        }
+        attrs = attrs.with_fullscreen(Some(Fullscreen::Borderless(monitor)));
+    } else {
+        attrs = attrs
+            .with_inner_size(winit::dpi::PhysicalSize::new(
+                wsize.0.max(1),
+                wsize.1.max(1),
+            ))
+            .with_decorations(opts.decorations)
+            .with_resizable(true);
+        if let Some((x, y)) = opts.position {
+            attrs = attrs.with_position(winit::dpi::PhysicalPosition::new(x, y));
+        }
+    }
+    let window = Arc::new(
+        el.create_window(attrs)
+            .map_err(|e| DisplayError::Window(e.to_string()))?,
+    );
+    let on_shared = shared.and_then(|s| {
+        let surface = s.instance.create_surface(window.clone()).ok()?;
+        s.adapter.is_surface_supported(&surface).then(|| {
+            (
+                surface,
+                s.adapter.clone(),
+                s.device.clone(),
+                s.queue.clone(),
+            )
+        })
+    });
+    if shared.is_some() && on_shared.is_none() {
+        eprintln!(
+            "colcos-display: the source's GPU cannot present to this window; its images are read back through the CPU"
+        );
+    }
+    let is_shared = on_shared.is_some();
+    let (surface, adapter, device, queue) = match on_shared {
+        Some(x) => x,
+        None => {
+            let inst = instance();
+            let surface = inst
+                .create_surface(window.clone())
+                .map_err(|e| DisplayError::Gpu(e.to_string()))?;
+            let adapter = pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions {
+                compatible_surface: Some(&surface),
+                ..Default::default()
+            }))
+            .map_err(|e| DisplayError::NoAdapter(e.to_string()))?;
+            let (device, queue) =
+                pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
+                    .map_err(|e| DisplayError::Gpu(e.to_string()))?;
+            (surface, adapter, device, queue)
+        }
+    };
+    eprintln!(
+        "colcos-display: adapter {} ({:?}, {:?}){}",
+        adapter.get_info().name,
+        adapter.get_info().device_type,
+        adapter.get_info().backend,
+        if is_shared {
+            ", the device of the field backend"
+        } else {
+            ""
+        }
+    );
+    let inner = window.inner_size();
+    let mut config = surface
+        .get_default_config(&adapter, inner.width.max(1), inner.height.max(1))
+        .ok_or_else(|| DisplayError::Gpu("the surface is not supported by the adapter".into()))?;
+    let caps = surface.get_capabilities(&adapter);
+    // A non-sRGB format, so the 8-bit levels are shown as they are.
+    if let Some(f) = caps.formats.iter().find(|f| !f.is_srgb()) {
+        config.format = *f;
+    } else {
+        config.view_formats = vec![config.format.remove_srgb_suffix()];
+    }
+    config.present_mode = if opts.vsync {
+        wgpu::PresentMode::Fifo
+    } else if caps.present_modes.contains(&wgpu::PresentMode::Immediate) {
+        wgpu::PresentMode::Immediate
+    } else {
+        wgpu::PresentMode::AutoNoVsync
+    };
+    surface.configure(&device, &config);
+    let view_format = config.format.remove_srgb_suffix();
+    let presenter = Presenter::new(device, queue, view_format, size);
+    Ok(WindowState {
+        window,
+        surface,
+        config,
+        presenter,
+        shared: is_shared,
+    })
+}
+
+/// Copies `buffer` (on `dev`) into CPU memory: `bytes` bytes (blocking).
+fn read_back(dev: &SharedDevice, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>> {
+    let staging = dev.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("colcos display read-back"),
+        size: bytes.max(4).next_multiple_of(4),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = dev.device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes.next_multiple_of(4));
+    dev.queue.submit([enc.finish()]);
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = tx.send(r);
+    });
+    dev.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| DisplayError::Gpu(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| DisplayError::Gpu(e.to_string()))?
+        .map_err(|e| DisplayError::Gpu(e.to_string()))?;
+    let out = staging
+        .get_mapped_range(..)
+        .map_err(|e| DisplayError::Gpu(format!("{e:?}")))?[..bytes as usize]
+        .to_vec();
+    staging.unmap();
+    Ok(out)
+}
+
+impl WindowState {
+    /// Puts `frame` (of `size`) into the window's texture; `source` is the device of buffer frames.
+    pub(crate) fn set_frame(
+        &mut self,
+        frame: Frame,
+        size: (u32, u32),
+        source: Option<&SharedDevice>,
+    ) -> Result<()> {
+        match frame {
+            Frame::Rgba(rgba) => self.presenter.upload(&rgba, size),
+            Frame::Buffer(b) if self.shared => self.presenter.upload_buffer(&b, size),
+            Frame::Buffer(b) => {
+                let dev = source.ok_or_else(|| {
+                    DisplayError::Gpu("a buffer frame from a source without a device".into())
+                })?;
+                let rgba = read_back(dev, &b, size.0 as u64 * size.1 as u64 * 4)?;
+                self.presenter.upload(&rgba, size);
+            }
+        }
+        Ok(())
+    }
+
+    /// Draws the texture and presents it; false when the surface had no frame to give.
+    pub(crate) fn present(&mut self) -> bool {
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return false;
+            }
+            _ => {
+                self.surface.configure(&self.presenter.device, &self.config);
+                return false;
+            }
+        };
+        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(self.config.format.remove_srgb_suffix()),
+            ..Default::default()
+        });
+        let mut enc = self
+            .presenter
+            .device
+            .create_command_encoder(&Default::default());
+        self.presenter
+            .draw(&mut enc, &view, (self.config.width, self.config.height));
+        self.presenter.queue.submit([enc.finish()]);
+        self.window.pre_present_notify();
+        self.presenter.queue.present(frame);
+        true
+    }
+
+    pub(crate) fn resize(&mut self, size: winit::dpi::PhysicalSize<u32>) {
+        self.config.width = size.width.max(1);
+        self.config.height = size.height.max(1);
+        self.surface.configure(&self.presenter.device, &self.config);
+        self.window.request_redraw();
+    }
 }
 
 struct App {
     opts: DisplayOptions,
     source: Box<dyn FrameSource>,
+    device: Option<SharedDevice>,
     state: Option<WindowState>,
     error: Option<DisplayError>,
     started: Instant,
     next_frame: Instant,
     presented: u64,
     /// The latest image, kept until the window exists.
-    pending: Option<Vec<u8>>,
+    pending: Option<Frame>,
 }
 
 impl App {
-    fn open(&mut self, el: &ActiveEventLoop) -> Result<WindowState> {
-        let monitors: Vec<_> = el.available_monitors().collect();
-        let names = monitors
-            .iter()
-            .enumerate()
-            .map(|(i, m)| format!("{i}: {} {:?}", m.name().unwrap_or_default(), m.size()))
-            .collect::<Vec<_>>()
-            .join(", ");
-        let monitor = match self.opts.monitor {
-            Some(i) => Some(monitors.get(i).cloned().ok_or(DisplayError::NoMonitor {
-                index: i,
-                count: monitors.len(),
-                names: names.clone(),
-            })?),
-            None => el.primary_monitor().or_else(|| monitors.first().cloned()),
-        };
-        eprintln!("colcos-display: monitors [{names}]");
-        let size = self.opts.window_size.unwrap_or(self.source.size());
-        let mut attrs = Window::default_attributes().with_title(self.opts.title.clone());
-        if self.opts.fullscreen {
-            // The monitor's size and position too: without a window manager (a bare X server, a kiosk)
-            // the fullscreen hint alone does not resize the window.
-            if let Some(m) = &monitor {
-                attrs = attrs
-                    .with_inner_size(m.size())
-                    .with_position(m.position())
-                    .with_decorations(false);
-            }
-            attrs = attrs.with_fullscreen(Some(Fullscreen::Borderless(monitor)));
-        } else {
-            attrs = attrs
-                .with_inner_size(winit::dpi::PhysicalSize::new(size.0.max(1), size.1.max(1)))
-                .with_decorations(self.opts.decorations)
-                .with_resizable(true);
-            if let Some((x, y)) = self.opts.position {
-                attrs = attrs.with_position(winit::dpi::PhysicalPosition::new(x, y));
-            }
-        }
-        let window = Arc::new(
-            el.create_window(attrs)
-                .map_err(|e| DisplayError::Window(e.to_string()))?,
-        );
-        let inst = instance();
-        let surface = inst
-            .create_surface(window.clone())
-            .map_err(|e| DisplayError::Gpu(e.to_string()))?;
-        let adapter = pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions {
-            compatible_surface: Some(&surface),
-            ..Default::default()
-        }))
-        .map_err(|e| DisplayError::NoAdapter(e.to_string()))?;
-        eprintln!(
-            "colcos-display: adapter {} ({:?}, {:?})",
-            adapter.get_info().name,
-            adapter.get_info().device_type,
-            adapter.get_info().backend
-        );
-        let (device, queue) =
-            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
-                .map_err(|e| DisplayError::Gpu(e.to_string()))?;
-        let inner = window.inner_size();
-        let mut config = surface
-            .get_default_config(&adapter, inner.width.max(1), inner.height.max(1))
-            .ok_or_else(|| {
-                DisplayError::Gpu("the surface is not supported by the adapter".into())
-            })?;
-        let caps = surface.get_capabilities(&adapter);
-        // A non-sRGB format, so the 8-bit levels are shown as they are.
-        if let Some(f) = caps.formats.iter().find(|f| !f.is_srgb()) {
-            config.format = *f;
-        } else {
-            config.view_formats = vec![config.format.remove_srgb_suffix()];
-        }
-        config.present_mode = if self.opts.vsync {
-            wgpu::PresentMode::Fifo
-        } else if caps.present_modes.contains(&wgpu::PresentMode::Immediate) {
-            wgpu::PresentMode::Immediate
-        } else {
-            wgpu::PresentMode::AutoNoVsync
-        };
-        surface.configure(&device, &config);
-        let view_format = config.format.remove_srgb_suffix();
-        let presenter = Presenter::new(device, queue, view_format, self.source.size());
-        Ok(WindowState {
-            window,
-            surface,
-            config,
-            presenter,
-        })
-    }
-
     fn redraw(&mut self) -> Result<()> {
         let now = Instant::now();
         if now >= self.next_frame {
@@ -561,32 +795,11 @@ impl App {
             return Ok(());
         };
         if let Some(f) = self.pending.take() {
-            st.presenter.upload(&f, size);
+            st.set_frame(f, size, self.device.as_ref())?;
         }
-        let frame = match st.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t)
-            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                return Ok(());
-            }
-            _ => {
-                st.surface.configure(&st.presenter.device, &st.config);
-                return Ok(());
-            }
-        };
-        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor {
-            format: Some(st.config.format.remove_srgb_suffix()),
-            ..Default::default()
-        });
-        let mut enc = st
-            .presenter
-            .device
-            .create_command_encoder(&Default::default());
-        st.presenter
-            .draw(&mut enc, &view, (st.config.width, st.config.height));
-        st.presenter.queue.submit([enc.finish()]);
-        st.window.pre_present_notify();
-        st.presenter.queue.present(frame);
+        if !st.present() {
+            return Ok(());
+        }
         self.presented += 1;
         if self.presented == 1 && self.opts.announce_first_frame {
             use std::io::Write;
@@ -602,7 +815,7 @@ impl ApplicationHandler for App {
         if self.state.is_some() {
             return;
         }
-        match self.open(el) {
+        match open_window(el, &self.opts, self.source.size(), self.device.as_ref()) {
             Ok(s) => {
                 s.window.request_redraw();
                 self.state = Some(s);
@@ -626,10 +839,7 @@ impl ApplicationHandler for App {
             }
             WindowEvent::Resized(size) => {
                 if let Some(st) = self.state.as_mut() {
-                    st.config.width = size.width.max(1);
-                    st.config.height = size.height.max(1);
-                    st.surface.configure(&st.presenter.device, &st.config);
-                    st.window.request_redraw();
+                    st.resize(size);
                 }
             }
             WindowEvent::RedrawRequested => {
@@ -661,8 +871,8 @@ impl ApplicationHandler for App {
     }
 }
 
-/// Opens the window and shows `source`'s frames until it is closed (or `close_after`).
-pub fn run_window(opts: DisplayOptions, source: Box<dyn FrameSource>) -> Result<()> {
+/// On Linux, an error when there is no X or Wayland display to open a window on.
+pub(crate) fn check_display() -> Result<()> {
     if std::env::var_os("DISPLAY").is_none()
         && std::env::var_os("WAYLAND_DISPLAY").is_none()
         && cfg!(target_os = "linux")
@@ -671,6 +881,12 @@ pub fn run_window(opts: DisplayOptions, source: Box<dyn FrameSource>) -> Result<
             "neither DISPLAY nor WAYLAND_DISPLAY is set".into(),
         ));
     }
+    Ok(())
+}
+
+/// Opens the window and shows `source`'s frames until it is closed (or `close_after`).
+pub fn run_window(opts: DisplayOptions, source: Box<dyn FrameSource>) -> Result<()> {
+    check_display()?;
     let mut builder = EventLoop::builder();
     #[cfg(target_os = "linux")]
     {
@@ -681,8 +897,10 @@ pub fn run_window(opts: DisplayOptions, source: Box<dyn FrameSource>) -> Result<
         .build()
         .map_err(|e| DisplayError::NoDisplay(e.to_string()))?;
     let now = Instant::now();
+    let device = source.device();
     let mut app = App {
         opts,
+        device,
         source,
         state: None,
         error: None,

@@ -165,3 +165,73 @@ fn fullscreen_screenshot_matches_headless_png() {
         true,
     );
 }
+
+/// The window of Python's `render_mode="human"`: a `Viewer` fed from this thread, its event loop on
+/// a display thread. The screenshot matches the headless PNG; a second viewer opens after the first
+/// is closed (winit allows one event loop per process: the display thread serves both).
+#[test]
+fn viewer_screenshot_matches_headless_png_and_reopens() {
+    use colcos_display::{DisplayOptions, Viewer};
+    if std::env::var_os("DISPLAY").is_none() {
+        return skip("DISPLAY is not set (run under xvfb-run, see gpu/ci.sh)");
+    }
+    if Command::new("import").arg("-version").output().is_err() {
+        return skip("ImageMagick's `import` is not installed (apt-get install imagemagick)");
+    }
+    let dir = std::env::temp_dir().join(format!("colcos-xvfb-{}-viewer", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let opts = || DisplayOptions {
+        position: Some((0, 0)),
+        decorations: false,
+        frame_period: Duration::from_millis(20),
+        ..Default::default()
+    };
+    for round in 0..2 {
+        let img = pattern(320 - 3 * round, 180);
+        let size = img.dimensions();
+        let mut v = match Viewer::open(opts(), size) {
+            Ok(v) => v,
+            Err(DisplayError::NoAdapter(e)) => return skip(&format!("no GPU adapter: {e}")),
+            Err(e) => panic!("the viewer did not open: {e}"),
+        };
+        // Paced: five images take at least four frame periods.
+        let t = Instant::now();
+        for _ in 0..5 {
+            assert!(v.show(img.as_raw().clone(), size));
+        }
+        assert!(
+            t.elapsed() >= Duration::from_millis(75),
+            "{:?}",
+            t.elapsed()
+        );
+        let deadline = Instant::now() + Duration::from_secs(30);
+        while v.presented() == 0 && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        assert!(v.presented() > 0, "round {round}: nothing presented");
+        std::thread::sleep(Duration::from_millis(500));
+        let shot_path = dir.join(format!("shot{round}.png"));
+        screenshot(&shot_path).unwrap();
+        let shot = image::open(&shot_path).unwrap().to_rgb8();
+        let headless = render_headless(&img, size).unwrap();
+        let mut differ = 0;
+        for y in 0..size.1 {
+            for x in 0..size.0 {
+                if shot.get_pixel(x, y) != headless.get_pixel(x, y) {
+                    differ += 1;
+                }
+            }
+        }
+        assert_eq!(
+            differ,
+            0,
+            "round {round}: {differ} pixels differ (see {})",
+            dir.display()
+        );
+        v.close();
+        assert!(!v.is_open());
+        assert!(!v.show(img.as_raw().clone(), size), "show after close");
+        v.close();
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

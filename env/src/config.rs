@@ -116,6 +116,8 @@ pub struct EnvConfig {
     pub num_threads: Option<usize>,
     /// Seed used until `reset` is given another.
     pub seed: u64,
+    /// Field backend of the grid pheromones; `None`: the scenario's `[field] backend`.
+    pub backend: Option<colcos_sim::field::BackendChoice>,
 }
 
 impl EnvConfig {
@@ -132,6 +134,7 @@ impl EnvConfig {
             num_envs: 1,
             num_threads: None,
             seed: 0,
+            backend: None,
         }
     }
 }

@@ -19,6 +19,9 @@ pub enum EnvError {
     /// A call that is not valid in the environment's current state (e.g. step before reset).
     #[error("{0}")]
     State(String),
+    /// The field backend asked for cannot be used (e.g. `gpu` where there is no GPU adapter).
+    #[error("{0}")]
+    Backend(String),
 }
 
 impl EnvError {

@@ -10,6 +10,7 @@
 //! Robots that are not agents (a leader, a predator) keep the behaviour their scenario gives them, with
 //! their own random streams.
 
+pub mod backend;
 pub mod baseline;
 pub mod config;
 pub mod encoding;
@@ -20,6 +21,7 @@ pub mod task;
 mod vec_env;
 mod world_slot;
 
+pub use backend::EnvBackend;
 pub use config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource};
 pub use error::{EnvError, Result};
 pub use spaces::{EnvSpec, Space};

@@ -4,6 +4,7 @@
 //! `[E, N]` rewards and flags, ...); they are allocated at construction and never reallocated, so a
 //! binding may hand out views of them that stay valid for the environment's lifetime. Each `step` and
 //! `reset` overwrites them in place.
+use crate::backend::EnvBackend;
 use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
 use crate::encoding::{self, OBS_DIM};
 use crate::error::{EnvError, Result};
@@ -39,6 +40,7 @@ struct Out<'a> {
 struct Ctx<'a> {
     task: &'a dyn Task,
     scenario: &'a Scenario,
+    backend: &'a EnvBackend,
     mode: AutoresetMode,
     max_cycles: u64,
     max_speed: f32,
@@ -51,6 +53,7 @@ pub struct VecEnv {
     task: Box<dyn Task>,
     /// The scenario with the current seed.
     scenario: Scenario,
+    backend: EnvBackend,
     mode: AutoresetMode,
     patch_cfg: Option<PatchConfig>,
     pool: rayon::ThreadPool,
@@ -77,6 +80,10 @@ impl VecEnv {
         }
         let (task, mut scenario) = registry::build(&cfg.task, &cfg.scenario, &cfg.params)?;
         scenario.spec.seed = cfg.seed;
+        if let Some(b) = cfg.backend {
+            scenario.spec.field.backend = b;
+        }
+        let mut backend = EnvBackend::resolve(scenario.spec.field.backend)?;
         let max_cycles = if cfg.max_cycles > 0 {
             cfg.max_cycles
         } else {
@@ -150,13 +157,15 @@ impl VecEnv {
         let slots = pool.install(|| {
             (0..e)
                 .into_par_iter()
-                .map(|w| WorldSlot::build(&scenario, task.as_ref(), w, 0))
+                .map(|w| WorldSlot::build(&scenario, task.as_ref(), &backend, w, 0))
                 .collect::<Result<Vec<_>>>()
         })?;
+        backend.settle(&slots[0].world);
         let mut env = VecEnv {
             spec,
             task,
             scenario,
+            backend,
             mode: cfg.autoreset,
             patch_cfg: cfg.patch,
             pool,
@@ -187,6 +196,10 @@ impl VecEnv {
     }
     pub fn scenario(&self) -> &Scenario {
         &self.scenario
+    }
+    /// The field backend of the worlds (see [`EnvBackend`]).
+    pub fn backend(&self) -> &EnvBackend {
+        &self.backend
     }
     pub fn autoreset_mode(&self) -> AutoresetMode {
         self.mode
@@ -278,7 +291,7 @@ impl VecEnv {
         if let Some(s) = seed {
             self.scenario.spec.seed = s;
         }
-        let (scenario, task) = (&self.scenario, self.task.as_ref());
+        let (scenario, task, backend) = (&self.scenario, self.task.as_ref(), &self.backend);
         // A seed restarts the episode count; the first reset after construction replays episode 0.
         let restart = seed.is_some();
         let first = self.needs_reset;
@@ -296,7 +309,7 @@ impl VecEnv {
                         } else {
                             slot.episode + 1
                         };
-                        *slot = WorldSlot::build(scenario, task, w, episode)?;
+                        *slot = WorldSlot::build(scenario, task, backend, w, episode)?;
                     }
                     Ok(())
                 })
@@ -327,6 +340,7 @@ impl VecEnv {
         let ctx = Ctx {
             task: self.task.as_ref(),
             scenario: &self.scenario,
+            backend: &self.backend,
             mode: self.mode,
             max_cycles: self.spec.max_cycles,
             max_speed: self.scenario.spec.robot.max_wheel_speed,
@@ -516,7 +530,7 @@ fn step_world(
     *out.final_mask = false;
     if slot.done {
         // Next-step autoreset: this step only resets the world.
-        *slot = WorldSlot::build(ctx.scenario, ctx.task, w, slot.episode + 1)?;
+        *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
         out.rewards.fill(0.0);
         out.terminated.fill(false);
         out.truncated.fill(false);
@@ -554,7 +568,7 @@ fn step_world(
         if ctx.mode == AutoresetMode::SameStep {
             out.final_obs.copy_from_slice(out.obs);
             *out.final_mask = true;
-            *slot = WorldSlot::build(ctx.scenario, ctx.task, w, slot.episode + 1)?;
+            *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
             write_world(ctx, slot, out);
         }
     }

@@ -1,4 +1,5 @@
 //! One world of a batch: the sim world, the behaviours of its scripted robots, and episode bookkeeping.
+use crate::backend::EnvBackend;
 use crate::error::Result;
 use crate::task::Task;
 use colcos_sim::behaviour::{Behaviour, WheelCommand, registry};
@@ -35,9 +36,16 @@ pub(crate) struct WorldSlot {
 
 impl WorldSlot {
     /// Builds episode `episode` of batch world `w`.
-    pub fn build(scenario: &Scenario, task: &dyn Task, w: usize, episode: u64) -> Result<Self> {
+    pub fn build(
+        scenario: &Scenario,
+        task: &dyn Task,
+        backend: &EnvBackend,
+        w: usize,
+        episode: u64,
+    ) -> Result<Self> {
         let index = world_index(w, episode);
         let mut world = World::with_index(scenario, index)?;
+        backend.install(&mut world)?;
         let agents = task.agents();
         let mut scripted = Vec::new();
         let mut first = 0;

@@ -136,7 +136,7 @@ fn bench_batch(ctx: &std::sync::Arc<GpuContext>, worlds: usize) {
     let mut cpu: Vec<GridField> = (0..worlds).map(|_| GridField::new(spec, params)).collect();
     let refs: Vec<&GridField> = cpu.iter().collect();
     let mut gpu = GpuGrids::from_fields(ctx.clone(), &refs).expect("batch");
-    let gs = GpuScreen::new(ctx.clone());
+    let gs = GpuScreen::new(ctx.clone()).expect("screen pipelines");
     let sensor = ColourSensor::new(ColourSensorParams::default());
     // Robots drive in circles of different radii.
     let pos = |w: usize, r: usize, t: f32| -> Vec2 {

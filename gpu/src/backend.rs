@@ -50,22 +50,70 @@ pub fn context_for(choice: BackendChoice) -> Result<(Option<Arc<GpuContext>>, St
 
 /// Installs the backend `choice` in `world` (see [`context_for`]) and says what it chose.
 pub fn install(world: &mut World, choice: BackendChoice) -> Result<BackendSelection> {
-    let (ctx, reason) = context_for(choice)?;
-    let Some(ctx) = ctx else {
-        world.set_field_backend(None);
-        return Ok(BackendSelection::Cpu { reason });
-    };
-    match GpuWorldBackend::new(ctx, world.pheromones())? {
-        Some(b) => {
-            let adapter = b.ctx.describe();
-            world.set_field_backend(Some(Box::new(b)));
-            Ok(BackendSelection::Gpu { adapter })
+    SharedBackend::resolve(choice)?.install(world)
+}
+
+/// A backend choice resolved once, for any number of worlds: one device (or the CPU) for all, so that
+/// a vector env's worlds, rebuilt every episode, do not each open a device and compile the shaders.
+#[derive(Clone)]
+pub struct SharedBackend {
+    ctx: Option<Arc<GpuContext>>,
+    /// Why the CPU, when it is the CPU.
+    reason: String,
+}
+
+impl SharedBackend {
+    /// The device `choice` asks for (see [`context_for`]): `gpu` without an adapter is an error,
+    /// `auto` falls back to the CPU.
+    pub fn resolve(choice: BackendChoice) -> Result<Self> {
+        let (ctx, reason) = context_for(choice)?;
+        Ok(SharedBackend { ctx, reason })
+    }
+
+    /// A backend on an open device.
+    pub fn on(ctx: Arc<GpuContext>) -> Self {
+        SharedBackend {
+            ctx: Some(ctx),
+            reason: String::new(),
         }
-        None => {
+    }
+
+    /// The device, or `None` for the CPU.
+    pub fn context(&self) -> Option<&Arc<GpuContext>> {
+        self.ctx.as_ref()
+    }
+
+    /// What the choice resolved to: `gpu: <adapter>` or `cpu (<reason>)`.
+    pub fn selection(&self) -> BackendSelection {
+        match &self.ctx {
+            Some(c) => BackendSelection::Gpu {
+                adapter: c.describe(),
+            },
+            None => BackendSelection::Cpu {
+                reason: self.reason.clone(),
+            },
+        }
+    }
+
+    /// Installs the backend in `world` and says what it chose (the CPU for a world without grid
+    /// pheromones).
+    pub fn install(&self, world: &mut World) -> Result<BackendSelection> {
+        let Some(ctx) = self.ctx.clone() else {
             world.set_field_backend(None);
-            Ok(BackendSelection::Cpu {
-                reason: "no grid pheromones to step".into(),
-            })
+            return Ok(self.selection());
+        };
+        match GpuWorldBackend::new(ctx, world.pheromones())? {
+            Some(b) => {
+                let adapter = b.ctx.describe();
+                world.set_field_backend(Some(Box::new(b)));
+                Ok(BackendSelection::Gpu { adapter })
+            }
+            None => {
+                world.set_field_backend(None);
+                Ok(BackendSelection::Cpu {
+                    reason: "no grid pheromones to step".into(),
+                })
+            }
         }
     }
 }

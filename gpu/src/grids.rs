@@ -101,7 +101,11 @@ struct FieldState {
     slot: u32,
 }
 
-struct Pipelines {
+/// The field shader's pipelines and their layout: compiled once per device (see
+/// [`FieldPipelines::get`]) and shared by every batch on it, so that making a batch (one per world, for a
+/// vector env) costs only its buffers.
+pub(crate) struct FieldPipelines {
+    layout: wgpu::BindGroupLayout,
     evaporate: wgpu::ComputePipeline,
     explicit: wgpu::ComputePipeline,
     one_sided: wgpu::ComputePipeline,
@@ -121,8 +125,7 @@ pub struct GpuGrids {
     ctx: Arc<GpuContext>,
     spec: GridSpec,
     fields: Vec<FieldState>,
-    layout: wgpu::BindGroupLayout,
-    pipes: Pipelines,
+    pipes: Arc<FieldPipelines>,
     vals: wgpu::Buffer,
     inj: wgpu::Buffer,
     inj_len: u32,
@@ -175,25 +178,22 @@ fn field_source(f64: bool) -> String {
     include_str!("field.wgsl").replace("//KEXP//", &kexp)
 }
 
-impl GpuGrids {
-    /// `params.len()` fields of `spec`, all zero, no injection maps.
-    pub fn new(ctx: Arc<GpuContext>, spec: GridSpec, params: &[GridParams]) -> Result<Self> {
-        let n = spec.len() as u64;
-        let bytes = 2 * n * params.len() as u64 * 4;
-        check_size(
-            &ctx,
-            "field values (2 slots x fields x cells x 4 bytes)",
-            bytes,
-        )?;
-        if params.len() > MAX_GROUPS as usize {
-            return Err(GpuError::Invalid(format!(
-                "{} fields in one batch; at most {MAX_GROUPS}",
-                params.len()
-            )));
+impl FieldPipelines {
+    /// The context's pipelines, compiled on first use.
+    fn get(ctx: &GpuContext) -> Result<Arc<FieldPipelines>> {
+        let mut slot = ctx
+            .field_pipelines
+            .lock()
+            .unwrap_or_else(|p| p.into_inner());
+        if let Some(p) = slot.as_ref() {
+            return Ok(p.clone());
         }
-        if spec.nx == 0 || spec.ny == 0 {
-            return Err(GpuError::Invalid("empty grid".into()));
-        }
+        let p = Arc::new(ctx.scoped("compiling the field shader", || Self::new(ctx))?);
+        *slot = Some(p.clone());
+        Ok(p)
+    }
+
+    fn new(ctx: &GpuContext) -> FieldPipelines {
         let device = &ctx.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("colcos field.wgsl"),
@@ -241,7 +241,7 @@ impl GpuGrids {
                 cache: None,
             })
         };
-        let pipes = Pipelines {
+        FieldPipelines {
             evaporate: pipe("evaporate"),
             explicit: pipe("explicit_step"),
             one_sided: pipe("one_sided"),
@@ -250,44 +250,72 @@ impl GpuGrids {
             advect_x: pipe("advect_x"),
             advect_y: pipe("advect_y"),
             deposit: pipe("deposit"),
-        };
-        let nf = params.len().max(1) as u64;
-        let vals = storage(
+            layout,
+        }
+    }
+}
+
+impl GpuGrids {
+    /// `params.len()` fields of `spec`, all zero, no injection maps.
+    pub fn new(ctx: Arc<GpuContext>, spec: GridSpec, params: &[GridParams]) -> Result<Self> {
+        let n = spec.len() as u64;
+        let bytes = 2 * n * params.len() as u64 * 4;
+        check_size(
             &ctx,
-            "colcos field values",
+            "field values (2 slots x fields x cells x 4 bytes)",
             bytes,
-            wgpu::BufferUsages::empty(),
-        );
-        let coef = storage(
-            &ctx,
-            "colcos thomas coefficients",
-            nf * 2 * (spec.nx + spec.ny) as u64 * 4,
-            wgpu::BufferUsages::empty(),
-        );
-        let inj = storage(
-            &ctx,
-            "colcos injection maps",
-            16,
-            wgpu::BufferUsages::empty(),
-        );
-        let plan = storage(
-            &ctx,
-            "colcos plan",
-            nf * 8 * 32,
-            wgpu::BufferUsages::empty(),
-        );
-        let deps = storage(
-            &ctx,
-            "colcos deposits",
-            64 * 64,
-            wgpu::BufferUsages::empty(),
-        );
-        let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("colcos pass uniforms"),
-            size: UNIFORM_STRIDE * 16,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        )?;
+        if params.len() > MAX_GROUPS as usize {
+            return Err(GpuError::Invalid(format!(
+                "{} fields in one batch; at most {MAX_GROUPS}",
+                params.len()
+            )));
+        }
+        if spec.nx == 0 || spec.ny == 0 {
+            return Err(GpuError::Invalid("empty grid".into()));
+        }
+        let pipes = FieldPipelines::get(&ctx)?;
+        let nf = params.len().max(1) as u64;
+        let (vals, coef, inj, plan, deps, uniforms) =
+            ctx.scoped("allocating the field buffers", || {
+                let vals = storage(
+                    &ctx,
+                    "colcos field values",
+                    bytes,
+                    wgpu::BufferUsages::empty(),
+                );
+                let coef = storage(
+                    &ctx,
+                    "colcos thomas coefficients",
+                    nf * 2 * (spec.nx + spec.ny) as u64 * 4,
+                    wgpu::BufferUsages::empty(),
+                );
+                let inj = storage(
+                    &ctx,
+                    "colcos injection maps",
+                    16,
+                    wgpu::BufferUsages::empty(),
+                );
+                let plan = storage(
+                    &ctx,
+                    "colcos plan",
+                    nf * 8 * 32,
+                    wgpu::BufferUsages::empty(),
+                );
+                let deps = storage(
+                    &ctx,
+                    "colcos deposits",
+                    64 * 64,
+                    wgpu::BufferUsages::empty(),
+                );
+                let uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("colcos pass uniforms"),
+                    size: UNIFORM_STRIDE * 16,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                (vals, coef, inj, plan, deps, uniforms)
+            })?;
         let fields = params
             .iter()
             .map(|&p| FieldState {
@@ -302,7 +330,6 @@ impl GpuGrids {
             ctx,
             spec,
             fields,
-            layout,
             pipes,
             vals,
             inj,
@@ -372,19 +399,22 @@ impl GpuGrids {
                 self.spec.len()
             )));
         }
-        self.ctx.queue.write_buffer(
-            &self.vals,
-            self.field_offset(field) * 4,
-            bytemuck::cast_slice(values),
-        );
-        Ok(())
+        self.ctx.scoped("writing field values", || {
+            self.ctx.queue.write_buffer(
+                &self.vals,
+                self.field_offset(field) * 4,
+                bytemuck::cast_slice(values),
+            )
+        })
     }
 
     /// Sets every field to zero.
-    pub fn clear(&mut self) {
-        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&self.vals, 0, None);
-        self.ctx.queue.submit([enc.finish()]);
+    pub fn clear(&mut self) -> Result<()> {
+        self.ctx.scoped("clearing the fields", || {
+            let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+            enc.clear_buffer(&self.vals, 0, None);
+            self.ctx.queue.submit([enc.finish()]);
+        })
     }
 
     /// Reads the values of `field` back (blocking).
@@ -413,6 +443,13 @@ impl GpuGrids {
 
     /// Sets (or removes) the static injection map `J` of `field`.
     pub fn set_static_injection(&mut self, field: usize, j: Option<&[f32]>) -> Result<()> {
+        let ctx = self.ctx.clone();
+        ctx.scoped("uploading an injection map", || {
+            self.set_static_injection_inner(field, j)
+        })?
+    }
+
+    fn set_static_injection_inner(&mut self, field: usize, j: Option<&[f32]>) -> Result<()> {
         let n = self.spec.len();
         match j {
             None => self.fields[field].inj_offset = None,
@@ -500,7 +537,7 @@ impl GpuGrids {
             .device
             .create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("colcos field bind group"),
-                layout: &self.layout,
+                layout: &self.pipes.layout,
                 entries: &[
                     whole(0, &self.vals),
                     whole(1, &self.plan),
@@ -590,6 +627,11 @@ impl GpuGrids {
     /// Advances every field by `dt` seconds: exact evaporation and static injection, diffusion by the
     /// field's scheme, then wind; the same passes, in the same order, as [`GridField::step`].
     pub fn step(&mut self, dt: f32) -> Result<()> {
+        let ctx = self.ctx.clone();
+        ctx.scoped("stepping the fields", || self.step_inner(dt))?
+    }
+
+    fn step_inner(&mut self, dt: f32) -> Result<()> {
         if dt.is_nan() || dt <= 0.0 || self.fields.is_empty() {
             return Ok(());
         }
@@ -854,6 +896,11 @@ impl GpuGrids {
     /// Adds trail deposits, in order (deposits on one field are summed in the order given, as a
     /// sequence of [`GridField::deposit_segment`] calls would).
     pub fn deposit(&mut self, deposits: &[Deposit]) -> Result<()> {
+        let ctx = self.ctx.clone();
+        ctx.scoped("depositing trails", || self.deposit_inner(deposits))?
+    }
+
+    fn deposit_inner(&mut self, deposits: &[Deposit]) -> Result<()> {
         let GridSpec { nx, ny, cell } = self.spec;
         let mut per_field_count = vec![0usize; self.fields.len()];
         let mut rounds: Vec<Vec<DepRecord>> = Vec::new();

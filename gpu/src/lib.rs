@@ -13,13 +13,16 @@
 
 pub mod backend;
 mod grids;
+
+/// The wgpu this crate is built on (for [`GpuContext`]'s device and buffers).
+pub use wgpu;
 pub mod screen;
 
-pub use backend::{BackendSelection, GpuWorldBackend, install};
+pub use backend::{BackendSelection, GpuWorldBackend, SharedBackend, install};
 pub use grids::{Deposit, GpuGrids};
 pub use screen::{GpuScreen, ScreenLayer, ScreenScene, SensorQuery, mean_levels};
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// Errors of the GPU backend.
 #[derive(Debug, thiserror::Error)]
@@ -40,6 +43,15 @@ pub enum GpuError {
     },
     #[error("GPU read-back failed: {0}")]
     Readback(String),
+    /// A validation, out-of-memory or internal error that wgpu reported (caught by an error scope or
+    /// the device's uncaptured-error handler, never a panic).
+    #[error("GPU error while {what}: {message}")]
+    Wgpu { what: String, message: String },
+    /// The device was lost (driver reset, GPU removed or hung, or destroyed); it cannot be used again.
+    #[error(
+        "the GPU device {adapter} was lost ({reason}); make a new GpuContext, or use the CPU backend"
+    )]
+    DeviceLost { adapter: String, reason: String },
     #[error("invalid input: {0}")]
     Invalid(String),
 }
@@ -57,13 +69,48 @@ pub enum AdapterPolicy {
 }
 
 /// One wgpu adapter, device and queue.
+///
+/// wgpu's default reaction to a validation error, an out-of-memory error or a lost device is a panic
+/// from its uncaptured-error handler. A `GpuContext` installs its own handler instead, and every
+/// operation of this crate runs inside error scopes ([`GpuContext::scoped`]), so those errors become
+/// [`GpuError::Wgpu`] and [`GpuError::DeviceLost`] values.
 pub struct GpuContext {
+    /// The instance the adapter came from: a window's surface must be made from it to share the device.
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub info: wgpu::AdapterInfo,
     pub limits: wgpu::Limits,
     /// Whether the device has `SHADER_F64` (exact Gaussian sources on the screen and in the sensors).
     pub f64: bool,
+    /// Errors no scope caught (from other threads or wgpu's own work), oldest first.
+    uncaptured: Arc<Mutex<Vec<String>>>,
+    /// Why the device was lost, once it is.
+    lost: Arc<Mutex<Option<String>>>,
+    /// The field pipelines, compiled once per device and shared by every [`GpuGrids`] on it.
+    pub(crate) field_pipelines: Mutex<Option<Arc<grids::FieldPipelines>>>,
+}
+
+/// A wgpu error as one line (its description; wgpu's are multi-line "Caused by" chains).
+fn error_text(e: &wgpu::Error) -> String {
+    let kind = match e {
+        wgpu::Error::OutOfMemory { .. } => "out of GPU memory: ",
+        wgpu::Error::Validation { .. } => "",
+        wgpu::Error::Internal { .. } => "internal error: ",
+    };
+    let mut text = e.to_string();
+    let mut src = std::error::Error::source(e);
+    while let Some(s) = src {
+        let t = s.to_string();
+        if !text.contains(&t) {
+            text.push_str(": ");
+            text.push_str(&t);
+        }
+        src = s.source();
+    }
+    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    format!("{kind}{text}")
 }
 
 /// True for software adapters: CPU device type, or llvmpipe/lavapipe/SwiftShader/WARP by name.
@@ -134,10 +181,10 @@ impl GpuContext {
         if policy == AdapterPolicy::HardwareOnly && is_software(&info) {
             return Err(GpuError::SoftwareOnly(describe(&info)));
         }
-        Self::open(adapter)
+        Self::open(inst, adapter)
     }
 
-    fn open(adapter: wgpu::Adapter) -> Result<Arc<GpuContext>> {
+    fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Arc<GpuContext>> {
         let info = adapter.get_info();
         let limits = adapter.limits();
         let f64 = adapter.features().contains(wgpu::Features::SHADER_F64);
@@ -157,13 +204,95 @@ impl GpuContext {
                 adapter: describe(&info),
                 message: e.to_string(),
             })?;
+        let uncaptured = Arc::new(Mutex::new(Vec::new()));
+        let lost = Arc::new(Mutex::new(None));
+        {
+            let uncaptured = uncaptured.clone();
+            device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+                let mut v = uncaptured.lock().unwrap_or_else(|p| p.into_inner());
+                // Keep the first few: later ones are usually consequences.
+                if v.len() < 16 {
+                    v.push(error_text(&e));
+                }
+            }));
+        }
+        {
+            let lost = lost.clone();
+            device.set_device_lost_callback(move |reason, message| {
+                let mut l = lost.lock().unwrap_or_else(|p| p.into_inner());
+                if l.is_none() {
+                    let message = message.split_whitespace().collect::<Vec<_>>().join(" ");
+                    *l = Some(if message.is_empty() {
+                        format!("{reason:?}")
+                    } else {
+                        format!("{reason:?}: {message}")
+                    });
+                }
+            });
+        }
         Ok(Arc::new(GpuContext {
+            instance,
+            adapter,
             device,
             queue,
             info,
             limits,
             f64,
+            uncaptured,
+            lost,
+            field_pipelines: Mutex::new(None),
         }))
+    }
+
+    /// Runs `f` (which creates resources on, records for or submits to this device) inside
+    /// validation, out-of-memory and internal error scopes; what wgpu reports there comes back as
+    /// [`GpuError::Wgpu`] naming `what`, a lost device as [`GpuError::DeviceLost`]. Errors that no
+    /// scope caught earlier (another thread's, or wgpu's own) are reported here too.
+    ///
+    /// Scopes are per thread: `f` must not hand its GPU work to another thread.
+    pub fn scoped<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+        self.check_lost()?;
+        let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let out = f();
+        let errors = [
+            pollster::block_on(validation.pop()),
+            pollster::block_on(internal.pop()),
+            pollster::block_on(oom.pop()),
+        ];
+        self.check_lost()?;
+        if let Some(e) = errors.iter().flatten().next() {
+            return Err(GpuError::Wgpu {
+                what: what.to_string(),
+                message: error_text(e),
+            });
+        }
+        self.check_uncaptured(what)?;
+        Ok(out)
+    }
+
+    /// [`GpuError::DeviceLost`] once the device is lost.
+    pub fn check_lost(&self) -> Result<()> {
+        match &*self.lost.lock().unwrap_or_else(|p| p.into_inner()) {
+            Some(reason) => Err(GpuError::DeviceLost {
+                adapter: describe(&self.info),
+                reason: reason.clone(),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// The errors wgpu reported outside any scope since the last call, as one [`GpuError::Wgpu`].
+    pub fn check_uncaptured(&self, what: &str) -> Result<()> {
+        let errs = std::mem::take(&mut *self.uncaptured.lock().unwrap_or_else(|p| p.into_inner()));
+        if errs.is_empty() {
+            return Ok(());
+        }
+        Err(GpuError::Wgpu {
+            what: format!("{what} (reported outside an error scope)"),
+            message: errs.join("; "),
+        })
     }
 
     /// One line describing the adapter in use.
@@ -193,30 +322,33 @@ impl GpuContext {
         if bytes == 0 {
             return Ok(Vec::new());
         }
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("colcos-gpu readback"),
-            size: bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("readback"),
-            });
-        enc.copy_buffer_to_buffer(src, offset, &staging, 0, bytes);
-        self.queue.submit([enc.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
-        staging.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
+        let staging = self.scoped("reading a buffer back", || {
+            let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("colcos-gpu readback"),
+                size: bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut enc = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("readback"),
+                });
+            enc.copy_buffer_to_buffer(src, offset, &staging, 0, bytes);
+            self.queue.submit([enc.finish()]);
+            staging.map_async(wgpu::MapMode::Read, .., move |r| {
+                let _ = tx.send(r);
+            });
+            staging
+        })?;
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
+            .map_err(|e| self.lost_or(GpuError::Readback(e.to_string())))?;
         match rx.recv() {
             Ok(Ok(())) => {}
-            Ok(Err(e)) => return Err(GpuError::Readback(e.to_string())),
-            Err(e) => return Err(GpuError::Readback(e.to_string())),
+            Ok(Err(e)) => return Err(self.lost_or(GpuError::Readback(e.to_string()))),
+            Err(e) => return Err(self.lost_or(GpuError::Readback(e.to_string()))),
         }
         let out = {
             let view = staging
@@ -233,7 +365,14 @@ impl GpuContext {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| GpuError::Readback(e.to_string()))
+            .map_err(|e| self.lost_or(GpuError::Readback(e.to_string())))?;
+        self.check_lost()?;
+        self.check_uncaptured("waiting for the GPU")
+    }
+
+    /// `e`, or [`GpuError::DeviceLost`] when the device is lost (the likelier cause).
+    fn lost_or(&self, e: GpuError) -> GpuError {
+        self.check_lost().err().unwrap_or(e)
     }
 }
 

@@ -197,7 +197,13 @@ fn groups(items: usize, per: usize) -> (u32, u32) {
 }
 
 impl GpuScreen {
-    pub fn new(ctx: Arc<GpuContext>) -> Self {
+    /// Compiles the screen shader on `ctx`'s device.
+    pub fn new(ctx: Arc<GpuContext>) -> Result<Self> {
+        let c = ctx.clone();
+        c.scoped("compiling the screen shader", || Self::build(ctx))
+    }
+
+    fn build(ctx: Arc<GpuContext>) -> Self {
         let src = include_str!("screen.wgsl").replace(
             "//GAUSS//",
             &if ctx.f64 {
@@ -365,8 +371,34 @@ impl GpuScreen {
     ) -> Result<()> {
         let (layers, srcs, nl) = Self::records(grids, scene)?;
         let uni = Uni { nlayers: nl, ..uni };
-        let lb = self.buffer_init("colcos layers", bytemuck::cast_slice(&layers));
-        let sb = self.buffer_init("colcos sources", bytemuck::cast_slice(&srcs));
+        self.ctx.scoped("composing the screen", || {
+            self.dispatch_inner(
+                grids,
+                uni,
+                pipe,
+                out,
+                (&layers, &srcs),
+                points,
+                qworld,
+                shape,
+            )
+        })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn dispatch_inner(
+        &self,
+        grids: Option<&GpuGrids>,
+        uni: Uni,
+        pipe: &wgpu::ComputePipeline,
+        out: &wgpu::Buffer,
+        (layers, srcs): (&[LayerRec], &[SrcRec]),
+        points: &[u8],
+        qworld: &[u8],
+        shape: (u32, u32),
+    ) {
+        let lb = self.buffer_init("colcos layers", bytemuck::cast_slice(layers));
+        let sb = self.buffer_init("colcos sources", bytemuck::cast_slice(srcs));
         let pb = self.buffer_init("colcos points", points);
         let qb = self.buffer_init("colcos sensor worlds", qworld);
         let ub = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -409,7 +441,6 @@ impl GpuScreen {
             pass.dispatch_workgroups(shape.0, shape.1, 1);
         }
         self.ctx.queue.submit([enc.finish()]);
-        Ok(())
     }
 
     /// Composes world `world`'s screen at `width x height` into a GPU buffer of packed RGBA8 pixels
@@ -427,12 +458,14 @@ impl GpuScreen {
         crate::check_size(&self.ctx, "screen image", pixels * 4)?;
         let reuse = matches!(&self.image, Some((_, w, h)) if *w == width && *h == height);
         if !reuse {
-            let b = storage(
-                &self.ctx,
-                "colcos screen image",
-                pixels * 4,
-                wgpu::BufferUsages::empty(),
-            );
+            let b = self.ctx.scoped("allocating the screen image", || {
+                storage(
+                    &self.ctx,
+                    "colcos screen image",
+                    pixels * 4,
+                    wgpu::BufferUsages::empty(),
+                )
+            })?;
             self.image = Some((b, width, height));
         }
         let (gx, gy) = groups(pixels as usize, 256);
@@ -510,12 +543,14 @@ impl GpuScreen {
                 "sensor query for a world the scene does not have".into(),
             ));
         }
-        let out = storage(
-            &self.ctx,
-            "colcos sensor sums",
-            n as u64 * 12,
-            wgpu::BufferUsages::empty(),
-        );
+        let out = self.ctx.scoped("allocating the sensor sums", || {
+            storage(
+                &self.ctx,
+                "colcos sensor sums",
+                n as u64 * 12,
+                wgpu::BufferUsages::empty(),
+            )
+        })?;
         let (gx, gy) = groups(n, 64);
         let spec = grids.map(|g| *g.spec());
         let ps = screen.pixel_size();

@@ -120,7 +120,7 @@ fn check_screen_and_sensors(name: &str, text: &str, steps: usize, sizes: &[(u32,
         world.step();
     }
     let (grids, scene) = upload(ctx.clone(), &world);
-    let mut gs = GpuScreen::new(ctx.clone());
+    let mut gs = GpuScreen::new(ctx.clone()).expect("screen pipelines");
     for &(w, h) in sizes {
         let cpu = screen::render(world.pheromones(), world.screen(), w, h);
         let gpu = gs

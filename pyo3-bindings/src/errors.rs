@@ -34,6 +34,18 @@ create_exception!(
     ColcosError,
     "A call that is not valid now (e.g. step before reset)."
 );
+create_exception!(
+    colcos,
+    BackendError,
+    ColcosError,
+    "The field backend asked for cannot be used (e.g. backend=\"gpu\" where there is no GPU adapter)."
+);
+create_exception!(
+    colcos,
+    DisplayError,
+    ColcosError,
+    "No window can be opened (no X/Wayland display, no GPU adapter for it, or built without it)."
+);
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -42,6 +54,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("TaskError", py.get_type::<TaskError>())?;
     m.add("ActionError", py.get_type::<ActionError>())?;
     m.add("StateError", py.get_type::<StateError>())?;
+    m.add("BackendError", py.get_type::<BackendError>())?;
+    m.add("DisplayError", py.get_type::<DisplayError>())?;
     Ok(())
 }
 
@@ -53,5 +67,6 @@ pub fn to_py(e: EnvError) -> PyErr {
         EnvError::UnknownTask { .. } | EnvError::Param { .. } => TaskError::new_err(msg),
         EnvError::Action(_) => ActionError::new_err(msg),
         EnvError::State(_) => StateError::new_err(msg),
+        EnvError::Backend(_) => BackendError::new_err(msg),
     }
 }

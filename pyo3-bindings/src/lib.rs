@@ -7,6 +7,7 @@ mod baseline;
 mod errors;
 mod registry;
 mod vec_env;
+mod window;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -14,6 +15,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     vec_env::register(m)?;
     baseline::register(m)?;
     registry::register(m)?;
+    window::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

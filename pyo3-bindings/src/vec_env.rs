@@ -71,7 +71,7 @@ unsafe fn view<'py, T: Element>(
 #[pymethods]
 impl PyVecEnv {
     #[new]
-    #[pyo3(signature = (task, num_envs=1, seed=0, num_threads=None, scenario=None, scenario_text=None, max_cycles=0, action="continuous", autoreset_mode="next_step", global_state=true, patch_pixels=None, patch_side=0.08, params_json=None))]
+    #[pyo3(signature = (task, num_envs=1, seed=0, num_threads=None, scenario=None, scenario_text=None, max_cycles=0, action="continuous", autoreset_mode="next_step", global_state=true, patch_pixels=None, patch_side=0.08, params_json=None, backend=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         task: &str,
@@ -87,6 +87,7 @@ impl PyVecEnv {
         patch_pixels: Option<usize>,
         patch_side: f32,
         params_json: Option<&str>,
+        backend: Option<&str>,
         py: Python<'_>,
     ) -> PyResult<Self> {
         let mut cfg = EnvConfig::new(task);
@@ -113,6 +114,10 @@ impl PyVecEnv {
         cfg.action = action.parse::<ActionKind>().map_err(to_py)?;
         cfg.autoreset = autoreset_mode.parse::<AutoresetMode>().map_err(to_py)?;
         cfg.global_state = global_state;
+        cfg.backend = backend
+            .map(|b| b.parse::<colcos_sim::field::BackendChoice>())
+            .transpose()
+            .map_err(|e| TaskError::new_err(format!("backend: {e}")))?;
         cfg.patch = patch_pixels.map(|pixels| PatchConfig {
             pixels,
             side: patch_side,
@@ -325,6 +330,18 @@ impl PyVecEnv {
         (0..w.robot_count())
             .map(|i| w.role(i).to_string())
             .collect()
+    }
+
+    /// What steps the grid pheromones: `"cpu"` or `"gpu"`.
+    #[getter]
+    fn backend_name(&self) -> &'static str {
+        self.lock().env.backend().name()
+    }
+
+    /// One line on the field backend: `gpu: <adapter>` or `cpu (<why>)`.
+    #[getter]
+    fn backend_info(&self) -> String {
+        self.lock().env.backend().describe().to_string()
     }
 
     /// The scenario actually used, as TOML.

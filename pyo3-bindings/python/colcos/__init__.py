@@ -20,7 +20,9 @@ from __future__ import annotations
 from colcos import _core
 from colcos._core import (
     ActionError,
+    BackendError,
     ColcosError,
+    DisplayError,
     ScenarioError,
     StateError,
     TaskError,
@@ -34,7 +36,9 @@ __version__ = _core.__version__
 
 __all__ = [
     "ActionError",
+    "BackendError",
     "ColcosError",
+    "DisplayError",
     "ColcosParallelEnv",
     "ScenarioError",
     "StateError",

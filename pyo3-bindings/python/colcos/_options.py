@@ -3,13 +3,20 @@
 from __future__ import annotations
 
 import json
+import logging
 import os
+import warnings
 from typing import Any
 
 import numpy as np
 from gymnasium import spaces
 
+from colcos import _core
 from colcos._core import TaskError
+
+log = logging.getLogger("colcos")
+
+BACKENDS = ("cpu", "gpu", "auto")
 
 
 def core_kwargs(
@@ -21,6 +28,7 @@ def core_kwargs(
     patch: int | None,
     patch_side: float,
     params: dict[str, Any],
+    backend: str | None = None,
 ) -> dict[str, Any]:
     """Keyword arguments of `colcos._core.VecEnv` (all but num_envs, seed, threads, autoreset)."""
     if not isinstance(task, str):
@@ -43,6 +51,10 @@ def core_kwargs(
     if patch is not None:
         kw["patch_pixels"] = int(patch)
         kw["patch_side"] = float(patch_side)
+    if backend is not None:
+        if not isinstance(backend, str) or backend.lower() not in BACKENDS:
+            raise TaskError(f"backend must be one of {BACKENDS} (or None: the scenario's [field] backend), got {backend!r}")
+        kw["backend"] = backend.lower()
     if params:
         try:
             kw["params_json"] = json.dumps(params)
@@ -57,3 +69,52 @@ def make_space(d: dict[str, Any]) -> spaces.Space:
         return spaces.Discrete(int(d["n"]))
     dtype = np.float32 if d["dtype"] == "float32" else np.uint8
     return spaces.Box(low=d["low"], high=d["high"], shape=tuple(d["shape"]), dtype=dtype)
+
+
+def log_backend(core: Any, asked: str | None) -> None:
+    """One log line on the field backend the environment took (`colcos` logger, INFO)."""
+    log.info("field backend%s: %s", f" ({asked} asked for)" if asked else "", core.backend_info)
+
+
+class HumanWindow:
+    """The window of `render_mode="human"`: opened at the first frame, paced to the field's rate.
+
+    Where no window can be opened (no display, built without it) it warns once and shows nothing, so
+    that code written for a desktop still runs headless.
+    """
+
+    def __init__(self, title: str, fps: float) -> None:
+        self.title = title
+        self.fps = fps
+        self.window: Any = None
+        self.failed = False
+        self.shown_key: Any = None
+
+    def show(self, frame: np.ndarray, key: Any = None) -> None:
+        """Shows `frame` (H, W, 3) uint8, unless `key` is that of the frame shown last."""
+        if self.failed or (key is not None and key == self.shown_key):
+            return
+        self.shown_key = key
+        if self.window is None:
+            try:
+                self.window = _core.Window(frame.shape[1], frame.shape[0], title=self.title, fps=self.fps)
+            except _core.DisplayError as e:
+                self.failed = True
+                warnings.warn(f"render_mode='human': no window ({e}); frames are not shown", RuntimeWarning, stacklevel=3)
+                return
+        self.window.show(frame)
+
+    @property
+    def presented(self) -> int:
+        """Frames the window has presented (0 before it opens)."""
+        return 0 if self.window is None else int(self.window.presented)
+
+    @property
+    def is_open(self) -> bool:
+        return self.window is not None and bool(self.window.is_open)
+
+    def close(self) -> None:
+        if self.window is not None:
+            self.window.close()
+            self.window = None
+        self.shown_key = None

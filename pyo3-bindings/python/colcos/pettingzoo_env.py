@@ -14,7 +14,7 @@ from pettingzoo.utils.conversions import parallel_to_aec_wrapper
 
 from colcos import _core
 from colcos._core import ActionError, StateError
-from colcos._options import core_kwargs, make_space
+from colcos._options import HumanWindow, core_kwargs, log_backend, make_space
 
 RENDER_WIDTH = 640
 
@@ -29,11 +29,18 @@ class ColcosParallelEnv(ParallelEnv):
         task: `"aggregation"`, `"foraging"` or `"trail"` (see `colcos.tasks()`).
         scenario: a scenario file (path) or scenario TOML text; default: the task's own.
         max_cycles: steps per episode before truncation (default: the scenario's duration / dt).
-        render_mode: None, `"human"` or `"rgb_array"` (the screen with the robots drawn on it).
+        render_mode: None, `"human"` (a window showing the screen with the robots, at the field's
+            rate, updated by every `reset` and `step`; `close()` closes it) or `"rgb_array"` (that
+            image as an array).
         continuous: two wheel speeds in [-1, 1] (True) or `Discrete(6)` (False).
         global_state: offer `state()` (all robot poses) for centralised critics.
         patch: if set, each observation is a dict with `"vector"` and an egocentric `"patch"` of the
             screen, `patch x patch x 3` uint8, covering `patch_side` m under and ahead of the robot.
+        backend: field backend of the grid pheromones: `"cpu"`, `"gpu"` (an error,
+            `colcos.BackendError`, where there is no GPU adapter) or `"auto"` (a hardware GPU if there
+            is one, else the CPU); None: the scenario's `[field] backend` (default `cpu`). What was
+            taken is in `backend_name` (`"cpu"` / `"gpu"`) and `backend_info`, and logged (logger
+            `colcos`, INFO).
         **params: task parameters (see the task's docs); unknown ones raise `colcos.TaskError`.
     """
 
@@ -55,16 +62,18 @@ class ColcosParallelEnv(ParallelEnv):
         patch: int | None = None,
         patch_side: float = 0.08,
         seed: int = 0,
+        backend: str | None = None,
         **params: Any,
     ) -> None:
         self._init_kwargs = dict(
             task=task, scenario=scenario, max_cycles=max_cycles, render_mode=render_mode, continuous=continuous,
-            global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, **params,
+            global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, backend=backend, **params,
         )
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise _core.TaskError(f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']} or None")
-        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params)
+        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend)
         self._core = _core.VecEnv(num_envs=1, seed=int(seed), num_threads=1, autoreset_mode="disabled", **kw)
+        log_backend(self._core, backend)
         spec = self._core.spec()
         self._spec = spec
         self.metadata = dict(self.metadata, name=spec["env_name"])
@@ -88,6 +97,24 @@ class ColcosParallelEnv(ParallelEnv):
         n = len(self.possible_agents)
         self._actions = np.zeros((1, n, 2), np.float32) if self._continuous else np.zeros((1, n), np.int64)
         self._needs_reset = True
+        self._window: HumanWindow | None = None
+        if render_mode == "human":
+            self._window = HumanWindow(f"colcos: {spec['env_name']}", 1.0 / spec["dt"])
+
+    @property
+    def backend_name(self) -> str:
+        """What steps the grid pheromones: `"cpu"` or `"gpu"`."""
+        return self._core.backend_name
+
+    @property
+    def backend_info(self) -> str:
+        """One line on the field backend: `gpu: <adapter>` or `cpu (<why>)`."""
+        return self._core.backend_info
+
+    def _show(self) -> None:
+        if self._window is not None:
+            key = (self._core.episode(0), self._core.episode_steps(0))
+            self._window.show(self._core.render(0, RENDER_WIDTH), key)
 
     def __getstate__(self) -> dict[str, Any]:
         # Pickling (SuperSuit, multiprocessing) rebuilds the env from its arguments: a fresh copy that
@@ -119,6 +146,9 @@ class ColcosParallelEnv(ParallelEnv):
         self._core.reset(seed)
         self.agents = self.possible_agents[:]
         self._needs_reset = False
+        if self._window is not None:
+            self._window.shown_key = None
+            self._show()
         return {a: self._obs(i) for i, a in enumerate(self.agents)}, {a: {} for a in self.agents}
 
     def step(self, actions: dict[str, Any]) -> tuple[dict, dict, dict, dict, dict]:
@@ -171,6 +201,7 @@ class ColcosParallelEnv(ParallelEnv):
             if not (t or u):
                 live.append(a)
         self.agents = live
+        self._show()
         return obs, rewards, terminations, truncations, infos
 
     def state(self) -> np.ndarray:
@@ -183,14 +214,17 @@ class ColcosParallelEnv(ParallelEnv):
         if mode is None:
             warnings.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human'", stacklevel=2)
             return None
-        frame = self._core.render(0, RENDER_WIDTH)
         if mode == "rgb_array":
-            return frame
-        self._last_frame = frame  # "human": no window on a headless machine; keep the frame for viewers
+            return self._core.render(0, RENDER_WIDTH)
+        if self._window is None:
+            self._window = HumanWindow(f"colcos: {self._spec['env_name']}", 1.0 / self._spec["dt"])
+        self._show()  # the frame of this step, if reset/step has not shown it yet
         return None
 
     def close(self) -> None:
-        pass
+        """Closes the `render_mode="human"` window, if one is open."""
+        if self._window is not None:
+            self._window.close()
 
     def poses(self) -> np.ndarray:
         """True poses (R, 3): x m, y m, heading rad, of every robot (for analysis, not for policies)."""

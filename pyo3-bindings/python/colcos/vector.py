@@ -23,7 +23,7 @@ from gymnasium import spaces
 
 from colcos import _core
 from colcos._core import ActionError
-from colcos._options import core_kwargs, make_space
+from colcos._options import HumanWindow, core_kwargs, log_backend, make_space
 
 __all__ = ["VecEnv"]
 
@@ -41,6 +41,10 @@ class VecEnv:
         scenario, max_cycles, continuous, global_state, patch, patch_side, **params: as for
             `colcos.parallel_env`.
         autoreset_mode: `"next_step"`, `"same_step"` or `"disabled"`.
+        backend: field backend of the grid pheromones, `"cpu"`, `"gpu"` or `"auto"` (None: the
+            scenario's `[field] backend`), as for `colcos.parallel_env`; see `backend_name`.
+        render_mode: None, `"rgb_array"` or `"human"` (a window showing world 0 with its robots,
+            updated by every `reset` and `step`, at the field's rate; `close()` closes it).
     """
 
     def __init__(
@@ -56,8 +60,12 @@ class VecEnv:
         global_state: bool = True,
         patch: int | None = None,
         patch_side: float = 0.08,
+        backend: str | None = None,
+        render_mode: str | None = None,
         **params: Any,
     ) -> None:
+        if render_mode not in (None, "rgb_array", "human"):
+            raise _core.TaskError(f"render_mode {render_mode!r} is not one of ['human', 'rgb_array'] or None")
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise _core.TaskError(f"num_envs must be a positive integer, got {num_envs!r}")
         if num_threads is not None and (not isinstance(num_threads, (int, np.integer)) or num_threads < 1):
@@ -67,13 +75,16 @@ class VecEnv:
         self._init_kwargs = dict(
             task=task, num_envs=num_envs, seed=seed, num_threads=num_threads, scenario=scenario, max_cycles=max_cycles,
             continuous=continuous, autoreset_mode=autoreset_mode, global_state=global_state, patch=patch,
-            patch_side=patch_side, **params,
+            patch_side=patch_side, backend=backend, render_mode=render_mode, **params,
         )
-        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params)
+        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend)
         self._core = _core.VecEnv(
             num_envs=int(num_envs), seed=int(seed), num_threads=num_threads, autoreset_mode=autoreset_mode, **kw
         )
+        log_backend(self._core, backend)
         self.spec: dict[str, Any] = self._core.spec()
+        self.render_mode = render_mode
+        self._window = HumanWindow(f"colcos: {self.spec['env_name']}", 1.0 / self.spec["dt"]) if render_mode == "human" else None
         self.task = task
         self.num_envs: int = self.spec["num_envs"]
         self.num_agents: int = self.spec["num_agents"]
@@ -113,6 +124,8 @@ class VecEnv:
         if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
             raise _core.TaskError(f"seed must be a non-negative integer, got {seed!r}")
         self._core.reset(None if seed is None else int(seed), mask)
+        if self._window is not None:
+            self._window.show(self._core.render(0, 640))
         return self.obs, self._infos()
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
@@ -132,7 +145,19 @@ class VecEnv:
         if a.shape != self._act_shape:
             raise ActionError(f"actions have shape {a.shape}, expected {self._act_shape}")
         self._core.step(a)
+        if self._window is not None:
+            self._window.show(self._core.render(0, 640))
         return self.obs, self.rewards, self.terminated, self.truncated, self._infos()
+
+    @property
+    def backend_name(self) -> str:
+        """What steps the grid pheromones: `"cpu"` or `"gpu"`."""
+        return self._core.backend_name
+
+    @property
+    def backend_info(self) -> str:
+        """One line on the field backend: `gpu: <adapter>` or `cpu (<why>)`."""
+        return self._core.backend_info
 
     def _infos(self) -> dict:
         infos: dict[str, Any] = {}
@@ -157,4 +182,6 @@ class VecEnv:
         return self._core.poses(world)
 
     def close(self) -> None:
-        pass
+        """Closes the `render_mode="human"` window, if one is open."""
+        if self._window is not None:
+            self._window.close()
