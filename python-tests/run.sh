@@ -40,7 +40,8 @@ if [ "$peers" != 1 ]; then
     make_venv venv-core "$here/requirements-core.txt"
     t2=$(stamp); echo "   installed in $((t2 - t1)) s"
     "$work/venv-core/bin/python" -m pytest -q -p no:cacheprovider \
-        test_pettingzoo.py test_errors.py test_vector.py test_determinism.py "$@" || status=1
+        test_pettingzoo.py test_errors.py test_vector.py test_determinism.py \
+        test_backend.py test_render_human.py "$@" || status=1
     echo "== python part done in $(( $(stamp) - t0 )) s (status $status)"
     exit $status
 fi
