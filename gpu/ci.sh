@@ -14,11 +14,19 @@ if [ "${COLCOS_CI_SKIP_APT:-0}" != 1 ]; then
 fi
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 export COLCOS_REQUIRE_GPU=1 COLCOS_REQUIRE_DISPLAY=1
-# GPU against CPU: every scheme and option, screens and sensors of both case studies, worlds.
+# GPU against CPU: every scheme and option, screens and sensors of both case studies, worlds; wgpu
+# errors and a lost device as Err values.
 cargo test --release -p colcos-gpu -- --test-threads=1
+# A vector env's worlds on the GPU (the scenario's [field] backend): the CPU's observations.
+cargo test --release -p colcos-env --features gpu --test backend -- --test-threads=1
 # The window under Xvfb: screenshot against the headless PNG.
 xvfb-run -a -s "-screen 0 640x480x24" cargo test --release -p colcos-display -- --test-threads=1
 # The CLI: `gpu` on lavapipe works, `auto` prefers the CPU over a software adapter.
 cargo run --release -q -- run scenarios/three_trails.toml --duration 0.2 --backend gpu --quiet --out target/ci-gpu-run
 cargo run --release -q -- run scenarios/three_trails.toml --duration 0.2 --backend auto --quiet --out target/ci-auto-run | grep -q "field backend: cpu"
 cargo run --release -q -- display scenarios/three_trails.toml --png target/ci-display.png --size 480x270 --seconds 0.1
+# The window with the GPU backend presents with the backend's device and the GPU-composed screen.
+xvfb-run -a -s "-screen 0 640x480x24" cargo run --release -q -- display scenarios/three_trails.toml \
+    --backend gpu --size 480x270 --close-after 2 2>&1 | tee target/ci-display-gpu.log
+grep -q "screen composed on the GPU" target/ci-display-gpu.log
+grep -q "the device of the field backend" target/ci-display-gpu.log

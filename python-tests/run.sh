@@ -63,7 +63,8 @@ if [ "${COLCOS_PY_PEERS:-1}" = 0 ]; then
     make_venv venv-core "$here/requirements-core.txt"
     lap "installed"
     "$work/venv-core/bin/python" -m pytest -q -p no:cacheprovider \
-        test_pettingzoo.py test_errors.py test_vector.py test_determinism.py "$@" || status=1
+        test_pettingzoo.py test_errors.py test_vector.py test_determinism.py \
+        test_backend.py test_render_human.py "$@" || status=1
     lap "core suites"
     echo "== python part done in $(($(stamp) - t0)) s (status $status)"
     exit $status

@@ -2,7 +2,9 @@
 //! `EnvConfig::backend`). With the `gpu` feature (`cargo test -p colcos-env --features gpu`): `gpu`
 //! runs on any adapter and gives the CPU's observations, also in worlds rebuilt by autoreset; without
 //! it, `gpu` is an error and `auto` the CPU.
-use colcos_env::{Actions, EnvConfig, EnvError, ScenarioSource, VecEnv};
+#[cfg(feature = "gpu")]
+use colcos_env::{Actions, ScenarioSource};
+use colcos_env::{EnvConfig, EnvError, VecEnv};
 use colcos_sim::field::BackendChoice;
 
 fn cfg(task: &str, backend: Option<BackendChoice>) -> EnvConfig {

@@ -100,7 +100,12 @@ class HumanWindow:
                 self.window = _core.Window(frame.shape[1], frame.shape[0], title=self.title, fps=self.fps)
             except _core.DisplayError as e:
                 self.failed = True
-                warnings.warn(f"render_mode='human': no window ({e}); frames are not shown", RuntimeWarning, stacklevel=3)
+                warnings.warn(
+                    f"render_mode='human': no window can be opened ({e}); frames are not shown "
+                    "(render_mode='rgb_array' gives them as arrays)",
+                    RuntimeWarning,
+                    stacklevel=4,
+                )
                 return
         self.window.show(frame)
 
