@@ -304,15 +304,20 @@ impl Presenter {
         (texture, bind)
     }
 
-    /// Uploads an RGBA8 image of `size` (replacing the texture when the size changes).
-    pub fn upload(&mut self, rgba: &[u8], size: (u32, u32)) {
+    /// Replaces the texture when `size` changes; false for an empty image (nothing to copy).
+    fn fit_texture(&mut self, size: (u32, u32)) -> bool {
         if size != self.size {
             let (t, b) = Self::make_texture(&self.device, &self.layout, &self.uniform, size);
             self.texture = t;
             self.bind = b;
             self.size = size;
         }
-        if size.0 == 0 || size.1 == 0 {
+        size.0 != 0 && size.1 != 0
+    }
+
+    /// Uploads an RGBA8 image of `size` (replacing the texture when the size changes).
+    pub fn upload(&mut self, rgba: &[u8], size: (u32, u32)) {
+        if !self.fit_texture(size) {
             return;
         }
         self.queue.write_texture(
@@ -339,13 +344,7 @@ impl Presenter {
     /// Copies an image of `size` from `buffer` (packed RGBA8, on this presenter's device) into the
     /// texture, on the GPU.
     pub fn upload_buffer(&mut self, buffer: &wgpu::Buffer, size: (u32, u32)) {
-        if size != self.size {
-            let (t, b) = Self::make_texture(&self.device, &self.layout, &self.uniform, size);
-            self.texture = t;
-            self.bind = b;
-            self.size = size;
-        }
-        if size.0 == 0 || size.1 == 0 {
+        if !self.fit_texture(size) {
             return;
         }
         let row = 4 * size.0;

@@ -123,3 +123,19 @@ class HumanWindow:
             self.window.close()
             self.window = None
         self.shown_key = None
+
+
+class BackendInfo:
+    """`backend_name` / `backend_info` of an environment whose native core is `self._core`."""
+
+    _core: Any
+
+    @property
+    def backend_name(self) -> str:
+        """What steps the grid pheromones: `"cpu"` or `"gpu"`."""
+        return self._core.backend_name
+
+    @property
+    def backend_info(self) -> str:
+        """One line on the field backend: `gpu: <adapter>` or `cpu (<why>)`."""
+        return self._core.backend_info

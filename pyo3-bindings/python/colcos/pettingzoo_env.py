@@ -14,12 +14,12 @@ from pettingzoo.utils.conversions import parallel_to_aec_wrapper
 
 from colcos import _core
 from colcos._core import ActionError, StateError
-from colcos._options import HumanWindow, core_kwargs, log_backend, make_space
+from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_space
 
 RENDER_WIDTH = 640
 
 
-class ColcosParallelEnv(ParallelEnv):
+class ColcosParallelEnv(BackendInfo, ParallelEnv):
     """A colcos task as a PettingZoo `ParallelEnv`: one world, agents `robot_0..`.
 
     Built on the batched core with one world, so a run here and world 0 of `colcos.vector.VecEnv`
@@ -100,16 +100,6 @@ class ColcosParallelEnv(ParallelEnv):
         self._window: HumanWindow | None = None
         if render_mode == "human":
             self._window = HumanWindow(f"colcos: {spec['env_name']}", 1.0 / spec["dt"])
-
-    @property
-    def backend_name(self) -> str:
-        """What steps the grid pheromones: `"cpu"` or `"gpu"`."""
-        return self._core.backend_name
-
-    @property
-    def backend_info(self) -> str:
-        """One line on the field backend: `gpu: <adapter>` or `cpu (<why>)`."""
-        return self._core.backend_info
 
     def _show(self) -> None:
         if self._window is not None:

@@ -23,14 +23,14 @@ from gymnasium import spaces
 
 from colcos import _core
 from colcos._core import ActionError
-from colcos._options import HumanWindow, core_kwargs, log_backend, make_space
+from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_space
 
 __all__ = ["VecEnv"]
 
 AUTORESET_MODES = ("next_step", "same_step", "disabled")
 
 
-class VecEnv:
+class VecEnv(BackendInfo):
     """`num_envs` worlds of one task, batched.
 
     Args:
@@ -148,16 +148,6 @@ class VecEnv:
         if self._window is not None:
             self._window.show(self._core.render(0, 640))
         return self.obs, self.rewards, self.terminated, self.truncated, self._infos()
-
-    @property
-    def backend_name(self) -> str:
-        """What steps the grid pheromones: `"cpu"` or `"gpu"`."""
-        return self._core.backend_name
-
-    @property
-    def backend_info(self) -> str:
-        """One line on the field backend: `gpu: <adapter>` or `cpu (<why>)`."""
-        return self._core.backend_info
 
     def _infos(self) -> dict:
         infos: dict[str, Any] = {}
