@@ -130,6 +130,7 @@ impl World {
             command_buffer: Vec::new(),
             velocities: Vec::new(),
             positions: Vec::new(),
+            sensor_points: Vec::new(),
             field_backend: None,
         };
         world.inject();

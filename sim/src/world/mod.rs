@@ -74,6 +74,8 @@ pub struct World {
     command_buffer: Vec<WheelCommand>,
     velocities: Vec<(f32, f32)>,
     positions: Vec<Vec2>,
+    /// Scratch: the four sensor positions of every robot, refreshed by each observation.
+    sensor_points: Vec<[Vec2; 4]>,
     /// Steps the pheromones instead of the CPU when set (e.g. the GPU backend of `colcos-gpu`).
     field_backend: Option<Box<dyn crate::field::FieldBackend>>,
 }

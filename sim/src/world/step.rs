@@ -84,6 +84,11 @@ impl World {
         self.positions.clear();
         self.positions.extend(poses.iter().map(|p| p.pos));
         self.neighbours.rebuild(self.arena, cell, &self.positions);
+        // Sensor positions once per robot: sensing reads robot i's, prefetching robot i + 1's.
+        self.sensor_points.clear();
+        self.sensor_points
+            .extend(poses.iter().map(|p| sensor_positions(p, SENSOR_RADIUS)));
+        let sensor_points = &self.sensor_points;
         let (pheromones, screen, sensor, neighbours) = (
             &self.pheromones,
             &self.screen,
@@ -97,11 +102,14 @@ impl World {
             self.time,
         );
         let footprint = sensor.params.footprint_radius;
+        let any_grid = pheromones
+            .iter()
+            .any(|ph| matches!(ph.model, FieldModel::Grid(_)));
         let sense = |(i, (slot, obs)): (usize, (&mut super::RobotSlot, &mut Observation))| {
             // The grid cells under the next robot's sensors are scattered over large fields: ask for
             // them now so that their cache misses overlap with this robot's work.
-            if let Some(next) = poses.get(i + 1) {
-                for p in sensor_positions(next, SENSOR_RADIUS) {
+            if let Some(next) = sensor_points.get(i + 1).filter(|_| any_grid) {
+                for &p in next {
                     for ph in pheromones {
                         if let FieldModel::Grid(g) = &ph.model {
                             g.prefetch_around(p, footprint);
@@ -114,10 +122,7 @@ impl World {
                 last_command: slot.command,
                 ..Observation::default()
             };
-            for (n, p) in sensor_positions(&poses[i], SENSOR_RADIUS)
-                .into_iter()
-                .enumerate()
-            {
+            for (n, &p) in sensor_points[i].iter().enumerate() {
                 o.counts[n] = sensor.read(pheromones, screen, p, &mut slot.rng);
                 o.intensity[n] = sensor.intensity(o.counts[n]);
             }
