@@ -23,7 +23,10 @@ cargo test --release -p colcos-env --features gpu --test backend -- --test-threa
 xvfb-run -a -s "-screen 0 640x480x24" cargo test --release -p colcos-display -- --test-threads=1
 # The CLI: `gpu` on lavapipe works, `auto` prefers the CPU over a software adapter.
 cargo run --release -q -- run scenarios/three_trails.toml --duration 0.2 --backend gpu --quiet --out target/ci-gpu-run
-cargo run --release -q -- run scenarios/three_trails.toml --duration 0.2 --backend auto --quiet --out target/ci-auto-run | grep -q "field backend: cpu"
+# (the report goes to a file first: `grep -q` stops reading at its first match)
+cargo run --release -q -- run scenarios/three_trails.toml --duration 0.2 --backend auto --quiet --out target/ci-auto-run \
+    > target/ci-auto-run.log
+grep -q "field backend: cpu" target/ci-auto-run.log
 cargo run --release -q -- display scenarios/three_trails.toml --png target/ci-display.png --size 480x270 --seconds 0.1
 # The window with the GPU backend presents with the backend's device and the GPU-composed screen.
 xvfb-run -a -s "-screen 0 640x480x24" cargo run --release -q -- display scenarios/three_trails.toml \

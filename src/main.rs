@@ -3,6 +3,8 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use colcos::run::{RunOptions, run};
 use colcos::sim::prelude::*;
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -63,8 +65,25 @@ fn main() -> ExitCode {
     }
 }
 
+/// Prints a command's report. A reader that went away (`colcos run ... | grep -q`) is not an error:
+/// `println!` would panic on the broken pipe after the run's files were already written.
+fn print_report(text: &str) -> Result<()> {
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(e).context("writing the report to stdout")
+        }
+        _ => Ok(()),
+    }
+}
+
 fn real_main() -> Result<()> {
-    match Cli::parse().command {
+    let mut out = String::new();
+    run_command(Cli::parse().command, &mut out)?;
+    print_report(&out)
+}
+
+fn run_command(command: Command, text: &mut String) -> Result<()> {
+    match command {
         Command::Display(args) => colcos::display::main(args),
         Command::Experiment(args) => colcos::experiment::main(args),
         Command::Run {
@@ -97,25 +116,27 @@ fn real_main() -> Result<()> {
                     no_gif: false,
                 },
             )?;
-            println!("field backend: {}", report.backend);
-            println!(
+            writeln!(text, "field backend: {}", report.backend)?;
+            writeln!(
+                text,
                 "{} robots, {} steps ({} s simulated) in {:.2} s: {:.1}x real time",
                 report.robots,
                 report.steps,
                 report.sim_seconds,
                 report.wall_seconds,
                 report.real_time_factor()
-            );
+            )?;
             for f in &report.files {
-                println!("  wrote {}", f.display());
+                writeln!(text, "  wrote {}", f.display())?;
             }
             Ok(())
         }
         Command::Check { scenario } => {
             let sc = Scenario::from_file(&scenario)?;
             let a = sc.arena_size();
-            println!("{}: ok", scenario.display());
-            println!(
+            writeln!(text, "{}: ok", scenario.display())?;
+            writeln!(
+                text,
                 "  arena {} x {} m, {} s at dt {} s ({} steps), seed {}",
                 a.x,
                 a.y,
@@ -123,24 +144,26 @@ fn real_main() -> Result<()> {
                 sc.spec.dt,
                 sc.steps(),
                 sc.spec.seed
-            );
+            )?;
             for p in &sc.spec.pheromones {
-                println!(
+                writeln!(
+                    text,
                     "  pheromone {:?}: {:?} model, colour {:?}",
                     p.name, p.model, p.colour
-                );
+                )?;
             }
             for g in &sc.spec.robots {
-                println!(
+                writeln!(
+                    text,
                     "  {} robot(s), role {:?}, behaviour {:?}",
                     g.count, g.role, g.behaviour
-                );
+                )?;
             }
             Ok(())
         }
         Command::Behaviours => {
             for (name, about) in colcos::sim::behaviour::registry::list() {
-                println!("{name:10} {about}");
+                writeln!(text, "{name:10} {about}")?;
             }
             Ok(())
         }
