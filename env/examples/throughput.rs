@@ -1,5 +1,6 @@
-//! Batched throughput with random actions: `cargo run --release -p colcos-env --example throughput -- aggregation 1024 2000`.
-use colcos_env::{Actions, EnvConfig, VecEnv};
+//! Batched throughput with random actions:
+//! `cargo run --release -p colcos-env --example throughput -- aggregation 1024 2000 [SCENARIO.toml]`.
+use colcos_env::{Actions, EnvConfig, ScenarioSource, VecEnv};
 use rand::{RngExt, SeedableRng};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -9,6 +10,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let steps: usize = args.get(3).map_or(Ok(500), |s| s.parse())?;
     let mut cfg = EnvConfig::new(task);
     cfg.num_envs = num_envs;
+    if let Some(path) = args.get(4) {
+        cfg.scenario = ScenarioSource::File(path.into());
+    }
     cfg.max_cycles = 500;
     let t0 = std::time::Instant::now();
     let mut env = VecEnv::new(&cfg)?;

@@ -1,6 +1,8 @@
 //! The screen, eq. (1): I(x, y, c) = clip(sum_j k_j Phi_j(x, y)) as 8-bit RGB at the panel's resolution.
 use crate::error::{Result, SimError};
-use crate::field::{BLOCK, Bilinear, FieldModel, GridSpec, Pheromone, bilinear_mix};
+use crate::field::{
+    BLOCK, Bilinear, FieldModel, FrozenSources, GridSpec, Pheromone, bilinear_mix, frozen_values_at,
+};
 use glam::Vec2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -84,11 +86,22 @@ pub fn pixel_at(pheromones: &[Pheromone], screen: &ScreenSpec, p: Vec2) -> [u8; 
     pixels_at(pheromones, screen, &[p])[0]
 }
 
-/// Eq. (1) at the pixels that show each of `points` (a sensor's footprint): the pixel centres and the
-/// grids' interpolation weights are computed once per point and shared by every field on the same
-/// grid, and each Gaussian source's time factors once per call. Same values as [`pixel_at`] per point.
+/// Eq. (1) at the pixels that show each of `points` (a sensor's footprint). Same values as
+/// [`pixel_at`] per point; see [`pixels_at_frozen`].
 pub fn pixels_at<const N: usize>(
     pheromones: &[Pheromone],
+    screen: &ScreenSpec,
+    points: &[Vec2; N],
+) -> [[u8; 3]; N] {
+    pixels_at_frozen(pheromones, &FrozenSources::new(pheromones), screen, points)
+}
+
+/// [`pixels_at`] with the Gaussian sources already frozen at the fields' time (`frozen` must come from
+/// these `pheromones` as they are now). The pixel centres and the grids' interpolation weights are
+/// computed once per point and shared by every field on the same grid.
+pub fn pixels_at_frozen<const N: usize>(
+    pheromones: &[Pheromone],
+    frozen: &FrozenSources,
     screen: &ScreenSpec,
     points: &[Vec2; N],
 ) -> [[u8; 3]; N] {
@@ -103,7 +116,7 @@ pub fn pixels_at<const N: usize>(
     let mut weights = [Bilinear::default(); N];
     let mut block = None;
     let mut values = [0f32; N];
-    for ph in pheromones {
+    for (index, ph) in pheromones.iter().enumerate() {
         match &ph.model {
             FieldModel::Grid(g) => {
                 let spec = *g.spec();
@@ -133,7 +146,7 @@ pub fn pixels_at<const N: usize>(
                     }
                 }
             }
-            FieldModel::Gaussian(g) => g.values_at(&centres, &mut values),
+            FieldModel::Gaussian(_) => frozen_values_at(frozen.of(index), &centres, &mut values),
         }
         for (a, &v) in acc.iter_mut().zip(&values) {
             a[0] += ph.colour[0] * v;

@@ -2,6 +2,7 @@
 //! and static injection maps. A [`Pheromone`] is one named field with its drawing colour.
 
 mod backend;
+mod frozen;
 mod gaussian;
 mod grid;
 mod kernel;
@@ -9,7 +10,8 @@ mod pheromone;
 mod static_map;
 
 pub use backend::{BackendChoice, FieldBackend};
-pub use gaussian::{FrozenSource, GaussianField, GaussianSource};
+pub use frozen::FrozenSources;
+pub use gaussian::{FrozenSource, GaussianField, GaussianSource, frozen_values_at};
 pub(crate) use grid::lerp_index;
 pub use grid::{
     BLOCK, Bilinear, DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,

@@ -8,7 +8,7 @@
 //! screen gives at most `30 + 1500 * 24 * 1.16 = 41,790` counts (the green row of the crosstalk matrix
 //! sums to 1.16), well below saturation with room for noise; at 40 ms or more white saturates every
 //! channel (`1500 * 40 * 1.11 > 65,535`), as a real TCS34725 does with too long an integration time.
-use crate::field::Pheromone;
+use crate::field::{FrozenSources, Pheromone};
 use crate::rng::SimRng;
 use crate::screen::ScreenSpec;
 use glam::Vec2;
@@ -127,8 +127,21 @@ impl ColourSensor {
         screen: &ScreenSpec,
         p: Vec2,
     ) -> [u32; 3] {
+        self.footprint_sum_frozen(pheromones, &FrozenSources::new(pheromones), screen, p)
+    }
+
+    /// [`ColourSensor::footprint_sum`] with the Gaussian sources frozen once for many sensors.
+    #[inline]
+    pub fn footprint_sum_frozen(
+        &self,
+        pheromones: &[Pheromone],
+        frozen: &FrozenSources,
+        screen: &ScreenSpec,
+        p: Vec2,
+    ) -> [u32; 3] {
         let mut sum = [0u32; 3];
-        for px in crate::screen::pixels_at(pheromones, screen, &self.sample_points(p)) {
+        let points = self.sample_points(p);
+        for px in crate::screen::pixels_at_frozen(pheromones, frozen, screen, &points) {
             for c in 0..3 {
                 sum[c] += px[c] as u32;
             }
@@ -147,15 +160,17 @@ impl ColourSensor {
     }
 
     /// What the sensor at `p` reads: the same as `counts(screen_levels(..))`, with the transfer curve
-    /// from a table.
+    /// from a table. `frozen`: the Gaussian sources of `pheromones` as they are now
+    /// ([`FrozenSources::new`]; a world refreshes one per step for all its sensors).
     pub fn read(
         &self,
         pheromones: &[Pheromone],
+        frozen: &FrozenSources,
         screen: &ScreenSpec,
         p: Vec2,
         rng: &mut SimRng,
     ) -> [u16; 3] {
-        let [r, g, b] = self.footprint_sum(pheromones, screen, p);
+        let [r, g, b] = self.footprint_sum_frozen(pheromones, frozen, screen, p);
         let lut = &self.light_by_sum;
         self.counts_for_light([lut[r as usize], lut[g as usize], lut[b as usize]], rng)
     }
@@ -295,7 +310,11 @@ mod tests {
         for k in 0..500 {
             let p = Vec2::new(k as f32 * 0.0019, 0.25 + 0.2 * (k as f32 * 0.1).sin());
             let want = s.counts(s.screen_levels(&ph, &screen, p), &mut a);
-            assert_eq!(s.read(&ph, &screen, p, &mut b), want, "at {p}");
+            assert_eq!(
+                s.read(&ph, &FrozenSources::new(&ph), &screen, p, &mut b),
+                want,
+                "at {p}"
+            );
             lit += usize::from(want[0] > 1000);
         }
         assert!(lit > 100, "only {lit} readings see the field");

@@ -131,6 +131,7 @@ impl World {
             velocities: Vec::new(),
             positions: Vec::new(),
             sensor_points: Vec::new(),
+            frozen: Default::default(),
             field_backend: None,
         };
         world.inject();

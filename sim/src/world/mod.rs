@@ -76,6 +76,8 @@ pub struct World {
     positions: Vec<Vec2>,
     /// Scratch: the four sensor positions of every robot, refreshed by each observation.
     sensor_points: Vec<[Vec2; 4]>,
+    /// Scratch: the Gaussian sources frozen at the time of the current observation.
+    frozen: crate::field::FrozenSources,
     /// Steps the pheromones instead of the CPU when set (e.g. the GPU backend of `colcos-gpu`).
     field_backend: Option<Box<dyn crate::field::FieldBackend>>,
 }

@@ -88,9 +88,11 @@ impl World {
         self.sensor_points.clear();
         self.sensor_points
             .extend(poses.iter().map(|p| sensor_positions(p, SENSOR_RADIUS)));
+        self.frozen.refresh(&self.pheromones);
         let sensor_points = &self.sensor_points;
-        let (pheromones, screen, sensor, neighbours) = (
+        let (pheromones, frozen, screen, sensor, neighbours) = (
             &self.pheromones,
+            &self.frozen,
             &self.screen,
             &self.sensor,
             &self.neighbours,
@@ -123,7 +125,7 @@ impl World {
                 ..Observation::default()
             };
             for (n, &p) in sensor_points[i].iter().enumerate() {
-                o.counts[n] = sensor.read(pheromones, screen, p, &mut slot.rng);
+                o.counts[n] = sensor.read(pheromones, frozen, screen, p, &mut slot.rng);
                 o.intensity[n] = sensor.intensity(o.counts[n]);
             }
             o.bumpers = neighbours.bumpers(i, poses, radius, arena, bumper);
