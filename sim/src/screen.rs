@@ -1,7 +1,7 @@
 //! The screen, eq. (1): I(x, y, c) = clip(sum_j k_j Phi_j(x, y)) as 8-bit RGB at the panel's resolution.
 use crate::error::{Result, SimError};
 use crate::field::{
-    BLOCK, Bilinear, FieldModel, FrozenSources, GridSpec, Pheromone, bilinear_mix, frozen_values_at,
+    BLOCK, Bilinear, FieldModel, FrozenSources, GridField, GridSpec, Pheromone, bilinear_mix,
 };
 use glam::Vec2;
 use rayon::prelude::*;
@@ -45,40 +45,33 @@ impl ScreenSpec {
     /// [`ScreenSpec::pixel_centre`] with the pixel size computed once by the caller.
     #[inline]
     pub fn pixel_centre_with(&self, ps: Vec2, p: Vec2) -> Vec2 {
-        let k = |v: f32, size: f32, n: u32| -> f32 {
-            let n = n.max(1);
-            // Truncation is floor for v >= 0, and negative (or NaN) v clamps to pixel 0 anyway; this
-            // avoids a libm `floorf` call per sample on baseline x86-64.
-            let f = v / size;
-            let idx = if f > 0.0 {
-                (f as u32).min(n - 1) as f32
-            } else {
-                0.0
-            };
-            (idx + 0.5) * size
-        };
         Vec2::new(
-            k(p.x, ps.x, self.resolution[0]),
-            k(p.y, ps.y, self.resolution[1]),
+            pixel_centre_coord(p.x, ps.x, self.resolution[0]),
+            pixel_centre_coord(p.y, ps.y, self.resolution[1]),
         )
     }
 }
 
-/// Eq. (1) for one channel: `clip(round(level), 0, 255)` (NaN gives 0).
-#[inline]
+/// One coordinate of [`ScreenSpec::pixel_centre`]: the centre of pixel `clamp(floor(v / size), 0, n - 1)`
+/// of `n` pixels of `size`. Branch-free so that loops over many points vectorise: truncation is floor
+/// for `v >= 0`, and negative (or NaN) `v` clamps to pixel 0 anyway (no libm `floorf` call on baseline
+/// x86-64); clamping before truncating gives the same integer since `n - 1` is one.
+#[inline(always)]
+pub fn pixel_centre_coord(v: f32, size: f32, n: u32) -> f32 {
+    let last = (n.max(1) - 1) as f32;
+    let f = v / size;
+    let f = if f > 0.0 { f.min(last) } else { 0.0 };
+    ((f as i32) as f32 + 0.5) * size
+}
+
+/// Eq. (1) for one channel: `clip(round(level), 0, 255)`, rounding half away from zero (NaN gives 0).
+/// Without a libm call and branch-free, so that loops over many pixels vectorise: clamp first, then
+/// truncate and look at the fraction (both exact in f32).
+#[inline(always)]
 pub fn to_level(level: f32) -> u8 {
-    // round-half-away-from-zero without a libm call: for level >= 0, truncate and look at the fraction
-    // (exact: both the truncation and the subtraction are exact in f32). NaN and negative levels clip
-    // to 0.
-    if level >= 255.0 {
-        255
-    } else if level > 0.0 {
-        let t = level as u8;
-        // Branch-free: the fraction is as good as random, a branch on it would mispredict half the time.
-        t + u8::from(level - t as f32 >= 0.5)
-    } else {
-        0
-    }
+    let c = if level > 0.0 { level.min(255.0) } else { 0.0 };
+    let t = (c as i32) as f32;
+    t as u8 + u8::from(c - t >= 0.5)
 }
 
 /// Eq. (1) at the pixel that shows `p`: 8-bit (r, g, b).
@@ -97,71 +90,133 @@ pub fn pixels_at<const N: usize>(
 }
 
 /// [`pixels_at`] with the Gaussian sources already frozen at the fields' time (`frozen` must come from
-/// these `pheromones` as they are now). The pixel centres and the grids' interpolation weights are
-/// computed once per point and shared by every field on the same grid.
+/// these `pheromones` as they are now).
 pub fn pixels_at_frozen<const N: usize>(
     pheromones: &[Pheromone],
     frozen: &FrozenSources,
     screen: &ScreenSpec,
     points: &[Vec2; N],
 ) -> [[u8; 3]; N] {
-    // Plain loops rather than `[T; N]::map`: the closures of `map` were not inlined in this hot path.
-    let mut centres = [Vec2::ZERO; N];
-    let pixel = screen.pixel_size();
-    for (c, &p) in centres.iter_mut().zip(points) {
-        *c = screen.pixel_centre_with(pixel, p);
-    }
-    let mut acc = [[0f32; 3]; N];
-    let mut weights_spec: Option<GridSpec> = None;
-    let mut weights = [Bilinear::default(); N];
-    let mut block = None;
-    let mut values = [0f32; N];
-    for (index, ph) in pheromones.iter().enumerate() {
-        match &ph.model {
-            FieldModel::Grid(g) => {
-                let spec = *g.spec();
-                if spec.is_empty() {
-                    continue;
-                }
-                if weights_spec != Some(spec) {
-                    for (w, &c) in weights.iter_mut().zip(&centres) {
-                        *w = Bilinear::at(&spec, c).unwrap_or_default();
-                    }
-                    block = CellBlock::around(&weights);
-                    weights_spec = Some(spec);
-                }
-                match &block {
-                    // A footprint is smaller than a cell or two: load the few cells it touches once
-                    // (independent loads, so their cache misses overlap), then interpolate from them.
-                    Some(b) => {
-                        let cells = g.block(b.i, b.j);
-                        for (v, w) in values.iter_mut().zip(&weights) {
-                            *v = b.interpolate(&cells, w);
-                        }
-                    }
-                    None => {
-                        for (v, w) in values.iter_mut().zip(&weights) {
-                            *v = g.bilinear(w);
-                        }
-                    }
-                }
-            }
-            FieldModel::Gaussian(_) => frozen_values_at(frozen.of(index), &centres, &mut values),
-        }
-        for (a, &v) in acc.iter_mut().zip(&values) {
-            a[0] += ph.colour[0] * v;
-            a[1] += ph.colour[1] * v;
-            a[2] += ph.colour[2] * v;
-        }
-    }
+    let levels = levels_at(pheromones, frozen, screen, points, N);
     let mut out = [[0u8; 3]; N];
-    for (o, a) in out.iter_mut().zip(&acc) {
-        *o = [to_level(a[0]), to_level(a[1]), to_level(a[2])];
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = [levels[0][k], levels[1][k], levels[2][k]];
     }
     out
 }
 
+/// Eq. (1) at the pixels that show each of `points`: 8-bit levels `[channel][point]`. The points come
+/// in groups of `group` consecutive points close together (sensor footprints): a group reads the few
+/// grid cells it touches as one block and shares one `exp` per Gaussian source. The pixel centres and
+/// the grids' interpolation weights are computed once per point and shared by every field on the same
+/// grid; the arithmetic runs over arrays of points (structure of arrays) so that it vectorises.
+pub fn levels_at<const N: usize>(
+    pheromones: &[Pheromone],
+    frozen: &FrozenSources,
+    screen: &ScreenSpec,
+    points: &[Vec2; N],
+    group: usize,
+) -> [[u8; N]; 3] {
+    let group = group.clamp(1, N.max(1));
+    let pixel = screen.pixel_size();
+    let [nx, ny] = screen.resolution;
+    let (mut xs, mut ys) = ([0f32; N], [0f32; N]);
+    for ((x, y), p) in xs.iter_mut().zip(&mut ys).zip(points) {
+        *x = pixel_centre_coord(p.x, pixel.x, nx);
+        *y = pixel_centre_coord(p.y, pixel.y, ny);
+    }
+    let mut acc = [[0f32; N]; 3];
+    let mut grid = GridSampler::<N>::new();
+    let mut values = [0f32; N];
+    for (index, ph) in pheromones.iter().enumerate() {
+        match &ph.model {
+            FieldModel::Grid(g) => {
+                if g.spec().is_empty() {
+                    continue;
+                }
+                grid.values(g, &xs, &ys, group, &mut values);
+            }
+            FieldModel::Gaussian(_) => {
+                values.fill(0.0);
+                for source in frozen.of(index) {
+                    source.add_values_soa(&xs, &ys, group, &mut values);
+                }
+            }
+        }
+        for (a, &k) in acc.iter_mut().zip(&ph.colour) {
+            for (a, &v) in a.iter_mut().zip(&values) {
+                *a += k * v;
+            }
+        }
+    }
+    let mut out = [[0u8; N]; 3];
+    for (o, a) in out.iter_mut().zip(&acc) {
+        for (o, &a) in o.iter_mut().zip(a) {
+            *o = to_level(a);
+        }
+    }
+    out
+}
+
+/// Grid interpolation at a fixed set of points, the weights (and each group's cell block) computed
+/// once per grid spec and reused by every field on that grid.
+struct GridSampler<const N: usize> {
+    spec: Option<GridSpec>,
+    weights: [Bilinear; N],
+    /// The cell block of each group (indexed by group), `None` where it does not fit one.
+    blocks: [Option<CellBlock>; N],
+}
+
+impl<const N: usize> GridSampler<N> {
+    fn new() -> Self {
+        GridSampler {
+            spec: None,
+            weights: [Bilinear::default(); N],
+            blocks: [None; N],
+        }
+    }
+
+    fn values(
+        &mut self,
+        g: &GridField,
+        xs: &[f32; N],
+        ys: &[f32; N],
+        group: usize,
+        out: &mut [f32; N],
+    ) {
+        let spec = *g.spec();
+        if self.spec != Some(spec) {
+            for ((w, &x), &y) in self.weights.iter_mut().zip(xs).zip(ys) {
+                *w = Bilinear::at(&spec, Vec2::new(x, y)).unwrap_or_default();
+            }
+            for (b, w) in self.blocks.iter_mut().zip(self.weights.chunks(group)) {
+                *b = CellBlock::around(w);
+            }
+            self.spec = Some(spec);
+        }
+        let groups = self.weights.chunks(group).zip(out.chunks_mut(group));
+        for ((weights, out), block) in groups.zip(&self.blocks) {
+            match block {
+                // A footprint is smaller than a cell or two: load the few cells it touches once
+                // (independent loads, so their cache misses overlap), then interpolate from them.
+                Some(b) => {
+                    let cells = g.block(b.i, b.j);
+                    for (v, w) in out.iter_mut().zip(weights) {
+                        *v = b.interpolate(&cells, w);
+                    }
+                }
+                None => {
+                    for (v, w) in out.iter_mut().zip(weights) {
+                        *v = g.bilinear(w);
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The 3 x 3 cells starting at cell `(i, j)` that hold every corner of a footprint's interpolations.
+#[derive(Clone, Copy)]
 struct CellBlock {
     i: usize,
     j: usize,

@@ -80,36 +80,55 @@ impl FrozenSource {
     /// The exponent of eq. (5) at `p`: `-q / (2 (1 - rho^2))`.
     #[inline]
     fn exponent(&self, p: Vec2) -> f64 {
-        let dx = (p.x - self.centre.x) as f64;
-        let dy = (p.y - self.centre.y) as f64;
+        self.exponent_xy(p.x, p.y)
+    }
+
+    #[inline(always)]
+    fn exponent_xy(&self, px: f32, py: f32) -> f64 {
+        let dx = (px - self.centre.x) as f64;
+        let dy = (py - self.centre.y) as f64;
         (dx * dx * self.qxx + dy * dy * self.qyy - dx * dy * self.qxy) * self.scale
     }
 
-    /// Adds the source's values at `points` to `out`. Points close together (a sensor's footprint)
-    /// share one `exp`: `exp(x0 + e) = exp(x0) (1 + e + ... + e^6 / 720)` for `|e| < TAYLOR_MAX`,
-    /// whose relative error (< 2e-15) is far below f32's resolution, so the f32 values are those of
-    /// [`FrozenSource::value_at`]; farther points take their own `exp`.
+    /// Adds the source's values at the points `(xs[k], ys[k])` to `out[k]`. The points come in groups of
+    /// `group` consecutive points close together (a sensor's footprint) that share one `exp`:
+    /// `exp(x0 + e) = exp(x0) (1 + e + ... + e^6 / 720)` for `|e| < TAYLOR_MAX`, whose relative error
+    /// (< 2e-15) is far below f32's resolution, so the f32 values are those of
+    /// [`FrozenSource::value_at`]; farther points take their own `exp`. Structure of arrays, and the
+    /// exponents in a fixed-size buffer, so that the arithmetic over the points vectorises.
     #[inline]
-    pub fn add_values_at(&self, points: &[Vec2], out: &mut [f32]) {
-        // Footprints come in chunks of at most LANES points: the exponents go to a fixed-size array
-        // first, so that the arithmetic over the points is branch-free and vectorises.
-        const LANES: usize = 16;
-        let Some(&first) = points.first() else { return };
-        let x0 = self.exponent(first);
-        let e0 = x0.exp();
-        for (points, out) in points.chunks(LANES).zip(out.chunks_mut(LANES)) {
-            let n = points.len().min(out.len());
-            let mut exponent = [0f64; LANES];
-            for (x, &p) in exponent.iter_mut().zip(&points[..n]) {
-                *x = self.exponent(p);
-            }
-            let spread = exponent[..n].iter().fold(0f64, |m, x| m.max((x - x0).abs()));
+    pub fn add_values_soa(&self, xs: &[f32], ys: &[f32], group: usize, out: &mut [f32]) {
+        let n = xs.len().min(ys.len()).min(out.len());
+        let group = group.clamp(1, MAX_POINTS);
+        let chunk = MAX_POINTS / group * group;
+        let (xs, ys, out) = (&xs[..n], &ys[..n], &mut out[..n]);
+        for ((xs, ys), out) in xs
+            .chunks(chunk)
+            .zip(ys.chunks(chunk))
+            .zip(out.chunks_mut(chunk))
+        {
+            self.add_values_chunk(xs, ys, group, out);
+        }
+    }
+
+    /// [`FrozenSource::add_values_soa`] for at most [`MAX_POINTS`] points.
+    #[inline]
+    fn add_values_chunk(&self, xs: &[f32], ys: &[f32], group: usize, out: &mut [f32]) {
+        let n = xs.len();
+        let mut exponent = [0f64; MAX_POINTS];
+        for ((x, &px), &py) in exponent[..n].iter_mut().zip(xs).zip(ys) {
+            *x = self.exponent_xy(px, py);
+        }
+        for (exponent, out) in exponent[..n].chunks(group).zip(out.chunks_mut(group)) {
+            let x0 = exponent[0];
+            let e0 = x0.exp();
+            let spread = exponent.iter().fold(0f64, |m, x| m.max((x - x0).abs()));
             if spread < TAYLOR_MAX {
-                for (o, &x) in out[..n].iter_mut().zip(&exponent[..n]) {
+                for (o, &x) in out.iter_mut().zip(exponent) {
                     *o += (self.amplitude * (e0 * exp_series(x - x0))) as f32;
                 }
             } else {
-                for (o, &x) in out[..n].iter_mut().zip(&exponent[..n]) {
+                for (o, &x) in out.iter_mut().zip(exponent) {
                     let e = x - x0;
                     let v = if e.abs() < TAYLOR_MAX {
                         e0 * exp_series(e)
@@ -122,6 +141,9 @@ impl FrozenSource {
         }
     }
 }
+
+/// Points evaluated together by [`FrozenSource::add_values_soa`] (four sensors' footprints fit).
+pub const MAX_POINTS: usize = 64;
 
 /// Offsets of the exponent below which [`exp_series`] stands in for `exp`.
 const TAYLOR_MAX: f64 = 0.03;
@@ -143,8 +165,15 @@ fn exp_series(e: f64) -> f64 {
 /// instead of once per sensor.
 pub fn frozen_values_at(sources: &[FrozenSource], points: &[Vec2], out: &mut [f32]) {
     out.fill(0.0);
-    for s in sources {
-        s.add_values_at(points, out);
+    let (mut xs, mut ys) = ([0f32; MAX_POINTS], [0f32; MAX_POINTS]);
+    for (points, out) in points.chunks(MAX_POINTS).zip(out.chunks_mut(MAX_POINTS)) {
+        let n = points.len();
+        for ((x, y), p) in xs.iter_mut().zip(&mut ys).zip(points) {
+            (*x, *y) = (p.x, p.y);
+        }
+        for s in sources {
+            s.add_values_soa(&xs[..n], &ys[..n], n, out);
+        }
     }
 }
 
@@ -161,12 +190,11 @@ impl GaussianField {
     }
     /// The field at many points: `out[k]` = the value at `points[k]` (the sum of
     /// [`GaussianField::value_at`], with each source's time factors computed once and nearby points
-    /// sharing an `exp`, see [`FrozenSource::add_values_at`]).
+    /// sharing an `exp`, see [`FrozenSource::add_values_soa`]).
     pub fn values_at(&self, points: &[Vec2], out: &mut [f32]) {
-        out.fill(0.0);
-        for s in self.sources.iter().filter_map(|s| s.at_time(self.time)) {
-            s.add_values_at(points, out);
-        }
+        let mut frozen = Vec::with_capacity(self.sources.len());
+        self.freeze_into(&mut frozen);
+        frozen_values_at(&frozen, points, out);
     }
     /// Appends every source that has started, frozen at the field's time, to `out`: what
     /// [`frozen_values_at`] needs to give the values of [`GaussianField::values_at`].

@@ -124,9 +124,10 @@ impl World {
                 last_command: slot.command,
                 ..Observation::default()
             };
-            for (n, &p) in sensor_points[i].iter().enumerate() {
-                o.counts[n] = sensor.read(pheromones, frozen, screen, p, &mut slot.rng);
-                o.intensity[n] = sensor.intensity(o.counts[n]);
+            o.counts =
+                sensor.read_all(pheromones, frozen, screen, &sensor_points[i], &mut slot.rng);
+            for (intensity, &counts) in o.intensity.iter_mut().zip(&o.counts) {
+                *intensity = sensor.intensity(counts);
             }
             o.bumpers = neighbours.bumpers(i, poses, radius, arena, bumper);
             *obs = o;
