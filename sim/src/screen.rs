@@ -58,10 +58,14 @@ impl ScreenSpec {
 /// x86-64); clamping before truncating gives the same integer since `n - 1` is one.
 #[inline(always)]
 pub fn pixel_centre_coord(v: f32, size: f32, n: u32) -> f32 {
-    let last = (n.max(1) - 1) as f32;
+    // (Capped far beyond any panel, validated scenarios allow 65,536 pixels, so the truncation below
+    // stays within i32.)
+    let last = (n.max(1) - 1).min(1 << 30) as f32;
     let f = v / size;
     let f = if f > 0.0 { f.min(last) } else { 0.0 };
-    ((f as i32) as f32 + 0.5) * size
+    // SAFETY: `f` is in [0, n - 1] (NaN went to 0 above), so the truncation is in range; the plain
+    // conversion (not the saturating `as`) is what vectorises.
+    (unsafe { f.to_int_unchecked::<i32>() } as f32 + 0.5) * size
 }
 
 /// Eq. (1) for one channel: `clip(round(level), 0, 255)`, rounding half away from zero (NaN gives 0).
@@ -69,9 +73,17 @@ pub fn pixel_centre_coord(v: f32, size: f32, n: u32) -> f32 {
 /// truncate and look at the fraction (both exact in f32).
 #[inline(always)]
 pub fn to_level(level: f32) -> u8 {
+    to_level_u32(level) as u8
+}
+
+/// [`to_level`] as a `u32` (0..=255).
+#[inline(always)]
+pub fn to_level_u32(level: f32) -> u32 {
     let c = if level > 0.0 { level.min(255.0) } else { 0.0 };
-    let t = (c as i32) as f32;
-    t as u8 + u8::from(c - t >= 0.5)
+    // SAFETY: `c` is in [0, 255] (NaN went to 0 above), so the truncation is in range; the plain
+    // conversion (not the saturating `as`) is what vectorises.
+    let t = unsafe { c.to_int_unchecked::<i32>() };
+    (t + i32::from(c - t as f32 >= 0.5)) as u32
 }
 
 /// Eq. (1) at the pixel that shows `p`: 8-bit (r, g, b).
@@ -100,12 +112,12 @@ pub fn pixels_at_frozen<const N: usize>(
     let levels = levels_at(pheromones, frozen, screen, points, N);
     let mut out = [[0u8; 3]; N];
     for (k, o) in out.iter_mut().enumerate() {
-        *o = [levels[0][k], levels[1][k], levels[2][k]];
+        *o = [levels[0][k] as u8, levels[1][k] as u8, levels[2][k] as u8];
     }
     out
 }
 
-/// Eq. (1) at the pixels that show each of `points`: 8-bit levels `[channel][point]`. The points come
+/// Eq. (1) at the pixels that show each of `points`: 8-bit levels (0..=255) `[channel][point]`. The points come
 /// in groups of `group` consecutive points close together (sensor footprints): a group reads the few
 /// grid cells it touches as one block and shares one `exp` per Gaussian source. The pixel centres and
 /// the grids' interpolation weights are computed once per point and shared by every field on the same
@@ -116,7 +128,7 @@ pub fn levels_at<const N: usize>(
     screen: &ScreenSpec,
     points: &[Vec2; N],
     group: usize,
-) -> [[u8; N]; 3] {
+) -> [[u32; N]; 3] {
     let group = group.clamp(1, N.max(1));
     let pixel = screen.pixel_size();
     let [nx, ny] = screen.resolution;
@@ -149,10 +161,11 @@ pub fn levels_at<const N: usize>(
             }
         }
     }
-    let mut out = [[0u8; N]; 3];
+    // 32-bit levels: with byte-sized results this loop did not vectorise.
+    let mut out = [[0u32; N]; 3];
     for (o, a) in out.iter_mut().zip(&acc) {
         for (o, &a) in o.iter_mut().zip(a) {
-            *o = to_level(a);
+            *o = to_level_u32(a);
         }
     }
     out

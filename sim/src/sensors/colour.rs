@@ -165,7 +165,7 @@ impl ColourSensor {
                 crate::screen::levels_at(pheromones, frozen, screen, &points, FOOTPRINT_POINTS);
             for (c, levels) in levels.iter().enumerate() {
                 for (sum, levels) in sums.iter_mut().zip(levels.chunks(FOOTPRINT_POINTS)) {
-                    sum[c] = levels.iter().map(|&l| l as u32).sum();
+                    sum[c] = levels.iter().sum();
                 }
             }
         }
