@@ -129,6 +129,38 @@ pub fn levels_at<const N: usize>(
     points: &[Vec2; N],
     group: usize,
 ) -> [[u32; N]; 3] {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2.
+        return unsafe { levels_at_avx2(pheromones, frozen, screen, points, group) };
+    }
+    levels_at_portable(pheromones, frozen, screen, points, group)
+}
+
+/// [`levels_at`] compiled for AVX2: the same operations in wider registers (twice the f64 lanes of
+/// baseline x86-64's SSE2 for the Gaussian exponents). Rust never fuses a multiply and an add on its
+/// own, so the results are bit-identical to [`levels_at_portable`] (tested).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn levels_at_avx2<const N: usize>(
+    pheromones: &[Pheromone],
+    frozen: &FrozenSources,
+    screen: &ScreenSpec,
+    points: &[Vec2; N],
+    group: usize,
+) -> [[u32; N]; 3] {
+    levels_at_portable(pheromones, frozen, screen, points, group)
+}
+
+/// [`levels_at`] for any x86-64 (or other) processor.
+#[inline(always)]
+pub fn levels_at_portable<const N: usize>(
+    pheromones: &[Pheromone],
+    frozen: &FrozenSources,
+    screen: &ScreenSpec,
+    points: &[Vec2; N],
+    group: usize,
+) -> [[u32; N]; 3] {
     let group = group.clamp(1, N.max(1));
     let pixel = screen.pixel_size();
     let [nx, ny] = screen.resolution;

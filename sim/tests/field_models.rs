@@ -402,6 +402,19 @@ proptest::proptest! {
         for (p, g) in points.iter().zip(got) {
             proptest::prop_assert_eq!(g, reference_pixel(&ps, &screen, *p), "at {}", p);
         }
+        // A robot's four footprints in one batch (groups of nine), on the processor's widest path and
+        // on the portable one: the same levels as the per-point reference.
+        let robot: [Vec2; 36] = std::array::from_fn(|k| {
+            points[k % 9] + 0.015 * Vec2::from_angle((k / 9) as f32 * std::f32::consts::FRAC_PI_2)
+        });
+        let frozen = colcos_sim::field::FrozenSources::new(&ps);
+        let fast = colcos_sim::screen::levels_at(&ps, &frozen, &screen, &robot, 9);
+        let portable = colcos_sim::screen::levels_at_portable(&ps, &frozen, &screen, &robot, 9);
+        proptest::prop_assert_eq!(fast, portable);
+        for (k, p) in robot.iter().enumerate() {
+            let want = reference_pixel(&ps, &screen, *p).map(u32::from);
+            proptest::prop_assert_eq!([fast[0][k], fast[1][k], fast[2][k]], want, "at {}", p);
+        }
     }
 }
 

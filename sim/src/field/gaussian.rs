@@ -96,7 +96,7 @@ impl FrozenSource {
     /// (< 2e-15) is far below f32's resolution, so the f32 values are those of
     /// [`FrozenSource::value_at`]; farther points take their own `exp`. Structure of arrays, and the
     /// exponents in a fixed-size buffer, so that the arithmetic over the points vectorises.
-    #[inline]
+    #[inline(always)]
     pub fn add_values_soa(&self, xs: &[f32], ys: &[f32], group: usize, out: &mut [f32]) {
         let n = xs.len().min(ys.len()).min(out.len());
         let group = group.clamp(1, MAX_POINTS);
@@ -112,7 +112,7 @@ impl FrozenSource {
     }
 
     /// [`FrozenSource::add_values_soa`] for at most [`MAX_POINTS`] points.
-    #[inline]
+    #[inline(always)]
     fn add_values_chunk(&self, xs: &[f32], ys: &[f32], group: usize, out: &mut [f32]) {
         let n = xs.len();
         let mut exponent = [0f64; MAX_POINTS];
