@@ -117,11 +117,12 @@ pub fn pixels_at_frozen<const N: usize>(
     out
 }
 
-/// Eq. (1) at the pixels that show each of `points`: 8-bit levels (0..=255) `[channel][point]`. The points come
-/// in groups of `group` consecutive points close together (sensor footprints): a group reads the few
-/// grid cells it touches as one block and shares one `exp` per Gaussian source. The pixel centres and
-/// the grids' interpolation weights are computed once per point and shared by every field on the same
-/// grid; the arithmetic runs over arrays of points (structure of arrays) so that it vectorises.
+/// Eq. (1) at the pixels that show each of `points`: 8-bit levels (0..=255), `[channel][point]`. The
+/// points come in groups of `group` consecutive points close together (sensor footprints): a group
+/// reads the few grid cells it touches as one block and shares one `exp` per Gaussian source. The pixel
+/// centres and the grids' interpolation weights are computed once per point and shared by every field
+/// on the same grid; the arithmetic runs over arrays of points (structure of arrays) so that it
+/// vectorises.
 pub fn levels_at<const N: usize>(
     pheromones: &[Pheromone],
     frozen: &FrozenSources,
