@@ -228,8 +228,7 @@ pub fn main(args: DisplayArgs) -> Result<()> {
             colcos_display::render_headless(&rgba, size)?
         };
         screen::save_png(&img, png)?;
-        println!("wrote {}", png.display());
-        return Ok(());
+        return crate::report::print_report(&format!("wrote {}\n", png.display()));
     }
     #[cfg(feature = "display")]
     {

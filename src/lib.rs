@@ -6,4 +6,5 @@ pub use colcos_sim as sim;
 pub mod backend;
 pub mod display;
 pub mod experiment;
+pub mod report;
 pub mod run;

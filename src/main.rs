@@ -1,10 +1,10 @@
 //! The `colcos` command line.
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
+use colcos::report::print_report;
 use colcos::run::{RunOptions, run};
 use colcos::sim::prelude::*;
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -62,17 +62,6 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
         }
-    }
-}
-
-/// Prints a command's report. A reader that went away (`colcos run ... | grep -q`) is not an error:
-/// `println!` would panic on the broken pipe after the run's files were already written.
-fn print_report(text: &str) -> Result<()> {
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(e).context("writing the report to stdout")
-        }
-        _ => Ok(()),
     }
 }
 

@@ -55,7 +55,8 @@ impl ScreenSpec {
 /// One coordinate of [`ScreenSpec::pixel_centre`]: the centre of pixel `clamp(floor(v / size), 0, n - 1)`
 /// of `n` pixels of `size`. Branch-free so that loops over many points vectorise: truncation is floor
 /// for `v >= 0`, and negative (or NaN) `v` clamps to pixel 0 anyway (no libm `floorf` call on baseline
-/// x86-64); clamping before truncating gives the same integer since `n - 1` is one.
+/// x86-64); clamping to `n - 1` before truncating gives the same pixel as after, `n - 1` being an
+/// integer.
 #[inline(always)]
 pub fn pixel_centre_coord(v: f32, size: f32, n: u32) -> f32 {
     // (Capped far beyond any panel, validated scenarios allow 65,536 pixels, so the truncation below

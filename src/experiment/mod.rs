@@ -233,10 +233,10 @@ pub fn main(args: ExperimentArgs) -> Result<()> {
     }
     let opts = Options::from_args(&args)?;
     let report = run(&opts)?;
-    print!("{}", summary::console(&report));
-    println!("wall time {:.2} s", report.wall_seconds);
+    let mut text = summary::console(&report);
+    text += &format!("wall time {:.2} s\n", report.wall_seconds);
     for f in &report.files {
-        println!("  wrote {}", f.display());
+        text += &format!("  wrote {}\n", f.display());
     }
-    Ok(())
+    crate::report::print_report(&text)
 }

@@ -11,7 +11,7 @@ mod static_map;
 
 pub use backend::{BackendChoice, FieldBackend};
 pub use frozen::FrozenSources;
-pub use gaussian::{FrozenSource, GaussianField, GaussianSource, MAX_POINTS, frozen_values_at};
+pub use gaussian::{FrozenSource, GaussianField, GaussianSource};
 pub(crate) use grid::lerp_index;
 pub use grid::{
     BLOCK, Bilinear, DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,

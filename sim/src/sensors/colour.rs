@@ -70,16 +70,16 @@ pub struct ColourSensor {
 
 /// The table of [`ColourSensor::light`] by footprint level sum for `gamma`, built once per process and
 /// value of `gamma`.
-fn shared_light_table(sensor: &ColourSensor) -> Arc<[f32]> {
+fn shared_light_table(gamma: f32) -> Arc<[f32]> {
     static TABLES: Mutex<Vec<(u32, Arc<[f32]>)>> = Mutex::new(Vec::new());
-    let key = sensor.params.gamma.to_bits();
+    let key = gamma.to_bits();
     // A poisoned lock only means another thread panicked while pushing: the list is still valid.
     let mut tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
     if let Some((_, t)) = tables.iter().find(|(k, _)| *k == key) {
         return t.clone();
     }
     let table: Arc<[f32]> = (0..=255 * FOOTPRINT_POINTS as u32)
-        .map(|sum| sensor.light([mean_level(sum); 3])[0])
+        .map(|sum| light_of_level(mean_level(sum), gamma))
         .collect();
     tables.push((key, table.clone()));
     table
@@ -119,14 +119,12 @@ impl ColourSensor {
         for (k, o) in offsets.iter_mut().skip(1).enumerate() {
             *o = ring * Vec2::from_angle(std::f32::consts::TAU * k as f32 / RING_POINTS as f32);
         }
-        let mut sensor = ColourSensor {
+        ColourSensor {
             params,
             inverse,
             offsets,
-            light_by_sum: Arc::from([]),
-        };
-        sensor.light_by_sum = shared_light_table(&sensor);
-        sensor
+            light_by_sum: shared_light_table(params.gamma),
+        }
     }
 
     /// Where on the screen the sensor at `p` samples, arena coordinates: `p` and a ring around it.
@@ -235,14 +233,7 @@ impl ColourSensor {
 
     /// Light emitted per primary, in [0, 1], for 8-bit levels.
     pub fn light(&self, levels: [f32; 3]) -> [f32; 3] {
-        levels.map(|l| {
-            let x = if l.is_nan() {
-                0.0
-            } else {
-                (l / 255.0).clamp(0.0, 1.0)
-            };
-            x.powf(self.params.gamma)
-        })
+        levels.map(|l| light_of_level(l, self.params.gamma))
     }
 
     /// Counts for the given mean screen levels: transfer curve, crosstalk, gain, integration, noise,
@@ -299,6 +290,16 @@ impl ColourSensor {
     }
 }
 
+/// The display's transfer curve: light in [0, 1] of one primary at an 8-bit `level` (NaN gives 0).
+fn light_of_level(level: f32, gamma: f32) -> f32 {
+    let x = if level.is_nan() {
+        0.0
+    } else {
+        (level / 255.0).clamp(0.0, 1.0)
+    };
+    x.powf(gamma)
+}
+
 /// Mean level of a footprint from the sum of its samples' levels.
 fn mean_level(sum: u32) -> f32 {
     sum as f32 / FOOTPRINT_POINTS as f32
@@ -338,18 +339,25 @@ mod tests {
         }
     }
 
+    /// An `nx x ny` grid of `cell` whose k-th value (row-major) is `value(k)`.
+    fn patterned_grid(
+        nx: usize,
+        ny: usize,
+        cell: f32,
+        value: impl Fn(usize) -> f32,
+    ) -> crate::field::GridField {
+        use crate::field::{GridField, GridParams, GridSpec};
+        let mut g = GridField::new(GridSpec { nx, ny, cell }, GridParams::default());
+        for (k, v) in g.values_mut().iter_mut().enumerate() {
+            *v = value(k);
+        }
+        g
+    }
+
     #[test]
     fn read_equals_counts_of_screen_levels() {
-        use crate::field::{FieldModel, GridField, GridParams, GridSpec, Pheromone};
-        let spec = GridSpec {
-            nx: 40,
-            ny: 20,
-            cell: 0.025,
-        };
-        let mut g = GridField::new(spec, GridParams::default());
-        for (k, v) in g.values_mut().iter_mut().enumerate() {
-            *v = (k as f32 * 0.37).sin().abs();
-        }
+        use crate::field::{FieldModel, Pheromone};
+        let g = patterned_grid(40, 20, 0.025, |k| (k as f32 * 0.37).sin().abs());
         let ph = [Pheromone {
             name: "p".into(),
             colour: [255.0, 90.0, 20.0],
@@ -382,20 +390,8 @@ mod tests {
     /// on a grid field and Gaussian sources (one narrow enough that footprints take their own `exp`).
     #[test]
     fn read_all_equals_single_reads_in_order() {
-        use crate::field::{
-            FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec,
-        };
-        let mut g = GridField::new(
-            GridSpec {
-                nx: 60,
-                ny: 30,
-                cell: 0.02,
-            },
-            GridParams::default(),
-        );
-        for (k, v) in g.values_mut().iter_mut().enumerate() {
-            *v = (k as f32 * 0.61).cos().abs();
-        }
+        use crate::field::{FieldModel, GaussianField, GaussianSource};
+        let g = patterned_grid(60, 30, 0.02, |k| (k as f32 * 0.61).cos().abs());
         let source = |sigma: f32, centre: Vec2| GaussianSource {
             k: 0.3,
             sigma_x: sigma,
