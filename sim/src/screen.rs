@@ -1,8 +1,6 @@
 //! The screen, eq. (1): I(x, y, c) = clip(sum_j k_j Phi_j(x, y)) as 8-bit RGB at the panel's resolution.
 use crate::error::{Result, SimError};
-use crate::field::{
-    BLOCK, Bilinear, FieldModel, FrozenSources, GridField, GridSpec, Pheromone, bilinear_mix,
-};
+use crate::field::{FieldModel, FrozenSources, GridSampler, Pheromone};
 use glam::Vec2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -120,7 +118,7 @@ pub fn pixels_at_frozen<const N: usize>(
 
 /// Eq. (1) at the pixels that show each of `points`: 8-bit levels (0..=255), `[channel][point]`. The
 /// points come in groups of `group` consecutive points close together (sensor footprints): a group
-/// reads the few grid cells it touches as one block and shares one `exp` per Gaussian source. The pixel
+/// shares one `exp` per Gaussian source. The pixel
 /// centres and the grids' interpolation weights are computed once per point and shared by every field
 /// on the same grid; the arithmetic runs over arrays of points (structure of arrays) so that it
 /// vectorises.
@@ -180,7 +178,7 @@ pub fn levels_at_portable<const N: usize>(
                 if g.spec().is_empty() {
                     continue;
                 }
-                grid.values(g, &xs, &ys, group, &mut values);
+                grid.values(g, &xs, &ys, &mut values);
             }
             FieldModel::Gaussian(_) => {
                 values.fill(0.0);
@@ -203,89 +201,6 @@ pub fn levels_at_portable<const N: usize>(
         }
     }
     out
-}
-
-/// Grid interpolation at a fixed set of points, the weights (and each group's cell block) computed
-/// once per grid spec and reused by every field on that grid.
-struct GridSampler<const N: usize> {
-    spec: Option<GridSpec>,
-    weights: [Bilinear; N],
-    /// The cell block of each group (indexed by group), `None` where it does not fit one.
-    blocks: [Option<CellBlock>; N],
-}
-
-impl<const N: usize> GridSampler<N> {
-    fn new() -> Self {
-        GridSampler {
-            spec: None,
-            weights: [Bilinear::default(); N],
-            blocks: [None; N],
-        }
-    }
-
-    fn values(
-        &mut self,
-        g: &GridField,
-        xs: &[f32; N],
-        ys: &[f32; N],
-        group: usize,
-        out: &mut [f32; N],
-    ) {
-        let spec = *g.spec();
-        if self.spec != Some(spec) {
-            for ((w, &x), &y) in self.weights.iter_mut().zip(xs).zip(ys) {
-                *w = Bilinear::at(&spec, Vec2::new(x, y)).unwrap_or_default();
-            }
-            for (b, w) in self.blocks.iter_mut().zip(self.weights.chunks(group)) {
-                *b = CellBlock::around(w);
-            }
-            self.spec = Some(spec);
-        }
-        let groups = self.weights.chunks(group).zip(out.chunks_mut(group));
-        for ((weights, out), block) in groups.zip(&self.blocks) {
-            match block {
-                // A footprint is smaller than a cell or two: load the few cells it touches once
-                // (independent loads, so their cache misses overlap), then interpolate from them.
-                Some(b) => {
-                    let cells = g.block(b.i, b.j);
-                    for (v, w) in out.iter_mut().zip(weights) {
-                        *v = b.interpolate(&cells, w);
-                    }
-                }
-                None => {
-                    for (v, w) in out.iter_mut().zip(weights) {
-                        *v = g.bilinear(w);
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// The 3 x 3 cells starting at cell `(i, j)` that hold every corner of a footprint's interpolations.
-#[derive(Clone, Copy)]
-struct CellBlock {
-    i: usize,
-    j: usize,
-}
-
-impl CellBlock {
-    /// The block around the corners of `weights`, or `None` when they span more than 3 x 3 cells (a
-    /// grid much finer than the footprint) or the grid is smaller than that.
-    fn around(weights: &[Bilinear]) -> Option<CellBlock> {
-        let i = weights.iter().map(|w| w.i0).min()?;
-        let j = weights.iter().map(|w| w.j0).min()?;
-        let fits = weights.iter().all(|w| w.i1 < i + BLOCK && w.j1 < j + BLOCK);
-        fits.then_some(CellBlock { i, j })
-    }
-
-    /// [`GridField::bilinear`] from the block's cells: the same values and arithmetic, bit for bit.
-    #[inline]
-    fn interpolate(&self, cells: &[[f32; BLOCK]; BLOCK], w: &Bilinear) -> f32 {
-        let (a, b) = (w.i0 - self.i, w.i1 - self.i);
-        let (r0, r1) = (&cells[w.j0 - self.j], &cells[w.j1 - self.j]);
-        bilinear_mix(r0[a], r0[b], r1[a], r1[b], w.tx, w.ty)
-    }
 }
 
 /// The whole screen image, eq. (1), rendered at `width x height` pixels (the panel's own resolution or

@@ -240,22 +240,6 @@ impl GridField {
         }
     }
 
-    /// The `BLOCK x BLOCK` cells starting at `(i, j)` (rows `j..`, columns `i..`), clamped to the grid:
-    /// rows or columns past the edge repeat the last one (never read by a caller whose corners lie
-    /// inside the grid).
-    #[inline]
-    pub fn block(&self, i: usize, j: usize) -> [[f32; BLOCK]; BLOCK] {
-        let GridSpec { nx, ny, .. } = self.spec;
-        let mut out = [[0f32; BLOCK]; BLOCK];
-        for (dj, row) in out.iter_mut().enumerate() {
-            let r = (j + dj).min(ny - 1) * nx;
-            for (di, v) in row.iter_mut().enumerate() {
-                *v = self.values[r + (i + di).min(nx - 1)];
-            }
-        }
-        out
-    }
-
     /// Hints the processor to fetch the cells that interpolations within `radius` of `p` read, so that
     /// their cache misses overlap with other work (sensing prefetches the next robot's cells). Only a
     /// hint: no effect on results.
@@ -557,10 +541,6 @@ fn substeps(x: f32, max: f32) -> usize {
     }
 }
 
-/// Index pair and weight for linear interpolation at fractional index `f` on `n` samples, clamped.
-/// Side of the cell blocks that [`GridField::block`] gathers.
-pub const BLOCK: usize = 3;
-
 /// Bilinear interpolation weights of one point on a grid: corner indices and fractions.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Bilinear {
@@ -602,6 +582,7 @@ impl Bilinear {
     }
 }
 
+/// Index pair and weight for linear interpolation at fractional index `f` on `n` samples, clamped.
 #[inline]
 pub(crate) fn lerp_index(f: f32, n: usize) -> (usize, usize, f32) {
     if n <= 1 || !(f > 0.0) {

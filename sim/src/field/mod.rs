@@ -5,6 +5,7 @@ mod backend;
 mod frozen;
 mod gaussian;
 mod grid;
+mod grid_sampler;
 mod kernel;
 mod pheromone;
 mod static_map;
@@ -13,8 +14,9 @@ pub use backend::{BackendChoice, FieldBackend};
 pub use frozen::FrozenSources;
 pub use gaussian::{FrozenSource, GaussianField, GaussianSource};
 pub(crate) use grid::lerp_index;
+pub(crate) use grid_sampler::GridSampler;
 pub use grid::{
-    BLOCK, Bilinear, DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,
+    Bilinear, DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,
     bilinear_mix, thomas_coefficients,
 };
 pub use kernel::Kernel;
