@@ -343,8 +343,8 @@ fn stepping_is_bit_identical_across_thread_counts() {
 }
 
 /// Eq. (1) at one point the slow, obvious way: every field's own `value_at` at the pixel centre and
-/// `f32::round` (the footprint path gathers cells in blocks and rounds without libm; it must agree
-/// bit for bit).
+/// `f32::round` (the footprint path interpolates arrays of points and rounds without libm; it must
+/// agree bit for bit).
 fn reference_pixel(pheromones: &[Pheromone], screen: &ScreenSpec, p: Vec2) -> [u8; 3] {
     let c = screen.pixel_centre(p);
     let mut acc = [0f32; 3];
@@ -359,9 +359,9 @@ fn reference_pixel(pheromones: &[Pheromone], screen: &ScreenSpec, p: Vec2) -> [u
 
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
-    /// Footprints of nine samples (the sensor's pattern, and wider ones that overflow the 3 x 3 cell
-    /// block) on coarse and fine grids with a Gaussian field among them, anywhere on the screen and
-    /// past its edges, read the same levels as the per-point reference.
+    /// Footprints of nine samples (the sensor's pattern, and wider ones spanning several cells) on
+    /// coarse and fine grids with a Gaussian field among them, anywhere on the screen and past its
+    /// edges, read the same levels as the per-point reference.
     #[test]
     fn footprint_pixels_match_per_point_reference(
         cell in proptest::sample::select(vec![0.0004f32, 0.003, 0.01, 0.2]),
