@@ -1,33 +1,70 @@
 //! Injection: robots lay trails on grid pheromones along their path and move their Gaussian sources,
 //! at their tracked poses (as the real host does) or their true ones.
-use super::World;
-use crate::field::FieldModel;
+use super::{Deposit, World};
+use crate::field::{FieldModel, Pheromone};
+use crate::robot::Pose;
 use crate::scenario::InjectAt;
+use crate::tracker::TrackedPose;
 use glam::Vec2;
+use rayon::prelude::*;
+
+/// From this many trail deposits a step, fields take their deposits in parallel.
+const PARALLEL_DEPOSITS: usize = 256;
+/// Deposits ahead whose cells are prefetched: their rows are scattered over a large field.
+const PREFETCH_AHEAD: usize = 2;
+
+/// Where the host believes robot `i` is (see [`World::injection_point`]).
+fn injection_point_of(
+    inject_at: InjectAt,
+    poses: &[Pose],
+    tracked: &[TrackedPose],
+    i: usize,
+) -> Option<Vec2> {
+    match inject_at {
+        InjectAt::True => Some(poses[i].pos),
+        InjectAt::Tracked => tracked[i].seen.then_some(tracked[i].pose.pos),
+    }
+}
 
 impl World {
     /// Where the host believes robot `i` is, or `None` if the tracker has not seen it yet.
     pub fn injection_point(&self, i: usize) -> Option<Vec2> {
-        match self.inject_at {
-            InjectAt::True => Some(self.physics.poses()[i].pos),
-            InjectAt::Tracked => self.tracked[i].seen.then_some(self.tracked[i].pose.pos),
-        }
+        injection_point_of(self.inject_at, self.physics.poses(), &self.tracked, i)
     }
 
     pub(super) fn inject(&mut self) {
         let dt = self.dt;
-        for d in 0..self.deposits.len() {
-            let (robot, pheromone, kernel, rate) = {
-                let dep = &self.deposits[d];
-                (dep.robot, dep.pheromone, dep.kernel, dep.rate)
+        // A field's values depend on the order of its own deposits only: each field takes its
+        // deposits in scenario order, and fields run in parallel.
+        let (inject_at, poses, tracked) = (self.inject_at, self.physics.poses(), &self.tracked);
+        let point = |i: usize| injection_point_of(inject_at, poses, tracked, i);
+        let (deposits, last) = (&self.deposits, &self.last_injection);
+        let deposit_into = |(index, ph): (usize, &mut Pheromone)| {
+            let FieldModel::Grid(grid) = &mut ph.model else {
+                return;
             };
-            let Some(to) = self.injection_point(robot) else {
-                continue;
-            };
-            let from = self.last_injection[robot].unwrap_or(to);
-            if let FieldModel::Grid(grid) = &mut self.pheromones[pheromone].model {
-                grid.deposit_segment(&kernel, from, to, rate * dt);
+            let mine = |d: &&Deposit| d.pheromone == index;
+            let mut ahead = deposits.iter().filter(mine).skip(PREFETCH_AHEAD);
+            for dep in deposits.iter().filter(mine) {
+                if let Some(next) = ahead.next()
+                    && let Some(p) = point(next.robot)
+                {
+                    grid.prefetch_around(p, next.kernel.support());
+                }
+                let Some(to) = point(dep.robot) else {
+                    continue;
+                };
+                let from = last[dep.robot].unwrap_or(to);
+                grid.deposit_segment(&dep.kernel, from, to, dep.rate * dt);
             }
+        };
+        if self.deposits.len() >= PARALLEL_DEPOSITS {
+            self.pheromones
+                .par_iter_mut()
+                .enumerate()
+                .for_each(deposit_into);
+        } else {
+            self.pheromones.iter_mut().enumerate().for_each(deposit_into);
         }
         for i in 0..self.robots.len() {
             if let Some(p) = self.injection_point(i) {
