@@ -115,8 +115,9 @@ fn level(world: &World, c: usize, p: Vec2) -> f32 {
     world
         .pheromones()
         .iter()
-        .filter(|ph| ph.colour[c] != 0.0)
-        .map(|ph| ph.colour[c] / 255.0 * ph.value_at(p))
+        .enumerate()
+        .filter(|(_, ph)| ph.colour[c] != 0.0)
+        .map(|(index, ph)| ph.colour[c] / 255.0 * world.pheromone_value_observed(index, p))
         .sum()
 }
 

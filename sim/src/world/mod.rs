@@ -135,6 +135,20 @@ impl World {
     pub fn role(&self, i: usize) -> &str {
         &self.scenario.spec.robots[self.robots[i].group].role
     }
+    /// Pheromone `index`'s value at `p` as of the current observations: the same value as
+    /// [`Pheromone::value_at`] then, with Gaussian sources as frozen once for this step's sensing (a
+    /// task's reward reads the field at many points without recomputing each source's time factors).
+    pub fn pheromone_value_observed(&self, index: usize, p: Vec2) -> f32 {
+        match &self.pheromones[index].model {
+            crate::field::FieldModel::Grid(g) => g.value_at(p),
+            // Sources that have not started are left out of the frozen set; they add 0.0.
+            crate::field::FieldModel::Gaussian(_) => self
+                .frozen
+                .of(index)
+                .iter()
+                .fold(0.0, |sum, s| sum + s.value_at(p)),
+        }
+    }
     /// The colour sensor model shared by all robots.
     pub fn sensor(&self) -> &ColourSensor {
         &self.sensor
