@@ -33,7 +33,13 @@ impl<const N: usize> GridSampler<N> {
     /// `g`'s bilinear values at the points `(xs[k], ys[k])`: the same values, bit for bit, as
     /// [`GridField::value_at`] (same clamping, same arithmetic).
     #[inline(always)]
-    pub(crate) fn values(&mut self, g: &GridField, xs: &[f32; N], ys: &[f32; N], out: &mut [f32; N]) {
+    pub(crate) fn values(
+        &mut self,
+        g: &GridField,
+        xs: &[f32; N],
+        ys: &[f32; N],
+        out: &mut [f32; N],
+    ) {
         let spec = *g.spec();
         let GridSpec { nx, ny, .. } = spec;
         // Flat indices fit 31 bits on every grid a scenario allows (2e8 cells); a larger grid built
@@ -56,10 +62,16 @@ impl<const N: usize> GridSampler<N> {
             unsafe { self.gather_avx2(v, out) };
             return;
         }
-        for k in 0..N {
+        self.interpolate_from(v, 0, out);
+    }
+
+    /// The interpolation of points `from..N`, one at a time.
+    #[inline(always)]
+    fn interpolate_from(&self, v: &[f32], from: usize, out: &mut [f32; N]) {
+        for (k, o) in out.iter_mut().enumerate().skip(from) {
             let b = self.base[k] as usize;
             let (sx, sy) = (self.step_x[k] as usize, self.step_y[k] as usize);
-            out[k] = bilinear_mix(
+            *o = bilinear_mix(
                 v[b],
                 v[b + sx],
                 v[b + sy],
@@ -104,18 +116,7 @@ impl<const N: usize> GridSampler<N> {
                 _mm256_storeu_ps(out.as_mut_ptr().add(k), r);
             }
         }
-        for k in whole..N {
-            let b = self.base[k] as usize;
-            let (sx, sy) = (self.step_x[k] as usize, self.step_y[k] as usize);
-            out[k] = bilinear_mix(
-                v[b],
-                v[b + sx],
-                v[b + sy],
-                v[b + sy + sx],
-                self.tx[k],
-                self.ty[k],
-            );
-        }
+        self.interpolate_from(v, whole, out);
     }
 
     /// Corners and weights of every point on `spec` (`nx, ny >= 1`, `nx * ny` within 31 bits).

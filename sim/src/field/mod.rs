@@ -14,11 +14,11 @@ pub use backend::{BackendChoice, FieldBackend};
 pub use frozen::FrozenSources;
 pub use gaussian::{FrozenSource, GaussianField, GaussianSource};
 pub(crate) use grid::lerp_index;
-pub(crate) use grid_sampler::GridSampler;
 pub use grid::{
-    Bilinear, DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,
-    bilinear_mix, thomas_coefficients,
+    Bilinear, DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS, bilinear_mix,
+    thomas_coefficients,
 };
+pub(crate) use grid_sampler::GridSampler;
 pub use kernel::Kernel;
 pub use pheromone::{FieldModel, Pheromone};
 pub use static_map::{image_map, polyline_map};

@@ -64,7 +64,10 @@ impl World {
                 .enumerate()
                 .for_each(deposit_into);
         } else {
-            self.pheromones.iter_mut().enumerate().for_each(deposit_into);
+            self.pheromones
+                .iter_mut()
+                .enumerate()
+                .for_each(deposit_into);
         }
         for i in 0..self.robots.len() {
             if let Some(p) = self.injection_point(i) {
