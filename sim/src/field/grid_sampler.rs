@@ -116,7 +116,31 @@ impl<const N: usize> GridSampler<N> {
                 _mm256_storeu_ps(out.as_mut_ptr().add(k), r);
             }
         }
-        self.interpolate_from(v, whole, out);
+        // A four-point remainder (a robot's 36 footprint samples) in one 128-bit gather.
+        let mut done = whole;
+        if N - whole >= 4 {
+            let k = whole;
+            // SAFETY: as above, with `k + 4 <= N`.
+            unsafe {
+                let load_i = |a: &[i32; N]| _mm_loadu_si128(a.as_ptr().add(k).cast());
+                let load_f = |a: &[f32; N]| _mm_loadu_ps(a.as_ptr().add(k));
+                let b = load_i(&self.base);
+                let b10 = _mm_add_epi32(b, load_i(&self.step_x));
+                let b01 = _mm_add_epi32(b, load_i(&self.step_y));
+                let b11 = _mm_add_epi32(b01, load_i(&self.step_x));
+                let v00 = _mm_i32gather_ps::<4>(p, b);
+                let v10 = _mm_i32gather_ps::<4>(p, b10);
+                let v01 = _mm_i32gather_ps::<4>(p, b01);
+                let v11 = _mm_i32gather_ps::<4>(p, b11);
+                let (tx, ty) = (load_f(&self.tx), load_f(&self.ty));
+                let lo = _mm_add_ps(v00, _mm_mul_ps(_mm_sub_ps(v10, v00), tx));
+                let hi = _mm_add_ps(v01, _mm_mul_ps(_mm_sub_ps(v11, v01), tx));
+                let r = _mm_add_ps(lo, _mm_mul_ps(_mm_sub_ps(hi, lo), ty));
+                _mm_storeu_ps(out.as_mut_ptr().add(k), r);
+            }
+            done += 4;
+        }
+        self.interpolate_from(v, done, out);
     }
 
     /// Corners and weights of every point on `spec` (`nx, ny >= 1`, `nx * ny` within 31 bits).

@@ -193,9 +193,11 @@ impl NeighbourIndex {
 
     fn cell_index(&self, p: Vec2) -> usize {
         let [nx, ny] = self.dims;
+        // `as usize` saturates negatives to 0 and truncates the rest: `floor(v / cell).max(0)`
+        // without a libm `floorf` call (baseline x86-64 has no rounding instruction).
         let c = |v: f32, n: usize| {
             if v.is_finite() {
-                ((v / self.cell).floor().max(0.0) as usize).min(n - 1)
+                ((v / self.cell) as usize).min(n - 1)
             } else {
                 0
             }
