@@ -288,33 +288,36 @@ impl GridField {
         b: Vec2,
         amount: f32,
     ) {
-        let GridSpec { nx, ny, cell } = self.spec;
-        let support = kernel.support();
-        if !(support >= 0.0) || !a.is_finite() || !b.is_finite() {
-            return;
+        let ny = self.spec.ny;
+        self.band_mut(0, ny).deposit_segment(kernel, a, b, amount);
+    }
+
+    /// Rows `first_row..first_row + rows` (clamped to the grid) as a band that takes deposits.
+    pub fn band_mut(&mut self, first_row: usize, rows: usize) -> GridBand<'_> {
+        let GridSpec { nx, ny, .. } = self.spec;
+        let first_row = first_row.min(ny);
+        let rows = rows.min(ny - first_row);
+        GridBand {
+            spec: self.spec,
+            first_row,
+            values: &mut self.values[first_row * nx..(first_row + rows) * nx],
         }
-        let (i0, i1) = self
-            .spec
-            .cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
-        let (j0, j1) = self
-            .spec
-            .cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
-        let ab = b - a;
-        let len2 = ab.length_squared();
-        for j in j0..j1 {
-            let y = (j as f32 + 0.5) * cell;
-            let row = &mut self.values[j * nx..(j + 1) * nx];
-            for (i, v) in row.iter_mut().enumerate().take(i1).skip(i0) {
-                let p = Vec2::new((i as f32 + 0.5) * cell, y);
-                let dist = segment_distance(p, a, ab, len2);
-                if dist <= support {
-                    let w = kernel.weight(dist);
-                    if w != 0.0 {
-                        *v += amount * w;
-                    }
-                }
-            }
-        }
+    }
+
+    /// The grid cut into bands of `rows` rows (the last may be shorter): deposits into different
+    /// bands can run in parallel, and a cell's deposits still arrive in the order they are made
+    /// when every band takes every deposit in that order.
+    pub fn bands_mut(&mut self, rows: usize) -> impl Iterator<Item = GridBand<'_>> {
+        let spec = self.spec;
+        let rows = rows.max(1);
+        self.values
+            .chunks_mut((rows * spec.nx).max(1))
+            .enumerate()
+            .map(move |(k, values)| GridBand {
+                spec,
+                first_row: k * rows,
+                values,
+            })
     }
 
     /// Adds `amount * kernel.weight(distance to p)` to every cell near `p`.
@@ -538,6 +541,77 @@ fn substeps(x: f32, max: f32) -> usize {
         1
     } else {
         ((x / max).ceil() as usize).max(1)
+    }
+}
+
+/// Consecutive rows of a grid's values (see [`GridField::bands_mut`]): deposits land on the cells of
+/// these rows only.
+pub struct GridBand<'a> {
+    spec: GridSpec,
+    first_row: usize,
+    values: &'a mut [f32],
+}
+
+impl GridBand<'_> {
+    /// [`GridField::deposit_segment`] restricted to this band's rows: the same additions, in the
+    /// same arithmetic, on the cells the band holds.
+    pub fn deposit_segment(
+        &mut self,
+        kernel: &crate::field::Kernel,
+        a: Vec2,
+        b: Vec2,
+        amount: f32,
+    ) {
+        let GridSpec { nx, ny, cell } = self.spec;
+        let support = kernel.support();
+        if !(support >= 0.0) || !a.is_finite() || !b.is_finite() {
+            return;
+        }
+        let (j0, j1) = self
+            .spec
+            .cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
+        let band_end = self.first_row + self.values.len() / nx.max(1);
+        let (j0, j1) = (j0.max(self.first_row), j1.min(band_end));
+        if j0 >= j1 {
+            return;
+        }
+        let (i0, i1) = self
+            .spec
+            .cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
+        let ab = b - a;
+        let len2 = ab.length_squared();
+        for j in j0..j1 {
+            let y = (j as f32 + 0.5) * cell;
+            let r = j - self.first_row;
+            let row = &mut self.values[r * nx..(r + 1) * nx];
+            for (i, v) in row.iter_mut().enumerate().take(i1).skip(i0) {
+                let p = Vec2::new((i as f32 + 0.5) * cell, y);
+                let dist = segment_distance(p, a, ab, len2);
+                if dist <= support {
+                    let w = kernel.weight(dist);
+                    if w != 0.0 {
+                        *v += amount * w;
+                    }
+                }
+            }
+        }
+    }
+
+    /// [`GridField::prefetch_around`] for the cells of this band.
+    #[inline]
+    pub fn prefetch_around(&self, p: Vec2, radius: f32) {
+        let GridSpec { nx, ny, cell } = self.spec;
+        if nx == 0 || ny == 0 || !p.is_finite() {
+            return;
+        }
+        let index = |v: f32, n: usize| ((v / cell - 0.5).max(0.0) as usize).min(n - 1);
+        let band_end = self.first_row + self.values.len() / nx;
+        let j0 = index(p.y - radius, ny).max(self.first_row);
+        let j1 = (index(p.y + radius, ny) + 1).min(band_end);
+        let i = index(p.x, nx);
+        for j in j0..j1 {
+            crate::prefetch::prefetch(&self.values[(j - self.first_row) * nx + i]);
+        }
     }
 }
 

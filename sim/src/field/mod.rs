@@ -15,8 +15,8 @@ pub use frozen::FrozenSources;
 pub use gaussian::{FrozenSource, GaussianField, GaussianSource};
 pub(crate) use grid::lerp_index;
 pub use grid::{
-    Bilinear, DiffusionScheme, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS, bilinear_mix,
-    thomas_coefficients,
+    Bilinear, DiffusionScheme, GridBand, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,
+    bilinear_mix, thomas_coefficients,
 };
 pub(crate) use grid_sampler::GridSampler;
 pub use kernel::Kernel;

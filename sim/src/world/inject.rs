@@ -1,7 +1,7 @@
 //! Injection: robots lay trails on grid pheromones along their path and move their Gaussian sources,
 //! at their tracked poses (as the real host does) or their true ones.
 use super::{Deposit, World};
-use crate::field::{FieldModel, Pheromone};
+use crate::field::{FieldModel, GridBand};
 use crate::robot::Pose;
 use crate::scenario::InjectAt;
 use crate::tracker::TrackedPose;
@@ -10,6 +10,8 @@ use rayon::prelude::*;
 
 /// From this many trail deposits a step, fields take their deposits in parallel.
 const PARALLEL_DEPOSITS: usize = 256;
+/// Bands of rows each grid field is cut into when deposits run in parallel.
+const BANDS: usize = 4;
 /// Deposits ahead whose cells are prefetched: their rows are scattered over a large field.
 const PREFETCH_AHEAD: usize = 2;
 
@@ -34,40 +36,48 @@ impl World {
 
     pub(super) fn inject(&mut self) {
         let dt = self.dt;
-        // A field's values depend on the order of its own deposits only: each field takes its
-        // deposits in scenario order, and fields run in parallel.
+        // A cell's value depends on the order of its own deposits only: each field, cut into bands
+        // of rows, takes its deposits in scenario order in every band, and bands run in parallel.
         let (inject_at, poses, tracked) = (self.inject_at, self.physics.poses(), &self.tracked);
         let point = |i: usize| injection_point_of(inject_at, poses, tracked, i);
         let (deposits, last) = (&self.deposits, &self.last_injection);
-        let deposit_into = |(index, ph): (usize, &mut Pheromone)| {
-            let FieldModel::Grid(grid) = &mut ph.model else {
-                return;
-            };
+        let deposit_into = |index: usize, band: &mut GridBand| {
             let mine = |d: &&Deposit| d.pheromone == index;
             let mut ahead = deposits.iter().filter(mine).skip(PREFETCH_AHEAD);
             for dep in deposits.iter().filter(mine) {
                 if let Some(next) = ahead.next()
                     && let Some(p) = point(next.robot)
                 {
-                    grid.prefetch_around(p, next.kernel.support());
+                    band.prefetch_around(p, next.kernel.support());
                 }
                 let Some(to) = point(dep.robot) else {
                     continue;
                 };
                 let from = last[dep.robot].unwrap_or(to);
-                grid.deposit_segment(&dep.kernel, from, to, dep.rate * dt);
+                band.deposit_segment(&dep.kernel, from, to, dep.rate * dt);
             }
         };
-        if self.deposits.len() >= PARALLEL_DEPOSITS {
-            self.pheromones
+        let parallel = self.deposits.len() >= PARALLEL_DEPOSITS;
+        let mut bands: Vec<(usize, GridBand)> = Vec::new();
+        for (index, ph) in self.pheromones.iter_mut().enumerate() {
+            if let FieldModel::Grid(grid) = &mut ph.model {
+                let ny = grid.spec().ny;
+                let rows = if parallel {
+                    ny.div_ceil(BANDS).max(1)
+                } else {
+                    ny.max(1)
+                };
+                bands.extend(grid.bands_mut(rows).map(|band| (index, band)));
+            }
+        }
+        if parallel {
+            bands
                 .par_iter_mut()
-                .enumerate()
-                .for_each(deposit_into);
+                .for_each(|(index, band)| deposit_into(*index, band));
         } else {
-            self.pheromones
+            bands
                 .iter_mut()
-                .enumerate()
-                .for_each(deposit_into);
+                .for_each(|(index, band)| deposit_into(*index, band));
         }
         for i in 0..self.robots.len() {
             if let Some(p) = self.injection_point(i) {
