@@ -119,6 +119,7 @@ impl World {
             physics,
             observations: vec![Observation::default(); robots.len()],
             last_injection: vec![None; robots.len()],
+            segments: Vec::new(),
             robots,
             tracker,
             tracker_rng,

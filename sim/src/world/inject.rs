@@ -1,7 +1,7 @@
 //! Injection: robots lay trails on grid pheromones along their path and move their Gaussian sources,
 //! at their tracked poses (as the real host does) or their true ones.
-use super::{Deposit, World};
-use crate::field::{FieldModel, GridBand};
+use super::World;
+use crate::field::{FieldModel, GridBand, Kernel};
 use crate::robot::Pose;
 use crate::scenario::InjectAt;
 use crate::tracker::TrackedPose;
@@ -12,8 +12,14 @@ use rayon::prelude::*;
 const PARALLEL_DEPOSITS: usize = 256;
 /// Bands of rows each grid field is cut into when deposits run in parallel.
 const BANDS: usize = 4;
-/// Deposits ahead whose cells are prefetched: their rows are scattered over a large field.
-const PREFETCH_AHEAD: usize = 2;
+/// One robot's trail deposit of this step: the segment from where it injected last to where it is.
+pub(super) struct Segment {
+    pheromone: usize,
+    kernel: Kernel,
+    from: Vec2,
+    to: Vec2,
+    amount: f32,
+}
 
 /// Where the host believes robot `i` is (see [`World::injection_point`]).
 fn injection_point_of(
@@ -36,25 +42,29 @@ impl World {
 
     pub(super) fn inject(&mut self) {
         let dt = self.dt;
+        // This step's trail segments, in scenario order.
+        self.segments.clear();
+        for dep in &self.deposits {
+            let robot = dep.robot;
+            let Some(to) =
+                injection_point_of(self.inject_at, self.physics.poses(), &self.tracked, robot)
+            else {
+                continue;
+            };
+            self.segments.push(Segment {
+                pheromone: dep.pheromone,
+                kernel: dep.kernel,
+                from: self.last_injection[robot].unwrap_or(to),
+                to,
+                amount: dep.rate * dt,
+            });
+        }
         // A cell's value depends on the order of its own deposits only: each field, cut into bands
-        // of rows, takes its deposits in scenario order in every band, and bands run in parallel.
-        let (inject_at, poses, tracked) = (self.inject_at, self.physics.poses(), &self.tracked);
-        let point = |i: usize| injection_point_of(inject_at, poses, tracked, i);
-        let (deposits, last) = (&self.deposits, &self.last_injection);
+        // of rows, takes its segments in scenario order in every band, and bands run in parallel.
+        let segments = &self.segments;
         let deposit_into = |index: usize, band: &mut GridBand| {
-            let mine = |d: &&Deposit| d.pheromone == index;
-            let mut ahead = deposits.iter().filter(mine).skip(PREFETCH_AHEAD);
-            for dep in deposits.iter().filter(mine) {
-                if let Some(next) = ahead.next()
-                    && let Some(p) = point(next.robot)
-                {
-                    band.prefetch_around(p, next.kernel.support());
-                }
-                let Some(to) = point(dep.robot) else {
-                    continue;
-                };
-                let from = last[dep.robot].unwrap_or(to);
-                band.deposit_segment(&dep.kernel, from, to, dep.rate * dt);
+            for s in segments.iter().filter(|s| s.pheromone == index) {
+                band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
             }
         };
         let parallel = self.deposits.len() >= PARALLEL_DEPOSITS;

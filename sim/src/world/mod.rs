@@ -66,6 +66,8 @@ pub struct World {
     tracked: Vec<TrackedPose>,
     /// Where each robot injected last (None before its first tracked pose).
     last_injection: Vec<Option<Vec2>>,
+    /// Scratch: this step's trail segments.
+    segments: Vec<inject::Segment>,
     neighbours: NeighbourIndex,
     sensor: ColourSensor,
     deposits: Vec<Deposit>,
