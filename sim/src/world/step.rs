@@ -103,7 +103,6 @@ impl World {
             &self.bumper_params,
             self.time,
         );
-        let footprint = sensor.params.footprint_radius;
         let any_grid = pheromones
             .iter()
             .any(|ph| matches!(ph.model, FieldModel::Grid(_)));
@@ -114,7 +113,7 @@ impl World {
                 for &p in next {
                     for ph in pheromones {
                         if let FieldModel::Grid(g) = &ph.model {
-                            g.prefetch_around(p, footprint);
+                            g.prefetch_at(p);
                         }
                     }
                 }
