@@ -1,5 +1,6 @@
 //! What a run writes: the trajectory log, the GIF, pictures and arrays.
 pub mod draw;
+pub mod fixed;
 pub mod gif;
 pub mod npy;
 pub mod trajectory;

@@ -1,5 +1,6 @@
 //! The trajectory log: one CSV row per robot and logged tick, appended and flushed as the run goes,
 //! so a killed run keeps every complete row.
+use super::fixed::{push_digits, push_fixed};
 use crate::error::{Result, SimError};
 use crate::world::World;
 use std::fs::File;
@@ -72,36 +73,48 @@ impl TrajectoryLog {
 
     /// Appends one row per robot for the world's current tick and flushes them to the file.
     pub fn record(&mut self, world: &World) -> Result<()> {
-        use std::fmt::Write as _;
         let (poses, tracked, obs) = (world.poses(), world.tracked(), world.observations());
         for i in 0..world.robot_count() {
             let (p, t, o, cmd) = (&poses[i], &tracked[i], &obs[i], world.robots()[i].command);
             let l = &mut self.line;
             l.clear();
-            let _ = write!(
-                l,
-                "{},{:.2},{},{},{:.5},{:.5},{:.4},{:.5},{:.5},{:.4},{},{:.4},{:.4}",
-                world.tick(),
-                world.time(),
-                i,
-                world.role(i),
-                p.pos.x,
-                p.pos.y,
-                p.heading,
-                t.pose.pos.x,
-                t.pose.pos.y,
-                t.pose.heading,
-                t.seen as u8,
-                cmd.left,
-                cmd.right
-            );
+            push_digits(l, world.tick(), 1);
+            l.push(',');
+            push_fixed(l, world.time(), 2);
+            l.push(',');
+            push_digits(l, i as u64, 1);
+            l.push(',');
+            l.push_str(world.role(i));
+            l.push(',');
+            for (k, (value, decimals)) in [
+                (p.pos.x, 5),
+                (p.pos.y, 5),
+                (p.heading, 4),
+                (t.pose.pos.x, 5),
+                (t.pose.pos.y, 5),
+                (t.pose.heading, 4),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                if k > 0 {
+                    l.push(',');
+                }
+                push_fixed(l, value, decimals);
+            }
+            l.push_str(if t.seen { ",1," } else { ",0," });
+            push_fixed(l, cmd.left, 4);
+            l.push(',');
+            push_fixed(l, cmd.right, 4);
             for counts in &o.counts {
-                for c in counts {
-                    let _ = write!(l, ",{c}");
+                for &c in counts {
+                    l.push(',');
+                    push_digits(l, u64::from(c), 1);
                 }
             }
-            for b in &o.bumpers {
-                let _ = write!(l, ",{b:.3}");
+            for &b in &o.bumpers {
+                l.push(',');
+                push_fixed(l, b, 3);
             }
             l.push('\n');
             let line = std::mem::take(&mut self.line);
