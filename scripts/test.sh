@@ -13,9 +13,13 @@ say() { echo; echo "== $* ($(( $(date +%s) - t0 )) s)"; }
 
 say "cargo fmt --check"
 cargo fmt --all -- --check
+cargo fmt --manifest-path pyo3-bindings/Cargo.toml -- --check
 
 say "cargo clippy"
 cargo clippy --workspace --all-targets -- -D warnings
+# The Python bindings are a workspace of their own (maturin builds them); sharing the target dir reuses
+# the checked dependencies of the line above.
+CARGO_TARGET_DIR=target cargo clippy --manifest-path pyo3-bindings/Cargo.toml --all-targets -- -D warnings
 
 say "cargo test (release profile, shared with the GPU and Python builds)"
 cargo test --workspace --release
