@@ -277,8 +277,9 @@ impl GridField {
     }
 
     /// Adds `amount * kernel.weight(distance to segment a-b)` to every cell near the segment.
-    /// Only the bounding box of the segment grown by the kernel's support is visited. `a == b` is a point
-    /// deposit. A kernel narrower than half a cell may touch no cell centre and deposit nothing.
+    /// Only cells of the segment's bounding box grown by the kernel's support are visited, and of
+    /// those only the ones each row can bring within the support. `a == b` is a point deposit. A
+    /// kernel narrower than half a cell may touch no cell centre and deposit nothing.
     pub fn deposit_segment(
         &mut self,
         kernel: &crate::field::Kernel,
