@@ -98,7 +98,8 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
     bar.finish_and_clear();
 
     let s = world.screen();
-    let img = screen::render(world.pheromones(), s, s.resolution[0], s.resolution[1]);
+    let (width, height) = png_size(s.resolution);
+    let img = screen::render(world.pheromones(), s, width, height);
     let png = out_dir.join("screen.png");
     screen::save_png(&img, &png)?;
     files.push(png);
@@ -184,4 +185,39 @@ fn sanitize(name: &str) -> String {
             }
         })
         .collect()
+}
+
+/// Largest final screen image written, in pixels: an 8K panel. A virtual screen beyond it (the
+/// 10,000-robot benchmark's arena is 38,400 x 21,600 pixels, 2.5 GB as RGB) is drawn scaled down to fit,
+/// with its aspect ratio.
+const MAX_PNG_PIXELS: u64 = 7680 * 4320;
+
+/// The size of `screen.png` for a panel of `resolution` pixels: the panel's own, or scaled down to at
+/// most [`MAX_PNG_PIXELS`].
+fn png_size(resolution: [u32; 2]) -> (u32, u32) {
+    let [w, h] = resolution.map(|r| r.max(1));
+    let pixels = u64::from(w) * u64::from(h);
+    if pixels <= MAX_PNG_PIXELS {
+        return (w, h);
+    }
+    let scale = (MAX_PNG_PIXELS as f64 / pixels as f64).sqrt();
+    let fit = |n: u32| ((f64::from(n) * scale).floor() as u32).max(1);
+    (fit(w), fit(h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn screen_png_keeps_panels_up_to_8k_and_scales_larger_ones() {
+        assert_eq!(png_size([3840, 2160]), (3840, 2160));
+        assert_eq!(png_size([7680, 4320]), (7680, 4320));
+        assert_eq!(png_size([38_400, 21_600]), (7680, 4320));
+        let (w, h) = png_size([65_536, 100]);
+        assert!(
+            u64::from(w) * u64::from(h) <= MAX_PNG_PIXELS && h >= 1,
+            "{w} x {h}"
+        );
+    }
 }

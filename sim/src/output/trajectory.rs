@@ -3,6 +3,7 @@
 use super::fixed::{push_digits, push_fixed};
 use crate::error::{Result, SimError};
 use crate::world::World;
+use rayon::prelude::*;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -73,56 +74,104 @@ impl TrajectoryLog {
 
     /// Appends one row per robot for the world's current tick and flushes them to the file.
     pub fn record(&mut self, world: &World) -> Result<()> {
-        let (poses, tracked, obs) = (world.poses(), world.tracked(), world.observations());
-        for i in 0..world.robot_count() {
-            let (p, t, o, cmd) = (&poses[i], &tracked[i], &obs[i], world.robots()[i].command);
-            let l = &mut self.line;
-            l.clear();
-            push_digits(l, world.tick(), 1);
-            l.push(',');
-            push_fixed(l, world.time(), 2);
-            l.push(',');
-            push_digits(l, i as u64, 1);
-            l.push(',');
-            l.push_str(world.role(i));
-            l.push(',');
-            for (k, (value, decimals)) in [
-                (p.pos.x, 5),
-                (p.pos.y, 5),
-                (p.heading, 4),
-                (t.pose.pos.x, 5),
-                (t.pose.pos.y, 5),
-                (t.pose.heading, 4),
-            ]
-            .into_iter()
-            .enumerate()
-            {
-                if k > 0 {
-                    l.push(',');
-                }
-                push_fixed(l, value, decimals);
-            }
-            l.push_str(if t.seen { ",1," } else { ",0," });
-            push_fixed(l, cmd.left, 4);
-            l.push(',');
-            push_fixed(l, cmd.right, 4);
-            for counts in &o.counts {
-                for &c in counts {
-                    l.push(',');
-                    push_digits(l, u64::from(c), 1);
-                }
-            }
-            for &b in &o.bumpers {
-                l.push(',');
-                push_fixed(l, b, 3);
-            }
-            l.push('\n');
-            let line = std::mem::take(&mut self.line);
-            let res = self.write_str(&line);
-            self.line = line;
+        let n = world.robot_count();
+        let rows = RowInputs {
+            tick: world.tick(),
+            time: world.time(),
+            poses: world.poses(),
+            tracked: world.tracked(),
+            obs: world.observations(),
+            commands: world.robots().iter().map(|r| r.command).collect(),
+            roles: (0..n).map(|i| world.role(i)).collect(),
+        };
+        if n < 2 * ROWS_PER_CHUNK {
+            let mut text = std::mem::take(&mut self.line);
+            text.clear();
+            (0..n).for_each(|i| rows.push_row(&mut text, i));
+            let res = self.write_str(&text);
+            self.line = text;
             res?;
+        } else {
+            // A large swarm's rows are formatted in parallel chunks and written in robot order.
+            let chunks: Vec<String> = (0..n.div_ceil(ROWS_PER_CHUNK))
+                .into_par_iter()
+                .map(|c| {
+                    let mut text = String::with_capacity(ROWS_PER_CHUNK * 160);
+                    (c * ROWS_PER_CHUNK..((c + 1) * ROWS_PER_CHUNK).min(n))
+                        .for_each(|i| rows.push_row(&mut text, i));
+                    text
+                })
+                .collect();
+            for text in &chunks {
+                self.write_str(text)?;
+            }
         }
         // Rows reach the file whole: the buffer is flushed only at a tick boundary.
         self.flush()
+    }
+}
+
+/// Robots whose rows one parallel task formats.
+const ROWS_PER_CHUNK: usize = 512;
+
+/// What the rows of one tick are made of (the world itself is not shared across threads).
+struct RowInputs<'a> {
+    tick: u64,
+    time: f32,
+    poses: &'a [crate::robot::Pose],
+    tracked: &'a [crate::tracker::TrackedPose],
+    obs: &'a [crate::behaviour::Observation],
+    commands: Vec<crate::behaviour::WheelCommand>,
+    roles: Vec<&'a str>,
+}
+
+impl RowInputs<'_> {
+    /// Appends robot `i`'s row, newline included.
+    fn push_row(&self, l: &mut String, i: usize) {
+        let (p, t, o, cmd) = (
+            &self.poses[i],
+            &self.tracked[i],
+            &self.obs[i],
+            self.commands[i],
+        );
+        push_digits(l, self.tick, 1);
+        l.push(',');
+        push_fixed(l, self.time, 2);
+        l.push(',');
+        push_digits(l, i as u64, 1);
+        l.push(',');
+        l.push_str(self.roles[i]);
+        l.push(',');
+        for (k, (value, decimals)) in [
+            (p.pos.x, 5),
+            (p.pos.y, 5),
+            (p.heading, 4),
+            (t.pose.pos.x, 5),
+            (t.pose.pos.y, 5),
+            (t.pose.heading, 4),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if k > 0 {
+                l.push(',');
+            }
+            push_fixed(l, value, decimals);
+        }
+        l.push_str(if t.seen { ",1," } else { ",0," });
+        push_fixed(l, cmd.left, 4);
+        l.push(',');
+        push_fixed(l, cmd.right, 4);
+        for counts in &o.counts {
+            for &c in counts {
+                l.push(',');
+                push_digits(l, u64::from(c), 1);
+            }
+        }
+        for &b in &o.bumpers {
+            l.push(',');
+            push_fixed(l, b, 3);
+        }
+        l.push('\n');
     }
 }

@@ -1,0 +1,81 @@
+//! The trajectory log: rows as `{:.N}` formats them, in robot order, for a swarm large enough to be
+//! formatted in parallel chunks.
+use colcos_sim::output::TrajectoryLog;
+use colcos_sim::prelude::*;
+use std::fmt::Write as _;
+
+/// One row the obvious way (the log's format written with `write!`).
+fn reference_row(world: &World, i: usize) -> String {
+    let (p, t, o) = (
+        &world.poses()[i],
+        &world.tracked()[i],
+        &world.observations()[i],
+    );
+    let cmd = world.robots()[i].command;
+    let mut l = format!(
+        "{},{:.2},{},{},{:.5},{:.5},{:.4},{:.5},{:.5},{:.4},{},{:.4},{:.4}",
+        world.tick(),
+        world.time(),
+        i,
+        world.role(i),
+        p.pos.x,
+        p.pos.y,
+        p.heading,
+        t.pose.pos.x,
+        t.pose.pos.y,
+        t.pose.heading,
+        t.seen as u8,
+        cmd.left,
+        cmd.right
+    );
+    for c in o.counts.iter().flatten() {
+        let _ = write!(l, ",{c}");
+    }
+    for b in &o.bumpers {
+        let _ = write!(l, ",{b:.3}");
+    }
+    l
+}
+
+#[test]
+fn a_large_swarm_logs_every_row_in_order_as_std_formats_it() {
+    let sc = Scenario::from_toml_str(
+        r#"
+duration = 1.0
+[screen]
+resolution = [3840, 2160]
+size = [3.2, 1.8]
+[field]
+cell = 0.01
+[output]
+gif_interval = 0
+[[pheromones]]
+name = "red"
+colour = [255, 0, 0]
+[[robots]]
+count = 1300
+behaviour = "wander"
+role = "walker"
+deposits = [{ pheromone = "red", kernel = { shape = "disc", radius = 0.01 }, rate = 5.0 }]
+"#,
+        ".",
+    )
+    .unwrap();
+    let mut world = World::new(&sc).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("trajectory.csv");
+    let mut log = TrajectoryLog::create(&path).unwrap();
+    let mut want = vec![colcos_sim::output::trajectory::header()];
+    for _ in 0..3 {
+        world.step();
+        log.record(&world).unwrap();
+        want.extend((0..world.robot_count()).map(|i| reference_row(&world, i)));
+    }
+    drop(log);
+    let got = std::fs::read_to_string(&path).unwrap();
+    let got: Vec<&str> = got.lines().collect();
+    assert_eq!(got.len(), 1 + 3 * 1300);
+    for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+        assert_eq!(g, w, "line {k}");
+    }
+}
