@@ -67,27 +67,25 @@ impl World {
                 band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
             }
         };
-        let parallel = self.deposits.len() >= PARALLEL_DEPOSITS;
-        let mut bands: Vec<(usize, GridBand)> = Vec::new();
-        for (index, ph) in self.pheromones.iter_mut().enumerate() {
-            if let FieldModel::Grid(grid) = &mut ph.model {
-                let ny = grid.spec().ny;
-                let rows = if parallel {
-                    ny.div_ceil(BANDS).max(1)
-                } else {
-                    ny.max(1)
-                };
-                bands.extend(grid.bands_mut(rows).map(|band| (index, band)));
+        if self.deposits.len() >= PARALLEL_DEPOSITS {
+            let mut bands: Vec<(usize, GridBand)> = Vec::new();
+            for (index, ph) in self.pheromones.iter_mut().enumerate() {
+                if let FieldModel::Grid(grid) = &mut ph.model {
+                    let rows = grid.spec().ny.div_ceil(BANDS).max(1);
+                    bands.extend(grid.bands_mut(rows).map(|band| (index, band)));
+                }
             }
-        }
-        if parallel {
             bands
                 .par_iter_mut()
                 .for_each(|(index, band)| deposit_into(*index, band));
         } else {
-            bands
-                .iter_mut()
-                .for_each(|(index, band)| deposit_into(*index, band));
+            // A small world (a batched environment's): the whole grid as one band, nothing allocated.
+            for (index, ph) in self.pheromones.iter_mut().enumerate() {
+                if let FieldModel::Grid(grid) = &mut ph.model {
+                    let ny = grid.spec().ny;
+                    deposit_into(index, &mut grid.band_mut(0, ny));
+                }
+            }
         }
         for i in 0..self.robots.len() {
             if let Some(p) = self.injection_point(i) {
