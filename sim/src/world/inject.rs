@@ -12,6 +12,7 @@ use rayon::prelude::*;
 const PARALLEL_DEPOSITS: usize = 256;
 /// Bands of rows each grid field is cut into when deposits run in parallel.
 const BANDS: usize = 4;
+
 /// One robot's trail deposit of this step: the segment from where it injected last to where it is.
 pub(super) struct Segment {
     pheromone: usize,
