@@ -182,6 +182,45 @@ mod tests {
     use super::*;
     use crate::field::lerp_index;
 
+    /// The gathered path (AVX2 where the processor has it), the scalar loop over every point and
+    /// `value_at` give the same bits, inside the grid, on its edges and beyond them.
+    #[test]
+    fn gathered_scalar_and_pointwise_values_agree() {
+        use crate::field::GridParams;
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand::rngs::SmallRng::seed_from_u64(5);
+        for (nx, ny) in [(1, 1), (2, 3), (37, 23), (200, 120)] {
+            let spec = GridSpec { nx, ny, cell: 0.01 };
+            let mut g = GridField::new(spec, GridParams::default());
+            g.values_mut()
+                .iter_mut()
+                .for_each(|v| *v = rng.random_range(0.0..2.0));
+            let (w, h) = (nx as f32 * 0.01, ny as f32 * 0.01);
+            for _ in 0..50 {
+                let xs: [f32; 36] = std::array::from_fn(|_| rng.random_range(-0.02..w + 0.02));
+                let ys: [f32; 36] = std::array::from_fn(|_| rng.random_range(-0.02..h + 0.02));
+                let mut sampler = GridSampler::<36>::new();
+                let mut gathered = [0.0; 36];
+                sampler.values(&g, &xs, &ys, &mut gathered);
+                let mut scalar = [0.0; 36];
+                sampler.interpolate_from(g.values(), 0, &mut scalar);
+                for k in 0..36 {
+                    let want = g.value_at(Vec2::new(xs[k], ys[k]));
+                    assert_eq!(
+                        gathered[k].to_bits(),
+                        want.to_bits(),
+                        "point {k} on {nx}x{ny}"
+                    );
+                    assert_eq!(
+                        scalar[k].to_bits(),
+                        want.to_bits(),
+                        "point {k} on {nx}x{ny}"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn lerp_lane_matches_lerp_index() {
         for n in [1i32, 2, 3, 10] {
