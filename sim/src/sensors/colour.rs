@@ -8,6 +8,7 @@
 //! screen gives at most `30 + 1500 * 24 * 1.16 = 41,790` counts (the green row of the crosstalk matrix
 //! sums to 1.16), well below saturation with room for noise; at 40 ms or more white saturates every
 //! channel (`1500 * 40 * 1.11 > 65,535`), as a real TCS34725 does with too long an integration time.
+use super::pow_unit;
 use crate::field::{FrozenSources, Pheromone};
 use crate::rng::SimRng;
 use crate::screen::ScreenSpec;
@@ -56,9 +57,8 @@ pub const RING_FRACTION: f32 = 0.7;
 /// A colour sensor model with its calibrated inverse.
 #[derive(Clone, Debug)]
 pub struct ColourSensor {
-    pub params: ColourSensorParams,
-    /// Inverse of `params.crosstalk` (identity if it is singular).
-    inverse: [[f32; 3]; 3],
+    /// Fixed at construction: the matrices below are derived from it.
+    params: ColourSensorParams,
     /// Sample offsets of the footprint, m, relative to the sensor centre.
     offsets: [Vec2; RING_POINTS + 1],
     /// `light` of the mean level, indexed by the sum of the footprint's 8-bit levels (the transfer
@@ -66,6 +66,9 @@ pub struct ColourSensor {
     /// sensor with the same `gamma`: a batch of a thousand worlds reads one table that stays in cache,
     /// not a thousand (9 KB each) that do not.
     light_by_sum: Arc<[f32]>,
+    /// `params.crosstalk` and its inverse (identity if singular) as lanes ([`matrix_lanes`]).
+    crosstalk_lanes: [[f32; LANES]; 3],
+    inverse_lanes: [[f32; LANES]; 3],
 }
 
 /// The table of [`ColourSensor::light`] by footprint level sum for `gamma`, built once per process and
@@ -121,10 +124,16 @@ impl ColourSensor {
         }
         ColourSensor {
             params,
-            inverse,
             offsets,
             light_by_sum: shared_light_table(params.gamma),
+            crosstalk_lanes: matrix_lanes(&params.crosstalk),
+            inverse_lanes: matrix_lanes(&inverse),
         }
+    }
+
+    /// The parameters the sensor was built with.
+    pub fn params(&self) -> &ColourSensorParams {
+        &self.params
     }
 
     /// Where on the screen the sensor at `p` samples, arena coordinates: `p` and a ring around it.
@@ -173,12 +182,14 @@ impl ColourSensor {
         const BATCH: usize = 4;
         let mut sums = [[0u32; 3]; S];
         for (sensors, sums) in sensors.chunks(BATCH).zip(sums.chunks_mut(BATCH)) {
+            // Missing sensors of a short batch repeat the first: the batch stays one compact group of
+            // points (Gaussian sources take one `exp` per group, at its centroid).
             let mut points = [Vec2::ZERO; BATCH * FOOTPRINT_POINTS];
-            for (points, &p) in points.chunks_mut(FOOTPRINT_POINTS).zip(sensors) {
-                points.copy_from_slice(&self.sample_points(p));
+            for (k, points) in points.chunks_mut(FOOTPRINT_POINTS).enumerate() {
+                points.copy_from_slice(&self.sample_points(*sensors.get(k).unwrap_or(&sensors[0])));
             }
             let levels =
-                crate::screen::levels_at(pheromones, frozen, screen, &points, FOOTPRINT_POINTS);
+                crate::screen::levels_at(pheromones, frozen, screen, &points, points.len());
             for (c, levels) in levels.iter().enumerate() {
                 for (sum, levels) in sums.iter_mut().zip(levels.chunks(FOOTPRINT_POINTS)) {
                     sum[c] = levels.iter().sum();
@@ -213,7 +224,8 @@ impl ColourSensor {
     }
 
     /// [`ColourSensor::read`] of `S` sensors (a robot's four) in order, their footprints evaluated
-    /// together: the same counts and the same random draws as `S` calls of `read`.
+    /// together: the same random draws as `S` calls of `read`, and the same counts up to the f32
+    /// rounding of Gaussian sources (which share one `exp` per batch of four footprints).
     pub fn read_all<const S: usize>(
         &self,
         pheromones: &[Pheromone],
@@ -224,11 +236,8 @@ impl ColourSensor {
     ) -> [[u16; 3]; S] {
         let sums = self.footprint_sums(pheromones, frozen, screen, sensors);
         let lut = &self.light_by_sum;
-        let mut out = [[0u16; 3]; S];
-        for (o, [r, g, b]) in out.iter_mut().zip(sums) {
-            *o = self.counts_for_light([lut[r as usize], lut[g as usize], lut[b as usize]], rng);
-        }
-        out
+        let light = sums.map(|sum| sum.map(|s| lut[s as usize]));
+        self.counts_for_lights(&light, rng)
     }
 
     /// Light emitted per primary, in [0, 1], for 8-bit levels.
@@ -239,20 +248,38 @@ impl ColourSensor {
     /// Counts for the given mean screen levels: transfer curve, crosstalk, gain, integration, noise,
     /// saturation at 65535.
     pub fn counts(&self, levels: [f32; 3], rng: &mut SimRng) -> [u16; 3] {
-        self.counts_for_light(self.light(levels), rng)
+        self.counts_for_lights(&[self.light(levels)], rng)[0]
     }
 
-    fn counts_for_light(&self, light: [f32; 3], rng: &mut SimRng) -> [u16; 3] {
+    /// Counts of `S` sensors from their light per primary. The noise is drawn first, sensor by sensor
+    /// in r, g, b order; the arithmetic then runs over the lanes of up to four sensors (vectorises).
+    fn counts_for_lights<const S: usize>(
+        &self,
+        light: &[[f32; 3]; S],
+        rng: &mut SimRng,
+    ) -> [[u16; 3]; S] {
         let p = &self.params;
         let scale = p.gain * p.integration_ms;
-        let mut out = [0u16; 3];
-        for (c, o) in out.iter_mut().enumerate() {
-            let signal: f32 = (0..3).map(|k| p.crosstalk[c][k] * light[k]).sum();
-            let mut raw = p.dark_counts + scale * signal;
+        let mut out = [[0u16; 3]; S];
+        for (light, out) in light.chunks(LANE_SENSORS).zip(out.chunks_mut(LANE_SENSORS)) {
+            let mut noise = [0.0f32; LANES];
             if p.noise > 0.0 {
-                raw += p.noise * crate::rng::normal(rng);
+                for s in 0..light.len() {
+                    for c in 0..3 {
+                        noise[lane(s, c)] = p.noise * crate::rng::normal(rng);
+                    }
+                }
             }
-            *o = round_count(raw);
+            let [r, g, b] = spread(light);
+            let m = &self.crosstalk_lanes;
+            let mut counts = [0u16; LANES];
+            for i in 0..LANES {
+                let signal = m[0][i] * r[i] + m[1][i] * g[i] + m[2][i] * b[i];
+                counts[i] = round_count(p.dark_counts + scale * signal + noise[i]);
+            }
+            for (s, out) in out.iter_mut().enumerate() {
+                *out = std::array::from_fn(|c| counts[lane(s, c)]);
+            }
         }
         out
     }
@@ -263,31 +290,78 @@ impl ColourSensor {
     /// the light to [0, 1] and inverts the transfer curve: `intensity = light^(1 / gamma)`, which is
     /// `level / 255`. A saturated channel (65535) reads 1.
     pub fn intensity(&self, counts: [u16; 3]) -> [f32; 3] {
+        self.intensities(&[counts])[0]
+    }
+
+    /// [`ColourSensor::intensity`] of `S` sensors, computed over the lanes of up to four sensors (the
+    /// transfer curve's inverse by [`pow_unit`], so that it vectorises): the same values as `S` calls.
+    pub fn intensities<const S: usize>(&self, counts: &[[u16; 3]; S]) -> [[f32; 3]; S] {
         let p = &self.params;
         let scale = p.gain * p.integration_ms;
-        let mut signal = [0.0f32; 3];
-        if scale > 0.0 {
-            for (s, &n) in signal.iter_mut().zip(&counts) {
-                *s = (n as f32 - p.dark_counts) / scale;
-            }
-        }
         let inv_gamma = if p.gamma > 0.0 { 1.0 / p.gamma } else { 1.0 };
-        let mut out = [0.0f32; 3];
-        for (c, o) in out.iter_mut().enumerate() {
-            if counts[c] == u16::MAX {
-                *o = 1.0;
-                continue;
+        let mut out = [[0.0f32; 3]; S];
+        for (counts, out) in counts
+            .chunks(LANE_SENSORS)
+            .zip(out.chunks_mut(LANE_SENSORS))
+        {
+            let mut signal = [[0.0f32; 3]; LANE_SENSORS];
+            if scale > 0.0 {
+                for (signal, counts) in signal.iter_mut().zip(counts) {
+                    *signal = counts.map(|n| (n as f32 - p.dark_counts) / scale);
+                }
             }
-            let light: f32 = (0..3).map(|k| self.inverse[c][k] * signal[k]).sum();
-            let light = if light.is_nan() {
-                0.0
-            } else {
-                light.clamp(0.0, 1.0)
-            };
-            *o = light.powf(inv_gamma);
+            let [r, g, b] = spread(&signal);
+            let m = &self.inverse_lanes;
+            let mut v = [0.0f32; LANES];
+            for i in 0..LANES {
+                let light = m[0][i] * r[i] + m[1][i] * g[i] + m[2][i] * b[i];
+                // NaN (from an infinite gain) reads as no light.
+                let light = if light > 0.0 { light.min(1.0) } else { 0.0 };
+                v[i] = pow_unit(light, inv_gamma);
+            }
+            for (s, (out, counts)) in out.iter_mut().zip(counts).enumerate() {
+                *out = std::array::from_fn(|c| {
+                    if counts[c] == u16::MAX {
+                        1.0
+                    } else {
+                        v[lane(s, c)]
+                    }
+                });
+            }
         }
         out
     }
+}
+
+/// Sensors whose channels are computed together: a robot's four.
+const LANE_SENSORS: usize = 4;
+/// Their channels, channel-major: lane `4 c + s` is channel `c` of sensor `s`, so that a 3x3 channel
+/// matrix applies as three multiply-adds over whole lanes.
+const LANES: usize = 3 * LANE_SENSORS;
+
+#[inline(always)]
+fn lane(sensor: usize, channel: usize) -> usize {
+    LANE_SENSORS * channel + sensor
+}
+
+/// Each input channel of up to four sensors repeated in every channel's lanes: `[k][lane(s, c)]` is
+/// `values[s][k]` (0 past the last sensor).
+#[inline(always)]
+fn spread(values: &[[f32; 3]]) -> [[f32; LANES]; 3] {
+    let mut out = [[0.0f32; LANES]; 3];
+    for (k, out) in out.iter_mut().enumerate() {
+        for (s, v) in values.iter().enumerate().take(LANE_SENSORS) {
+            for c in 0..3 {
+                out[lane(s, c)] = v[k];
+            }
+        }
+    }
+    out
+}
+
+/// A 3x3 channel matrix as lanes: `[k][lane(s, c)]` is `m[c][k]`.
+fn matrix_lanes(m: &[[f32; 3]; 3]) -> [[f32; LANES]; 3] {
+    std::array::from_fn(|k| std::array::from_fn(|i| m[i / LANE_SENSORS][k]))
 }
 
 /// The display's transfer curve: light in [0, 1] of one primary at an 8-bit `level` (NaN gives 0).
@@ -307,16 +381,14 @@ fn mean_level(sum: u32) -> f32 {
 
 /// `raw.clamp(0, 65535).round() as u16` (NaN gives 0) without a libm `roundf` call: below 2^16 the
 /// truncation and the fraction are exact in f32.
-#[inline]
+#[inline(always)]
 fn round_count(raw: f32) -> u16 {
-    if raw >= 65535.0 {
-        u16::MAX
-    } else if raw > 0.0 {
-        let t = raw as u16;
-        t + u16::from(raw - t as f32 >= 0.5)
-    } else {
-        0
-    }
+    let c = if raw > 0.0 { raw.min(65535.0) } else { 0.0 };
+    // SAFETY: `c` is in [0, 65535] (NaN went to 0 above), so the truncation is in range; the plain
+    // conversion (not the saturating `as`) is what vectorises. Rounding up never passes 65535: a
+    // fraction of one half needs `c >= t + 0.5`, so `t <= 65534`.
+    let t = unsafe { c.to_int_unchecked::<i32>() };
+    (t + i32::from(c - t as f32 >= 0.5)) as u16
 }
 
 #[cfg(test)]

@@ -125,9 +125,7 @@ impl World {
             };
             o.counts =
                 sensor.read_all(pheromones, frozen, screen, &sensor_points[i], &mut slot.rng);
-            for (intensity, &counts) in o.intensity.iter_mut().zip(&o.counts) {
-                *intensity = sensor.intensity(counts);
-            }
+            o.intensity = sensor.intensities(&o.counts);
             o.bumpers = neighbours.bumpers(i, poses, radius, arena, bumper);
             *obs = o;
         };
