@@ -1,6 +1,6 @@
 //! The screen, eq. (1): I(x, y, c) = clip(sum_j k_j Phi_j(x, y)) as 8-bit RGB at the panel's resolution.
 use crate::error::{Result, SimError};
-use crate::field::{FieldModel, FrozenSources, GridSampler, Pheromone};
+use crate::field::{FieldModel, FrozenSources, GridSampler, NearbyPoints, Pheromone};
 use glam::Vec2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -169,6 +169,8 @@ pub fn levels_at_portable<const N: usize>(
         *x = pixel_centre_coord(p.x, pixel.x, nx);
         *y = pixel_centre_coord(p.y, pixel.y, ny);
     }
+    // One group (a robot's footprints, the usual call): its offsets computed once for every source.
+    let near = (group == N && !frozen.is_empty()).then(|| NearbyPoints::<N>::new(&xs, &ys));
     let mut acc = [[0f32; N]; 3];
     let mut grid = GridSampler::<N>::new();
     let mut values = [0f32; N];
@@ -183,7 +185,10 @@ pub fn levels_at_portable<const N: usize>(
             FieldModel::Gaussian(_) => {
                 values.fill(0.0);
                 for source in frozen.of(index) {
-                    source.add_values_soa(&xs, &ys, group, &mut values);
+                    match &near {
+                        Some(near) => source.add_values_near(near, &xs, &ys, &mut values),
+                        None => source.add_values_soa(&xs, &ys, group, &mut values),
+                    }
                 }
             }
         }

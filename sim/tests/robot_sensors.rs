@@ -1,7 +1,8 @@
 //! IR bumpers, neighbour index, and the colour-sensor layout.
 use colcos_sim::robot::Pose;
 use colcos_sim::sensors::{
-    BumperParams, NeighbourIndex, SENSOR_RADIUS, ray_disc, reading_for_distance, sensor_positions,
+    BumperParams, BumperRays, NeighbourIndex, SENSOR_RADIUS, ray_disc, reading_for_distance,
+    sensor_positions,
 };
 use glam::Vec2;
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4};
@@ -13,7 +14,7 @@ fn readings(poses: &[Pose], arena: Vec2, i: usize) -> [f32; 3] {
     let mut index = NeighbourIndex::default();
     let pos: Vec<Vec2> = poses.iter().map(|p| p.pos).collect();
     index.rebuild(arena, NeighbourIndex::cell_for(R, &params), &pos);
-    index.bumpers(i, poses, R, arena, &params)
+    index.bumpers(i, poses, R, arena, &BumperRays::new(&params))
 }
 
 #[test]
@@ -100,14 +101,14 @@ fn index_finds_the_same_as_brute_force() {
     // A whole-arena cell is brute force.
     index.rebuild(arena, 10.0, &pos);
     let brute: Vec<[f32; 3]> = (0..poses.len())
-        .map(|i| index.bumpers(i, &poses, R, arena, &params))
+        .map(|i| index.bumpers(i, &poses, R, arena, &BumperRays::new(&params)))
         .collect();
     let mut hits = 0;
     for cell in [NeighbourIndex::cell_for(R, &params), 0.03, 0.2] {
         index.rebuild(arena, cell, &pos);
         for (i, b) in brute.iter().enumerate() {
             assert_eq!(
-                index.bumpers(i, &poses, R, arena, &params),
+                index.bumpers(i, &poses, R, arena, &BumperRays::new(&params)),
                 *b,
                 "robot {i} cell {cell}"
             );

@@ -27,6 +27,11 @@ impl FrozenSources {
         }
     }
 
+    /// No started source in any pheromone.
+    pub fn is_empty(&self) -> bool {
+        self.per_pheromone.iter().all(Vec::is_empty)
+    }
+
     /// The frozen sources of pheromone `index` (empty for a grid pheromone).
     #[inline]
     pub fn of(&self, index: usize) -> &[FrozenSource] {

@@ -96,28 +96,76 @@ impl FrozenSource {
     }
 
     /// Adds the source's values at the points `(xs[k], ys[k])` to `out[k]`. The points come in groups of
-    /// `group` consecutive points close together (a robot's four sensor footprints) that share one
-    /// `exp` at their centroid `c`: the exponent is quadratic, so its change from `c` to a point,
-    /// `d = x(p) - x(c)`, is computed in f32 from the small offset `p - c`, and
-    /// `exp(x(p)) = exp(x(c)) exp(d)` with `exp(d)` by its series to 7th order where the terms of `d`
-    /// sum to at most [`SERIES_MAX`] in magnitude (error below 4e-10). The values agree with [`FrozenSource::value_at`] to a few f32 ulps
-    /// (tested), exactly for a group of one point; farther points take their own f64 `exp`. Structure
-    /// of arrays, so that the arithmetic over the points vectorises.
+    /// `group` consecutive points close together (a robot's four sensor footprints, at most
+    /// [`MAX_GROUP`]) that share one `exp`: see [`FrozenSource::add_values_near`].
     #[inline(always)]
     pub fn add_values_soa(&self, xs: &[f32], ys: &[f32], group: usize, out: &mut [f32]) {
         let n = xs.len().min(ys.len()).min(out.len());
-        let group = group.max(1);
+        let group = group.clamp(1, MAX_GROUP);
         let (xs, ys, out) = (&xs[..n], &ys[..n], &mut out[..n]);
         for ((xs, ys), out) in xs
             .chunks(group)
             .zip(ys.chunks(group))
             .zip(out.chunks_mut(group))
         {
-            self.add_values_group(xs, ys, out);
+            let near = NearbyPoints::<MAX_GROUP>::new(xs, ys);
+            let mut values = [0f32; MAX_GROUP];
+            self.add_values_near(&near, xs, ys, &mut values);
+            for (o, v) in out.iter_mut().zip(values) {
+                *o += v;
+            }
         }
     }
 
-    /// [`FrozenSource::add_values_soa`] for one group of points.
+    /// Adds the source's values at a group of points close together (`near`, made from `xs`, `ys`)
+    /// to `out`, with one `exp` at the group's centroid `c`: the exponent `x` is quadratic, so its
+    /// change to a point `p = c + e` is
+    /// `d = e_x (2 kxx dx0 - kxy dy0) + e_y (2 kyy dy0 - kxy dx0) + kxx e_x^2 + kyy e_y^2 - kxy e_x e_y`
+    /// (`(dx0, dy0) = c - centre`), computed in f32, and `exp(x(p)) = exp(x(c)) exp(d)` with `exp(d)`
+    /// by its series. A bound on the magnitudes of `d`'s terms over the whole group (from the largest
+    /// offsets) picks the series: 5th order up to 0.1 (error below 1.4e-9), 7th up to [`SERIES_MAX`]
+    /// (4e-10); f32's rounding of `d` is within a few ulps of that bound. A group beyond it (a narrow
+    /// source) takes [`FrozenSource::add_values_group`]. The values agree with
+    /// [`FrozenSource::value_at`] to a few f32 ulps (tested), exactly for a group of one point.
+    /// Structure of arrays over all `G` slots (a slot past the group's points reads as the centroid;
+    /// `out[k]` for `k >= xs.len()` is not meaningful): the loops vectorise and unroll.
+    #[inline(always)]
+    pub fn add_values_near<const G: usize>(
+        &self,
+        near: &NearbyPoints<G>,
+        xs: &[f32],
+        ys: &[f32],
+        out: &mut [f32; G],
+    ) {
+        let (cx, cy) = near.centroid;
+        let (dx0, dy0) = (cx - self.centre.x, cy - self.centre.y);
+        let [kxx, kyy, kxy] = self.form;
+        let (mx, my) = near.max_offset;
+        let bound = kxx.abs() * mx * (2.0 * dx0.abs() + mx)
+            + kyy.abs() * my * (2.0 * dy0.abs() + my)
+            + kxy.abs() * (dx0.abs() * my + mx * dy0.abs() + mx * my);
+        if !(bound <= SERIES_MAX) {
+            let n = near.len;
+            self.add_values_group(&xs[..n], &ys[..n], &mut out[..n]);
+            return;
+        }
+        let base = (self.amplitude * self.exponent_xy(cx, cy).exp()) as f32;
+        let (a, b) = (kxx * (dx0 + dx0) - kxy * dy0, kyy * (dy0 + dy0) - kxy * dx0);
+        let (ex, ey, exx, eyy, exy) = (&near.ex, &near.ey, &near.exx, &near.eyy, &near.exy);
+        let change = |k: usize| a * ex[k] + b * ey[k] + kxx * exx[k] + kyy * eyy[k] - kxy * exy[k];
+        if bound <= 0.1 {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o += base * exp_series5(change(k));
+            }
+        } else {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o += base * exp_series(change(k));
+            }
+        }
+    }
+
+    /// One group of points with a per-point check: the series where a point's own change of the
+    /// exponent is small, its own f64 `exp` elsewhere (narrow sources).
     #[inline(always)]
     fn add_values_group(&self, xs: &[f32], ys: &[f32], out: &mut [f32]) {
         let inv_n = 1.0 / xs.len() as f32;
@@ -154,6 +202,71 @@ impl FrozenSource {
     }
 }
 
+/// The most points that share one `exp` per source (a robot's 36 footprint samples fit).
+pub const MAX_GROUP: usize = 64;
+
+/// A group of at most `G` points close together (a robot's footprints), seen from their centroid:
+/// the offsets, their squares and products, and their largest magnitudes, computed once and shared
+/// by every Gaussian source ([`FrozenSource::add_values_near`]).
+pub struct NearbyPoints<const G: usize> {
+    len: usize,
+    centroid: (f32, f32),
+    max_offset: (f32, f32),
+    ex: [f32; G],
+    ey: [f32; G],
+    exx: [f32; G],
+    eyy: [f32; G],
+    exy: [f32; G],
+}
+
+impl<const G: usize> NearbyPoints<G> {
+    /// The first `G` of the points `(xs[k], ys[k])`.
+    #[inline(always)]
+    pub fn new(xs: &[f32], ys: &[f32]) -> Self {
+        let n = xs.len().min(ys.len()).min(G);
+        let (xs, ys) = (&xs[..n], &ys[..n]);
+        // The centroid summed in eight interleaved lanes (vectorises; a plain running sum is one long
+        // chain of dependent additions). A single point is its own centroid.
+        let (mut sx, mut sy) = ([0f32; 8], [0f32; 8]);
+        for (xs, ys) in xs.chunks(8).zip(ys.chunks(8)) {
+            for (k, (&x, &y)) in xs.iter().zip(ys).enumerate() {
+                sx[k] += x;
+                sy[k] += y;
+            }
+        }
+        let inv_n = 1.0 / n.max(1) as f32;
+        let (cx, cy) = (
+            sx.iter().sum::<f32>() * inv_n,
+            sy.iter().sum::<f32>() * inv_n,
+        );
+        let mut near = NearbyPoints {
+            len: n,
+            centroid: (cx, cy),
+            max_offset: (0.0, 0.0),
+            ex: [0.0; G],
+            ey: [0.0; G],
+            exx: [0.0; G],
+            eyy: [0.0; G],
+            exy: [0.0; G],
+        };
+        // Largest magnitudes as integers: the bits of non-negative floats order as the floats (and a
+        // NaN offset, above infinity, makes the bound NaN: the per-point path).
+        let (mut mx, mut my) = (0u32, 0u32);
+        for k in 0..n {
+            let (ex, ey) = (xs[k] - cx, ys[k] - cy);
+            near.ex[k] = ex;
+            near.ey[k] = ey;
+            near.exx[k] = ex * ex;
+            near.eyy[k] = ey * ey;
+            near.exy[k] = ex * ey;
+            mx = mx.max(ex.abs().to_bits());
+            my = my.max(ey.abs().to_bits());
+        }
+        near.max_offset = (f32::from_bits(mx), f32::from_bits(my));
+        near
+    }
+}
+
 /// Changes of the exponent (the sum of its terms' magnitudes) up to which [`exp_series`] stands in
 /// for `exp`: the exponent of a source of sigma 0.4 m changes by at most ~0.16 over a robot's
 /// footprints (1.6 cm from their centre) 1.6 m away; narrower sources take their own `exp` per point.
@@ -176,8 +289,15 @@ fn exp_series(d: f32) -> f32 {
     C[0] + d * (C[1] + d * (C[2] + d * (C[3] + d * (C[4] + d * (C[5] + d * (C[6] + d * C[7]))))))
 }
 
+/// `exp(d)` for `|d| <= 0.1` to 5th order: error below `0.1^6 / 6! = 1.4e-9`.
+#[inline(always)]
+fn exp_series5(d: f32) -> f32 {
+    const C: [f32; 6] = [1.0, 1.0, 1.0 / 2.0, 1.0 / 6.0, 1.0 / 24.0, 1.0 / 120.0];
+    C[0] + d * (C[1] + d * (C[2] + d * (C[3] + d * (C[4] + d * C[5]))))
+}
+
 /// Points [`frozen_values_at`] treats as one group.
-const MAX_POINTS: usize = 64;
+const MAX_POINTS: usize = MAX_GROUP;
 
 /// The sum of frozen sources at many points (the same values as [`GaussianField::values_at`] for the
 /// field's sources frozen by [`GaussianField::freeze_into`]): sensing freezes them once per step

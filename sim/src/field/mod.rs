@@ -12,7 +12,7 @@ mod static_map;
 
 pub use backend::{BackendChoice, FieldBackend};
 pub use frozen::FrozenSources;
-pub use gaussian::{FrozenSource, GaussianField, GaussianSource};
+pub use gaussian::{FrozenSource, GaussianField, GaussianSource, MAX_GROUP, NearbyPoints};
 pub(crate) use grid::lerp_index;
 pub use grid::{
     Bilinear, DiffusionScheme, GridBand, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,

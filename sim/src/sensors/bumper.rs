@@ -25,6 +25,23 @@ impl Default for BumperParams {
     }
 }
 
+/// The three bumper rays in the robot frame (unit vectors at [`BumperParams::angles`]), computed once
+/// per world: each reading then takes one `sin_cos` of the heading instead of three.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BumperRays {
+    range: f32,
+    local: [Vec2; 3],
+}
+
+impl BumperRays {
+    pub fn new(params: &BumperParams) -> Self {
+        BumperRays {
+            range: params.range,
+            local: params.angles.map(Vec2::from_angle),
+        }
+    }
+}
+
 /// Reading of an IR bumper whose first obstacle is `distance` m from the robot's rim: `1 - d / range`
 /// inside the range, 0 beyond it (and for a non-positive range).
 pub fn reading_for_distance(distance: f32, range: f32) -> f32 {
@@ -119,6 +136,17 @@ impl NeighbourIndex {
             .max(arena.x / max_cells_per_axis)
             .max(arena.y / max_cells_per_axis);
         self.cell = cell;
+        if positions.len() <= SCAN_ALL_BELOW {
+            // One cell (its bounds still clamp a query): the robots in index order, no sort.
+            self.dims = [1, 1];
+            self.starts.clear();
+            self.starts.extend([0, positions.len() as u32]);
+            self.cell_of.clear();
+            self.cell_of.resize(positions.len(), 0);
+            self.items.clear();
+            self.items.extend(0..positions.len() as u32);
+            return;
+        }
         let nx = ((arena.x / cell).ceil() as usize).max(1);
         let ny = ((arena.y / cell).ceil() as usize).max(1);
         self.dims = [nx, ny];
@@ -218,12 +246,12 @@ impl NeighbourIndex {
         poses: &[Pose],
         radius: f32,
         arena: Vec2,
-        params: &BumperParams,
+        rays: &BumperRays,
     ) -> [f32; 3] {
         let Some(me) = poses.get(index) else {
             return [0.0; 3];
         };
-        let range = params.range;
+        let range = rays.range;
         let mut readings = [0.0f32; 3];
         if range.is_nan() || range <= 0.0 {
             return readings;
@@ -231,8 +259,9 @@ impl NeighbourIndex {
         let mut dists = [range; 3];
         let mut dirs = [Vec2::ZERO; 3];
         let mut origins = [Vec2::ZERO; 3];
+        let forward = me.forward();
         for s in 0..3 {
-            let d = Vec2::from_angle(me.heading + params.angles[s]);
+            let d = forward.rotate(rays.local[s]);
             dirs[s] = d;
             origins[s] = me.pos + radius * d;
             dists[s] = dists[s].min(ray_walls(origins[s], d, arena));

@@ -9,7 +9,7 @@ use crate::field::{
 use crate::rng;
 use crate::robot::{ArenaPhysics, DriveState, Pose};
 use crate::scenario::{EmitWhen, MapSpec, ModelKind, PheromoneSpec, Scenario};
-use crate::sensors::{ColourSensor, NeighbourIndex};
+use crate::sensors::{BumperRays, ColourSensor, NeighbourIndex};
 use crate::tracker::Tracker;
 use glam::Vec2;
 
@@ -113,6 +113,7 @@ impl World {
             arena,
             robot_params: spec.robot,
             bumper_params: spec.bumper,
+            bumper_rays: BumperRays::new(&spec.bumper),
             screen: spec.screen,
             inject_at: spec.field.inject_at,
             pheromones,

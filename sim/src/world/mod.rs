@@ -12,7 +12,7 @@ use crate::rng::SimRng;
 use crate::robot::{ArenaPhysics, ColiasParams, DriveState, Pose};
 use crate::scenario::{InjectAt, Scenario};
 use crate::screen::ScreenSpec;
-use crate::sensors::{BumperParams, ColourSensor, NeighbourIndex};
+use crate::sensors::{BumperParams, BumperRays, ColourSensor, NeighbourIndex};
 use crate::tracker::{TrackedPose, Tracker};
 use glam::Vec2;
 
@@ -55,6 +55,7 @@ pub struct World {
     arena: Vec2,
     robot_params: ColiasParams,
     bumper_params: BumperParams,
+    bumper_rays: BumperRays,
     screen: ScreenSpec,
     inject_at: InjectAt,
     pheromones: Vec<Pheromone>,

@@ -100,7 +100,7 @@ impl World {
         let (radius, arena, bumper, time) = (
             self.robot_params.radius,
             self.arena,
-            &self.bumper_params,
+            &self.bumper_rays,
             self.time,
         );
         let any_grid = pheromones
