@@ -28,7 +28,8 @@ pub const DESCRIPTION: &str =
     "case II: followers gather at the leader and flee the alarm near the predator";
 pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/aggregation.toml");
 
-/// Step of the central differences that give the alarm gradient, m.
+/// Step of the central differences that give the alarm gradient of a grid pheromone, m (Gaussian
+/// sources give theirs analytically).
 const GRADIENT_STEP: f32 = 0.005;
 
 #[derive(Deserialize)]
@@ -110,15 +111,19 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
     }))
 }
 
-/// Screen level (0..1, not clamped) of channel `c` at `p`: sum over pheromones of `colour_c * value`.
-fn level(world: &World, c: usize, p: Vec2) -> f32 {
+/// Screen level (0..1, not clamped) of channel `c` at `p`, the sum over pheromones of
+/// `colour_c * value`, and its gradient (analytic for Gaussian sources: one `exp` per source).
+fn level_and_gradient(world: &World, c: usize, p: Vec2) -> (f32, Vec2) {
     world
         .pheromones()
         .iter()
         .enumerate()
         .filter(|(_, ph)| ph.colour[c] != 0.0)
-        .map(|(index, ph)| ph.colour[c] / 255.0 * world.pheromone_value_observed(index, p))
-        .sum()
+        .fold((0.0, Vec2::ZERO), |(level, grad), (index, ph)| {
+            let k = ph.colour[c] / 255.0;
+            let (v, g) = world.pheromone_value_and_gradient_observed(index, p, GRADIENT_STEP);
+            (level + k * v, grad + k * g)
+        })
 }
 
 impl Task for Aggregation {
@@ -145,13 +150,8 @@ impl Task for Aggregation {
             let p = poses[i].pos;
             let to_leader = leader - p;
             let d = to_leader.length();
-            let alarm = level(world, c, p);
+            let (alarm, grad) = level_and_gradient(world, c, p);
             let goal = if alarm > self.alarm_threshold {
-                let (hx, hy) = (Vec2::X * GRADIENT_STEP, Vec2::Y * GRADIENT_STEP);
-                let grad = Vec2::new(
-                    level(world, c, p + hx) - level(world, c, p - hx),
-                    level(world, c, p + hy) - level(world, c, p - hy),
-                );
                 -grad.normalize_or_zero()
             } else {
                 to_leader.normalize_or_zero()

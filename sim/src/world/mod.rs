@@ -152,6 +152,35 @@ impl World {
                 .fold(0.0, |sum, s| sum + s.value_at(p)),
         }
     }
+    /// [`World::pheromone_value_observed`] and its gradient at `p` (per m): analytic for Gaussian
+    /// sources (one `exp` per source), central differences `step` m apart on a grid.
+    pub fn pheromone_value_and_gradient_observed(
+        &self,
+        index: usize,
+        p: Vec2,
+        step: f32,
+    ) -> (f32, Vec2) {
+        match &self.pheromones[index].model {
+            crate::field::FieldModel::Grid(g) => {
+                let (hx, hy) = (Vec2::X * step, Vec2::Y * step);
+                let inv = 1.0 / (2.0 * step);
+                let grad = Vec2::new(
+                    g.value_at(p + hx) - g.value_at(p - hx),
+                    g.value_at(p + hy) - g.value_at(p - hy),
+                ) * inv;
+                (g.value_at(p), grad)
+            }
+            crate::field::FieldModel::Gaussian(_) => {
+                self.frozen
+                    .of(index)
+                    .iter()
+                    .fold((0.0, Vec2::ZERO), |(value, grad), s| {
+                        let (v, g) = s.value_and_gradient(p);
+                        (value + v, grad + g)
+                    })
+            }
+        }
+    }
     /// The colour sensor model shared by all robots.
     pub fn sensor(&self) -> &ColourSensor {
         &self.sensor
