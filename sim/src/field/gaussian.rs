@@ -158,7 +158,7 @@ impl FrozenSource {
             + kxy.abs() * (dx0.abs() * my + mx * dy0.abs() + mx * my);
         if !(bound <= SERIES_MAX) {
             let n = near.len;
-            self.add_values_group(&xs[..n], &ys[..n], &mut out[..n]);
+            self.add_values_group(near.centroid, &xs[..n], &ys[..n], &mut out[..n]);
             return;
         }
         let base = (self.amplitude * self.exponent_xy(cx, cy).exp()) as f32;
@@ -176,13 +176,11 @@ impl FrozenSource {
         }
     }
 
-    /// One group of points with a per-point check: the series where a point's own change of the
-    /// exponent is small, its own f64 `exp` elsewhere (narrow sources).
+    /// One group of points around `centroid` with a per-point check: the series where a point's own
+    /// change of the exponent is small, its own f64 `exp` elsewhere (narrow sources).
     #[inline(always)]
-    fn add_values_group(&self, xs: &[f32], ys: &[f32], out: &mut [f32]) {
-        let inv_n = 1.0 / xs.len() as f32;
-        let cx = xs.iter().sum::<f32>() * inv_n;
-        let cy = ys.iter().sum::<f32>() * inv_n;
+    fn add_values_group(&self, centroid: (f32, f32), xs: &[f32], ys: &[f32], out: &mut [f32]) {
+        let (cx, cy) = centroid;
         let base = (self.amplitude * self.exponent_xy(cx, cy).exp()) as f32;
         let (dx0, dy0) = (cx - self.centre.x, cy - self.centre.y);
         let [kxx, kyy, kxy] = self.form;
@@ -308,16 +306,13 @@ fn exp_series5(d: f32) -> f32 {
     C[0] + d * (C[1] + d * (C[2] + d * (C[3] + d * (C[4] + d * C[5]))))
 }
 
-/// Points [`frozen_values_at`] treats as one group.
-const MAX_POINTS: usize = MAX_GROUP;
-
 /// The sum of frozen sources at many points (the same values as [`GaussianField::values_at`] for the
 /// field's sources frozen by [`GaussianField::freeze_into`]): sensing freezes them once per step
 /// instead of once per sensor.
 pub fn frozen_values_at(sources: &[FrozenSource], points: &[Vec2], out: &mut [f32]) {
     out.fill(0.0);
-    let (mut xs, mut ys) = ([0f32; MAX_POINTS], [0f32; MAX_POINTS]);
-    for (points, out) in points.chunks(MAX_POINTS).zip(out.chunks_mut(MAX_POINTS)) {
+    let (mut xs, mut ys) = ([0f32; MAX_GROUP], [0f32; MAX_GROUP]);
+    for (points, out) in points.chunks(MAX_GROUP).zip(out.chunks_mut(MAX_GROUP)) {
         let n = points.len();
         for ((x, y), p) in xs.iter_mut().zip(&mut ys).zip(points) {
             (*x, *y) = (p.x, p.y);

@@ -41,6 +41,10 @@ pub struct TrajectoryLog {
     out: BufWriter<File>,
     path: String,
     line: String,
+    /// Each robot's last command and group, copied per tick into buffers kept between ticks (the
+    /// robots themselves cannot be shared across the formatting threads).
+    commands: Vec<crate::behaviour::WheelCommand>,
+    groups: Vec<usize>,
 }
 
 impl TrajectoryLog {
@@ -52,6 +56,8 @@ impl TrajectoryLog {
             out: BufWriter::with_capacity(1 << 20, file),
             path: path.display().to_string(),
             line: String::new(),
+            commands: Vec::new(),
+            groups: Vec::new(),
         };
         let h = header();
         log.write_str(&h)?;
@@ -75,15 +81,34 @@ impl TrajectoryLog {
     /// Appends one row per robot for the world's current tick and flushes them to the file.
     pub fn record(&mut self, world: &World) -> Result<()> {
         let n = world.robot_count();
+        // Taken out of `self` while the rows borrow them (writing needs `&mut self`), then put back.
+        let (mut commands, mut groups) = (
+            std::mem::take(&mut self.commands),
+            std::mem::take(&mut self.groups),
+        );
+        commands.clear();
+        commands.extend(world.robots().iter().map(|r| r.command));
+        groups.clear();
+        groups.extend(world.robots().iter().map(|r| r.group));
         let rows = RowInputs {
             tick: world.tick(),
             time: world.time(),
             poses: world.poses(),
             tracked: world.tracked(),
             obs: world.observations(),
-            commands: world.robots().iter().map(|r| r.command).collect(),
-            roles: (0..n).map(|i| world.role(i)).collect(),
+            commands: &commands,
+            groups: &groups,
+            group_specs: &world.scenario().spec.robots,
         };
+        let written = self.write_rows(&rows, n);
+        (self.commands, self.groups) = (commands, groups);
+        written?;
+        // Rows reach the file whole: the buffer is flushed only at a tick boundary.
+        self.flush()
+    }
+
+    /// Formats and writes the `n` rows of one tick, in robot order.
+    fn write_rows(&mut self, rows: &RowInputs, n: usize) -> Result<()> {
         if n < 2 * ROWS_PER_CHUNK {
             let mut text = std::mem::take(&mut self.line);
             text.clear();
@@ -106,8 +131,7 @@ impl TrajectoryLog {
                 self.write_str(text)?;
             }
         }
-        // Rows reach the file whole: the buffer is flushed only at a tick boundary.
-        self.flush()
+        Ok(())
     }
 }
 
@@ -121,8 +145,9 @@ struct RowInputs<'a> {
     poses: &'a [crate::robot::Pose],
     tracked: &'a [crate::tracker::TrackedPose],
     obs: &'a [crate::behaviour::Observation],
-    commands: Vec<crate::behaviour::WheelCommand>,
-    roles: Vec<&'a str>,
+    commands: &'a [crate::behaviour::WheelCommand],
+    groups: &'a [usize],
+    group_specs: &'a [crate::scenario::RobotGroupSpec],
 }
 
 impl RowInputs<'_> {
@@ -140,7 +165,7 @@ impl RowInputs<'_> {
         l.push(',');
         push_digits(l, i as u64, 1);
         l.push(',');
-        l.push_str(self.roles[i]);
+        l.push_str(&self.group_specs[self.groups[i]].role);
         l.push(',');
         for (k, (value, decimals)) in [
             (p.pos.x, 5),
