@@ -2,15 +2,21 @@
 //! parts switched off. `cargo run --release --example profile_swarm [LABEL-WORD]`
 use colcos::sim::prelude::*;
 use std::time::Instant;
+#[path = "../benches/common/swarm_scenario.rs"]
+mod swarm_scenario;
 
 fn time(label: &str, text: &str) {
+    time_scenario(label, || Scenario::from_toml_str(text, ".").unwrap());
+}
+
+fn time_scenario(label: &str, scenario: impl FnOnce() -> Scenario) {
     // `profile_swarm WORD` runs only the cases whose label contains WORD (for `perf record`).
     if let Some(only) = std::env::args().nth(1)
         && !label.contains(&only)
     {
         return;
     }
-    let sc = Scenario::from_toml_str(text, ".").unwrap();
+    let sc = scenario();
     let mut w = World::new(&sc).unwrap();
     for _ in 0..3 {
         w.step();
@@ -73,6 +79,13 @@ fn main() {
     let base = |robots: usize, behaviour: &str, pheromones: bool, deposits: bool, physics: &str| {
         base_cell(robots, behaviour, pheromones, deposits, physics, 0.01)
     };
+    // Exactly what `cargo bench --bench swarm_step` steps.
+    time_scenario("bench: 10,000 robots, discs", || {
+        swarm_scenario::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, "discs")
+    });
+    time_scenario("bench: 100 robots, 65-inch, 5 mm, rapier", || {
+        swarm_scenario::scenario(100, [1.439, 0.809], [3840, 2160], 0.005, "rapier")
+    });
     time(
         "full (follow, 3 fields, deposits, discs)",
         &base(10_000, "follow", true, true, "discs"),

@@ -15,6 +15,7 @@
 //! vertical sweeps); small grids run on the calling thread. Every output cell is computed by the same
 //! arithmetic whatever the partition, so results are bit-identical for any number of threads.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)] // NaN-aware tests; index loops over several equal-length slices
+use super::CellBuffer;
 use glam::Vec2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -174,10 +175,10 @@ impl Thomas {
 pub struct GridField {
     spec: GridSpec,
     params: GridParams,
-    values: Vec<f32>,
+    values: CellBuffer,
     injection: Option<Vec<f32>>,
     /// Second buffer of the explicit passes (swapped with `values`).
-    scratch: Vec<f32>,
+    scratch: CellBuffer,
     thomas_x: Option<Box<Thomas>>,
     thomas_y: Option<Box<Thomas>>,
     /// Log of (exact cumulative decay / applied cumulative decay): error feedback that keeps the product
@@ -190,9 +191,9 @@ impl GridField {
         GridField {
             spec,
             params,
-            values: vec![0.0; spec.len()],
+            values: CellBuffer::zeros(spec.len()),
             injection: None,
-            scratch: Vec::new(),
+            scratch: CellBuffer::default(),
             thomas_x: None,
             thomas_y: None,
             decay_carry: 0.0,
@@ -237,26 +238,6 @@ impl GridField {
         match Bilinear::at(&self.spec, p) {
             Some(b) => self.bilinear(&b),
             None => 0.0,
-        }
-    }
-
-    /// Hints the processor to fetch the cells that interpolations at and near `p` read (rows `j0` and
-    /// `j0 + 1` at column `i0`: a cache line holds the columns next to it), so that their cache misses
-    /// overlap with other work (sensing prefetches the next robot's cells). Only a hint: no effect on
-    /// results, and cheap (two prefetches, no loop).
-    #[inline]
-    pub fn prefetch_at(&self, p: Vec2) {
-        let GridSpec { nx, ny, cell } = self.spec;
-        if nx == 0 || ny == 0 || self.values.len() < nx * ny {
-            return;
-        }
-        // Saturating conversions: NaN and negatives give 0.
-        let i = ((p.x / cell - 0.5) as usize).min(nx - 1);
-        let j = ((p.y / cell - 0.5) as usize).min(ny - 1);
-        let row = j * nx + i;
-        crate::prefetch::prefetch(&self.values[row]);
-        if j + 1 < ny {
-            crate::prefetch::prefetch(&self.values[row + nx]);
         }
     }
 
@@ -492,7 +473,9 @@ impl GridField {
     /// One sub-step of the conservative reading of eq. (4) with number `s = d dt / h^2`.
     fn one_sided_pass(&mut self, s: f32, parallel: bool) {
         let GridSpec { nx, ny, .. } = self.spec;
-        self.scratch.resize(self.values.len(), 0.0);
+        if self.scratch.len() != self.values.len() {
+            self.scratch = CellBuffer::zeros(self.values.len());
+        }
         let src = &self.values;
         let half = 0.5 * s;
         let f = |(band, out): (usize, &mut [f32])| {
@@ -552,6 +535,22 @@ pub struct GridBand<'a> {
 }
 
 impl GridBand<'_> {
+    /// Hints the processor to fetch this band's cells in the three rows around `p` (a small deposit's
+    /// footprint); only a hint, never a change of values.
+    #[inline]
+    pub fn prefetch_around(&self, p: Vec2) {
+        let GridSpec { nx, cell, .. } = self.spec;
+        let rows = self.values.len() / nx.max(1);
+        // Saturating conversions: NaN and negatives give 0.
+        let i = ((p.x / cell - 0.5) as usize).min(nx.saturating_sub(1));
+        let j = (p.y / cell) as usize;
+        for j in j.saturating_sub(1)..=j + 1 {
+            if let Some(r) = j.checked_sub(self.first_row).filter(|&r| r < rows) {
+                crate::prefetch::prefetch(&self.values[r * nx + i]);
+            }
+        }
+    }
+
     /// [`GridField::deposit_segment`] restricted to this band's rows: the same additions, in the
     /// same arithmetic, on the cells the band holds.
     pub fn deposit_segment(

@@ -2,15 +2,18 @@
 //! and static injection maps. A [`Pheromone`] is one named field with its drawing colour.
 
 mod backend;
+mod cells;
 mod frozen;
 mod gaussian;
 mod grid;
+mod grid_prefetch;
 mod grid_sampler;
 mod kernel;
 mod pheromone;
 mod static_map;
 
 pub use backend::{BackendChoice, FieldBackend};
+pub use cells::CellBuffer;
 pub use frozen::FrozenSources;
 pub use gaussian::{FrozenSource, GaussianField, GaussianSource, MAX_GROUP, NearbyPoints};
 pub(crate) use grid::lerp_index;
@@ -18,6 +21,7 @@ pub use grid::{
     Bilinear, DiffusionScheme, GridBand, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,
     bilinear_mix, thomas_coefficients,
 };
+pub use grid_prefetch::GridPrefetcher;
 pub(crate) use grid_sampler::GridSampler;
 pub use kernel::Kernel;
 pub use pheromone::{FieldModel, Pheromone};

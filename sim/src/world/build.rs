@@ -121,6 +121,7 @@ impl World {
             observations: vec![Observation::default(); robots.len()],
             last_injection: vec![None; robots.len()],
             segments: Vec::new(),
+            band_segments: Vec::new(),
             robots,
             tracker,
             tracker_rng,

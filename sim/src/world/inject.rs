@@ -1,7 +1,7 @@
 //! Injection: robots lay trails on grid pheromones along their path and move their Gaussian sources,
 //! at their tracked poses (as the real host does) or their true ones.
 use super::World;
-use crate::field::{FieldModel, GridBand, Kernel};
+use crate::field::{FieldModel, GridBand, GridSpec, Kernel};
 use crate::robot::Pose;
 use crate::scenario::InjectAt;
 use crate::tracker::TrackedPose;
@@ -35,6 +35,26 @@ fn injection_point_of(
     }
 }
 
+/// The first and last of `count` bands of `rows` rows that segment `s` may reach: its bounding box
+/// grown by the kernel's support and a cell (the margin [`GridBand::deposit_segment`] skips by, so no
+/// band it would deposit into is left out). `None` for a segment that deposits nothing.
+fn bands_reached(
+    s: &Segment,
+    spec: &GridSpec,
+    rows: usize,
+    count: usize,
+) -> Option<(usize, usize)> {
+    let support = s.kernel.support();
+    if support.is_nan() || support < 0.0 || !s.from.is_finite() || !s.to.is_finite() {
+        return None;
+    }
+    let reach = support + spec.cell;
+    let row = |y: f32| ((y / spec.cell) as usize / rows).min(count - 1);
+    let lo = row(s.from.y.min(s.to.y) - reach);
+    let hi = row(s.from.y.max(s.to.y) + reach);
+    Some((lo, hi))
+}
+
 impl World {
     /// Where the host believes robot `i` is, or `None` if the tracker has not seen it yet.
     pub fn injection_point(&self, i: usize) -> Option<Vec2> {
@@ -60,31 +80,59 @@ impl World {
                 amount: dep.rate * dt,
             });
         }
-        // A cell's value depends on the order of its own deposits only: each field, cut into bands
-        // of rows, takes its segments in scenario order in every band, and bands run in parallel.
+        // A cell's value depends on the order of its own deposits only: each field is cut into bands
+        // of rows, every band takes the segments that may reach it in scenario order, and bands run in
+        // parallel.
         let segments = &self.segments;
-        let deposit_into = |index: usize, band: &mut GridBand| {
-            for s in segments.iter().filter(|s| s.pheromone == index) {
-                band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
-            }
-        };
         if self.deposits.len() >= PARALLEL_DEPOSITS {
-            let mut bands: Vec<(usize, GridBand)> = Vec::new();
+            let mut bands: Vec<(GridBand, &[u32])> = Vec::new();
+            let lists = &mut self.band_segments;
+            lists.iter_mut().for_each(Vec::clear);
+            let mut first_list = 0;
             for (index, ph) in self.pheromones.iter_mut().enumerate() {
                 if let FieldModel::Grid(grid) = &mut ph.model {
-                    let rows = grid.spec().ny.div_ceil(BANDS).max(1);
-                    bands.extend(grid.bands_mut(rows).map(|band| (index, band)));
+                    let spec = *grid.spec();
+                    let rows = spec.ny.div_ceil(BANDS).max(1);
+                    let count = spec.ny.div_ceil(rows).max(1);
+                    if lists.len() < first_list + count {
+                        lists.resize_with(first_list + count, Vec::new);
+                    }
+                    for (k, s) in segments.iter().enumerate() {
+                        if s.pheromone == index
+                            && let Some((lo, hi)) = bands_reached(s, &spec, rows, count)
+                        {
+                            for list in &mut lists[first_list + lo..=first_list + hi] {
+                                list.push(k as u32);
+                            }
+                        }
+                    }
+                    bands.extend(grid.bands_mut(rows).map(|band| (band, &[][..])));
+                    first_list += count;
                 }
             }
-            bands
-                .par_iter_mut()
-                .for_each(|(index, band)| deposit_into(*index, band));
+            for ((_, list), own) in bands.iter_mut().zip(lists.iter()) {
+                *list = own;
+            }
+            bands.par_iter_mut().for_each(|(band, list)| {
+                for (n, &k) in list.iter().enumerate() {
+                    // The next segments' cells are scattered over the field: ask for them now, so
+                    // that their cache misses overlap with this deposit.
+                    if let Some(&next) = list.get(n + 2) {
+                        band.prefetch_around(segments[next as usize].to);
+                    }
+                    let s = &segments[k as usize];
+                    band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
+                }
+            });
         } else {
             // A small world (a batched environment's): the whole grid as one band, nothing allocated.
             for (index, ph) in self.pheromones.iter_mut().enumerate() {
                 if let FieldModel::Grid(grid) = &mut ph.model {
                     let ny = grid.spec().ny;
-                    deposit_into(index, &mut grid.band_mut(0, ny));
+                    let mut band = grid.band_mut(0, ny);
+                    for s in segments.iter().filter(|s| s.pheromone == index) {
+                        band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
+                    }
                 }
             }
         }
@@ -111,6 +159,50 @@ impl World {
                     // The field's own clock, not the world's: the two are summed differently in f32,
                     // and a start a hair in the future would read as "not yet emitted".
                     g.sources[source].start = g.time;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::{GridField, GridParams};
+
+    proptest::proptest! {
+        /// Every band that a segment's deposit changes is among the bands it is listed for.
+        #[test]
+        fn a_segment_is_listed_for_every_band_it_reaches(
+            shape in 0usize..3,
+            size in 0.0005f32..0.05,
+            cell in proptest::sample::select(vec![0.003f32, 0.005, 0.01, 0.0137]),
+            a in (-0.05f32..0.65, -0.05f32..0.45),
+            step in (-0.06f32..0.06, -0.06f32..0.06),
+            bands in 1usize..9,
+        ) {
+            let kernel = match shape {
+                0 => Kernel::Disc { radius: size },
+                1 => Kernel::Cone { radius: size },
+                _ => Kernel::Gaussian { sigma: size / 3.0 },
+            };
+            let spec = GridSpec::covering(Vec2::new(0.6, 0.4), cell);
+            let rows = spec.ny.div_ceil(bands).max(1);
+            let count = spec.ny.div_ceil(rows).max(1);
+            let from = Vec2::new(a.0, a.1);
+            let s = Segment { pheromone: 0, kernel, from, to: from + Vec2::new(step.0, step.1), amount: 1.0 };
+            let (lo, hi) = bands_reached(&s, &spec, rows, count).expect("a finite segment");
+            let mut g = GridField::new(spec, GridParams::default());
+            for mut band in g.bands_mut(rows) {
+                band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
+            }
+            for (j, row) in g.values().chunks(spec.nx).enumerate() {
+                if row.iter().any(|&v| v != 0.0) {
+                    let band = j / rows;
+                    proptest::prop_assert!(
+                        (lo..=hi).contains(&band),
+                        "row {j} (band {band}) got a deposit, listed bands {lo}..={hi}"
+                    );
                 }
             }
         }

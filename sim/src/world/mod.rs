@@ -69,6 +69,9 @@ pub struct World {
     last_injection: Vec<Option<Vec2>>,
     /// Scratch: this step's trail segments.
     segments: Vec<inject::Segment>,
+    /// Scratch: for each band of rows of each grid field (in field order), the indices of the segments
+    /// that may reach it (see `inject`).
+    band_segments: Vec<Vec<u32>>,
     neighbours: NeighbourIndex,
     sensor: ColourSensor,
     deposits: Vec<Deposit>,

@@ -1,7 +1,7 @@
 //! One step of a world: behaviours -> drive -> physics -> tracker -> fields and injection -> sensors.
 use super::World;
 use crate::behaviour::{Observation, WheelCommand};
-use crate::field::FieldModel;
+use crate::field::GridPrefetcher;
 use crate::sensors::SENSOR_RADIUS;
 use crate::sensors::sensor_positions;
 use rayon::prelude::*;
@@ -50,35 +50,70 @@ impl World {
             "one wheel command per robot"
         );
         let dt = self.dt;
-        self.velocities.clear();
-        for (slot, cmd) in self.robots.iter_mut().zip(commands) {
+        let params = &self.robot_params;
+        let drive = |(slot, cmd): (&mut super::RobotSlot, &WheelCommand)| {
             let cmd = if cmd.left.is_finite() && cmd.right.is_finite() {
                 *cmd
             } else {
                 WheelCommand::STOP
             };
             slot.command = cmd;
-            slot.drive.update(cmd, &self.robot_params, dt);
-            self.velocities
-                .push(slot.drive.body_velocity(&self.robot_params));
+            slot.drive.update(cmd, params, dt);
+            slot.drive.body_velocity(params)
+        };
+        self.velocities.clear();
+        if self.robots.len() >= PARALLEL_ROBOTS {
+            self.robots
+                .par_iter_mut()
+                .zip(commands)
+                .map(drive)
+                .collect_into_vec(&mut self.velocities);
+        } else {
+            let velocities = self.robots.iter_mut().zip(commands).map(drive);
+            self.velocities.extend(velocities);
         }
-        self.physics.step(&self.velocities, dt);
         self.tick += 1;
         self.time = self.tick as f32 * dt;
+        // The fields evolve from the last step's deposits without the robots, and the robots move
+        // without the fields: a large world runs the field pass (parallel, bound by memory bandwidth)
+        // beside the contact solver, tracker and robot index (serial). Nothing either side reads what
+        // the other writes, so the results are those of running them one after the other.
+        let mut pheromones = std::mem::take(&mut self.pheromones);
+        let mut backend = self.field_backend.take();
+        let mut step_fields = || match backend.as_mut() {
+            Some(backend) => backend.step(&mut pheromones, dt),
+            None => pheromones.iter_mut().for_each(|p| p.step(dt)),
+        };
+        if self.robots.len() >= PARALLEL_ROBOTS {
+            rayon::join(|| self.move_robots(), step_fields);
+        } else {
+            self.move_robots();
+            step_fields();
+        }
+        self.pheromones = pheromones;
+        self.field_backend = backend;
+        self.inject();
+        self.sense();
+    }
+
+    /// Physics, the tracker's view of the new poses, and the robot index that sensing reads.
+    fn move_robots(&mut self) {
+        self.physics.step(&self.velocities, self.dt);
         let tracked = self
             .tracker
             .update(self.time, self.physics.poses(), &mut self.tracker_rng);
         self.tracked.copy_from_slice(tracked);
-        match self.field_backend.as_mut() {
-            Some(backend) => backend.step(&mut self.pheromones, dt),
-            None => self.pheromones.iter_mut().for_each(|p| p.step(dt)),
-        }
-        self.inject();
-        self.observe();
+        self.index_robots();
     }
 
     /// Recomputes every robot's observation from the current screen and poses.
     pub(super) fn observe(&mut self) {
+        self.index_robots();
+        self.sense();
+    }
+
+    /// The neighbour index of the bumpers and the sensor positions, from the current poses.
+    fn index_robots(&mut self) {
         let poses = self.physics.poses();
         let cell = 2.0 * self.robot_params.radius + self.bumper_params.range;
         self.positions.clear();
@@ -88,6 +123,11 @@ impl World {
         self.sensor_points.clear();
         self.sensor_points
             .extend(poses.iter().map(|p| sensor_positions(p, SENSOR_RADIUS)));
+    }
+
+    /// Every robot's observation from the current screen, robot index and poses.
+    fn sense(&mut self) {
+        let poses = self.physics.poses();
         self.frozen.refresh(&self.pheromones);
         let sensor_points = &self.sensor_points;
         let (pheromones, frozen, screen, sensor, neighbours) = (
@@ -103,20 +143,12 @@ impl World {
             &self.bumper_rays,
             self.time,
         );
-        let any_grid = pheromones
-            .iter()
-            .any(|ph| matches!(ph.model, FieldModel::Grid(_)));
+        let prefetcher = GridPrefetcher::new(pheromones);
         let sense = |(i, (slot, obs)): (usize, (&mut super::RobotSlot, &mut Observation))| {
             // The grid cells under the next robot's sensors are scattered over large fields: ask for
             // them now so that their cache misses overlap with this robot's work.
-            if let Some(next) = sensor_points.get(i + 1).filter(|_| any_grid) {
-                for &p in next {
-                    for ph in pheromones {
-                        if let FieldModel::Grid(g) = &ph.model {
-                            g.prefetch_at(p);
-                        }
-                    }
-                }
+            if let (Some(prefetcher), Some(next)) = (&prefetcher, sensor_points.get(i + 1)) {
+                prefetcher.prefetch(next);
             }
             let mut o = Observation {
                 time,
