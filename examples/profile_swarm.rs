@@ -1,5 +1,6 @@
 //! Where a large swarm's step goes: times whole steps of the 10,000-robot benchmark scenario with
-//! parts switched off. `cargo run --release --example profile_swarm [LABEL-WORD]`
+//! parts switched off. `cargo run --release --example profile_swarm [LABEL-WORD]` (environment:
+//! `PROFILE_STEPS=N` to time N steps per case instead of 60).
 use colcos::sim::prelude::*;
 use std::time::Instant;
 #[path = "../benches/common/swarm_scenario.rs"]
@@ -21,7 +22,11 @@ fn time_scenario(label: &str, scenario: impl FnOnce() -> Scenario) {
     for _ in 0..3 {
         w.step();
     }
-    let steps = 60;
+    // PROFILE_STEPS=N times N steps instead of 60 (small worlds need thousands for a steady median).
+    let steps = std::env::var("PROFILE_STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(60);
     let cpu0 = process_cpu_seconds();
     let mut xs: Vec<f64> = (0..steps)
         .map(|_| {

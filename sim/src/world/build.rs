@@ -130,7 +130,6 @@ impl World {
             sensor: ColourSensor::new(spec.sensor),
             deposits,
             emitters,
-            command_buffer: Vec::new(),
             velocities: Vec::new(),
             positions: Vec::new(),
             sensor_points: Vec::new(),

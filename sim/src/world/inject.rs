@@ -8,9 +8,11 @@ use crate::tracker::TrackedPose;
 use glam::Vec2;
 use rayon::prelude::*;
 
-/// From this many trail deposits a step, fields take their deposits in parallel.
-const PARALLEL_DEPOSITS: usize = 256;
-/// Bands of rows each grid field is cut into when deposits run in parallel.
+/// From this many trail deposits a step, fields take their deposits in parallel (one task per field).
+const PARALLEL_DEPOSITS: usize = 64;
+/// From this many, each grid field is also cut into bands of rows that take their deposits in parallel.
+const BANDED_DEPOSITS: usize = 256;
+/// Bands of rows each grid field is cut into then.
 const BANDS: usize = 4;
 
 /// One robot's trail deposit of this step: the segment from where it injected last to where it is.
@@ -88,11 +90,16 @@ impl World {
             let mut bands: Vec<(GridBand, &[u32])> = Vec::new();
             let lists = &mut self.band_segments;
             lists.iter_mut().for_each(Vec::clear);
+            let bands_per_field = if self.deposits.len() >= BANDED_DEPOSITS {
+                BANDS
+            } else {
+                1
+            };
             let mut first_list = 0;
             for (index, ph) in self.pheromones.iter_mut().enumerate() {
                 if let FieldModel::Grid(grid) = &mut ph.model {
                     let spec = *grid.spec();
-                    let rows = spec.ny.div_ceil(BANDS).max(1);
+                    let rows = spec.ny.div_ceil(bands_per_field).max(1);
                     let count = spec.ny.div_ceil(rows).max(1);
                     if lists.len() < first_list + count {
                         lists.resize_with(first_list + count, Vec::new);

@@ -77,7 +77,6 @@ pub struct World {
     deposits: Vec<Deposit>,
     emitters: Vec<Emitter>,
     // Scratch buffers reused every step (no per-step allocation).
-    command_buffer: Vec<WheelCommand>,
     velocities: Vec<(f32, f32)>,
     positions: Vec<Vec2>,
     /// Scratch: the four sensor positions of every robot, refreshed by each observation.

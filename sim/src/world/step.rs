@@ -2,6 +2,7 @@
 use super::World;
 use crate::behaviour::{Observation, WheelCommand};
 use crate::field::GridPrefetcher;
+use crate::robot::ColiasParams;
 use crate::sensors::SENSOR_RADIUS;
 use crate::sensors::sensor_positions;
 use rayon::prelude::*;
@@ -11,30 +12,49 @@ use rayon::prelude::*;
 /// and batched environments parallelise over worlds instead.
 const PARALLEL_ROBOTS: usize = 64;
 
+/// Robot `slot` takes wheel command `cmd` (a non-finite one is a stop): its drive's lag advances by
+/// `dt`, and the body velocity (forward, yaw rate) it gives is returned.
+fn drive(
+    slot: &mut super::RobotSlot,
+    cmd: WheelCommand,
+    params: &ColiasParams,
+    dt: f32,
+) -> (f32, f32) {
+    let cmd = if cmd.left.is_finite() && cmd.right.is_finite() {
+        cmd
+    } else {
+        WheelCommand::STOP
+    };
+    slot.command = cmd;
+    slot.drive.update(cmd, params, dt);
+    slot.drive.body_velocity(params)
+}
+
 impl World {
     /// One step with every robot's own behaviour deciding from its current observation.
     pub fn step(&mut self) {
-        let mut commands = std::mem::take(&mut self.command_buffer);
-        commands.resize(self.robots.len(), WheelCommand::STOP);
-        let decide =
-            |((slot, obs), cmd): ((&mut super::RobotSlot, &Observation), &mut WheelCommand)| {
-                *cmd = slot.behaviour.act(obs, &mut slot.rng);
-            };
+        let (dt, params) = (self.dt, &self.robot_params);
+        // Deciding and driving in one pass over the robots (one parallel region, not two).
+        let decide_and_drive = |(slot, obs): (&mut super::RobotSlot, &Observation)| {
+            let cmd = slot.behaviour.act(obs, &mut slot.rng);
+            drive(slot, cmd, params, dt)
+        };
+        self.velocities.clear();
         if self.robots.len() >= PARALLEL_ROBOTS {
             self.robots
                 .par_iter_mut()
                 .zip(self.observations.par_iter())
-                .zip(commands.par_iter_mut())
-                .for_each(decide);
+                .map(decide_and_drive)
+                .collect_into_vec(&mut self.velocities);
         } else {
-            self.robots
+            let velocities = self
+                .robots
                 .iter_mut()
                 .zip(self.observations.iter())
-                .zip(commands.iter_mut())
-                .for_each(decide);
+                .map(decide_and_drive);
+            self.velocities.extend(velocities);
         }
-        self.step_with_commands(&commands);
-        self.command_buffer = commands;
+        self.advance();
     }
 
     /// One step with the given wheel commands (one per robot, m/s), e.g. from a learned policy.
@@ -49,18 +69,9 @@ impl World {
             self.robots.len(),
             "one wheel command per robot"
         );
-        let dt = self.dt;
-        let params = &self.robot_params;
-        let drive = |(slot, cmd): (&mut super::RobotSlot, &WheelCommand)| {
-            let cmd = if cmd.left.is_finite() && cmd.right.is_finite() {
-                *cmd
-            } else {
-                WheelCommand::STOP
-            };
-            slot.command = cmd;
-            slot.drive.update(cmd, params, dt);
-            slot.drive.body_velocity(params)
-        };
+        let (dt, params) = (self.dt, &self.robot_params);
+        let drive =
+            |(slot, cmd): (&mut super::RobotSlot, &WheelCommand)| drive(slot, *cmd, params, dt);
         self.velocities.clear();
         if self.robots.len() >= PARALLEL_ROBOTS {
             self.robots
@@ -72,6 +83,12 @@ impl World {
             let velocities = self.robots.iter_mut().zip(commands).map(drive);
             self.velocities.extend(velocities);
         }
+        self.advance();
+    }
+
+    /// The rest of a step once every robot's drive has its command: motion, fields, injection, sensing.
+    fn advance(&mut self) {
+        let dt = self.dt;
         self.tick += 1;
         self.time = self.tick as f32 * dt;
         // The fields evolve from the last step's deposits without the robots, and the robots move
@@ -80,15 +97,20 @@ impl World {
         // the other writes, so the results are those of running them one after the other.
         let mut pheromones = std::mem::take(&mut self.pheromones);
         let mut backend = self.field_backend.take();
-        let mut step_fields = || match backend.as_mut() {
-            Some(backend) => backend.step(&mut pheromones, dt),
-            None => pheromones.iter_mut().for_each(|p| p.step(dt)),
-        };
         if self.robots.len() >= PARALLEL_ROBOTS {
+            // Fields step side by side too: each field's pass is its own (and splits into bands
+            // itself when large).
+            let step_fields = || match backend.as_mut() {
+                Some(backend) => backend.step(&mut pheromones, dt),
+                None => pheromones.par_iter_mut().for_each(|p| p.step(dt)),
+            };
             rayon::join(|| self.move_robots(), step_fields);
         } else {
             self.move_robots();
-            step_fields();
+            match backend.as_mut() {
+                Some(backend) => backend.step(&mut pheromones, dt),
+                None => pheromones.iter_mut().for_each(|p| p.step(dt)),
+            }
         }
         self.pheromones = pheromones;
         self.field_backend = backend;
