@@ -535,22 +535,6 @@ pub struct GridBand<'a> {
 }
 
 impl GridBand<'_> {
-    /// Hints the processor to fetch this band's cells in the three rows around `p` (a small deposit's
-    /// footprint); only a hint, never a change of values.
-    #[inline]
-    pub fn prefetch_around(&self, p: Vec2) {
-        let GridSpec { nx, cell, .. } = self.spec;
-        let rows = self.values.len() / nx.max(1);
-        // Saturating conversions: NaN and negatives give 0.
-        let i = ((p.x / cell - 0.5) as usize).min(nx.saturating_sub(1));
-        let j = (p.y / cell) as usize;
-        for j in j.saturating_sub(1)..=j + 1 {
-            if let Some(r) = j.checked_sub(self.first_row).filter(|&r| r < rows) {
-                crate::prefetch::prefetch(&self.values[r * nx + i]);
-            }
-        }
-    }
-
     /// [`GridField::deposit_segment`] restricted to this band's rows: the same additions, in the
     /// same arithmetic, on the cells the band holds.
     pub fn deposit_segment(

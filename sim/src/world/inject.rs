@@ -121,12 +121,7 @@ impl World {
                 *list = own;
             }
             bands.par_iter_mut().for_each(|(band, list)| {
-                for (n, &k) in list.iter().enumerate() {
-                    // The next segments' cells are scattered over the field: ask for them now, so
-                    // that their cache misses overlap with this deposit.
-                    if let Some(&next) = list.get(n + 2) {
-                        band.prefetch_around(segments[next as usize].to);
-                    }
+                for &k in *list {
                     let s = &segments[k as usize];
                     band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
                 }
