@@ -1,4 +1,5 @@
 //! One step of a world: behaviours -> drive -> physics -> tracker -> fields and injection -> sensors.
+//! In a large world the field pass runs beside physics, tracker and robot index (they share no data).
 use super::World;
 use crate::behaviour::{Observation, WheelCommand};
 use crate::field::GridPrefetcher;
