@@ -21,16 +21,17 @@ pub struct CellBuffer {
     ptr: NonNull<f32>,
     len: usize,
     /// Owns the memory `ptr` points into (never resized, so the values never move).
-    _storage: Storage,
+    owner: Storage,
 }
 
 // SAFETY: a `CellBuffer` owns its values exclusively (like a `Vec<f32>`): the pointer is into memory
-// that `_storage` owns and that no one else can reach, shared access only reads and mutation takes
+// that `owner` owns and that no one else can reach, shared access only reads and mutation takes
 // `&mut self`.
 unsafe impl Send for CellBuffer {}
 // SAFETY: as above; `&CellBuffer` only gives out `&[f32]`.
 unsafe impl Sync for CellBuffer {}
 
+/// The owner of a buffer's memory: held only to keep the values alive and to free them on drop.
 enum Storage {
     Heap(#[allow(dead_code)] Vec<f32>),
     Mapped(#[allow(dead_code)] MmapMut),
@@ -55,13 +56,13 @@ impl CellBuffer {
         CellBuffer {
             ptr,
             len,
-            _storage: storage,
+            owner: storage,
         }
     }
 
     /// Whether the values live in a mapping that asked for huge pages.
     pub fn is_mapped(&self) -> bool {
-        matches!(self._storage, Storage::Mapped(_))
+        matches!(self.owner, Storage::Mapped(_))
     }
 }
 
@@ -88,7 +89,7 @@ impl Deref for CellBuffer {
     type Target = [f32];
     #[inline(always)]
     fn deref(&self) -> &[f32] {
-        // SAFETY: `ptr` points to `len` initialised f32 owned by `_storage`, which lives as long as
+        // SAFETY: `ptr` points to `len` initialised f32 owned by `owner`, which lives as long as
         // `self` and never moves or resizes them (moving a `Vec` or a mapping does not move its data).
         unsafe { std::slice::from_raw_parts(self.ptr.as_ptr(), self.len) }
     }
