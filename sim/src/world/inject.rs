@@ -87,19 +87,20 @@ impl World {
         // parallel.
         let segments = &self.segments;
         if self.deposits.len() >= PARALLEL_DEPOSITS {
-            let mut bands: Vec<(GridBand, &[u32])> = Vec::new();
-            let lists = &mut self.band_segments;
-            lists.iter_mut().for_each(Vec::clear);
             let bands_per_field = if self.deposits.len() >= BANDED_DEPOSITS {
                 BANDS
             } else {
                 1
             };
+            let band_rows = |spec: &GridSpec| spec.ny.div_ceil(bands_per_field).max(1);
+            // First the lists of segments per band (reading the grids' geometry only) ...
+            let lists = &mut self.band_segments;
+            lists.iter_mut().for_each(Vec::clear);
             let mut first_list = 0;
-            for (index, ph) in self.pheromones.iter_mut().enumerate() {
-                if let FieldModel::Grid(grid) = &mut ph.model {
+            for (index, ph) in self.pheromones.iter().enumerate() {
+                if let FieldModel::Grid(grid) = &ph.model {
                     let spec = *grid.spec();
-                    let rows = spec.ny.div_ceil(bands_per_field).max(1);
+                    let rows = band_rows(&spec);
                     let count = spec.ny.div_ceil(rows).max(1);
                     if lists.len() < first_list + count {
                         lists.resize_with(first_list + count, Vec::new);
@@ -113,12 +114,18 @@ impl World {
                             }
                         }
                     }
-                    bands.extend(grid.bands_mut(rows).map(|band| (band, &[][..])));
                     first_list += count;
                 }
             }
-            for ((_, list), own) in bands.iter_mut().zip(lists.iter()) {
-                *list = own;
+            // ... then the bands themselves, in the same order, each with its list.
+            let mut lists = self.band_segments.iter();
+            let mut bands: Vec<(GridBand, &[u32])> = Vec::new();
+            for ph in &mut self.pheromones {
+                if let FieldModel::Grid(grid) = &mut ph.model {
+                    let rows = band_rows(grid.spec());
+                    let with_lists = grid.bands_mut(rows).zip(&mut lists);
+                    bands.extend(with_lists.map(|(band, list)| (band, list.as_slice())));
+                }
             }
             bands.par_iter_mut().for_each(|(band, list)| {
                 for &k in *list {

@@ -2,15 +2,15 @@
 //! In a large world the field pass runs beside physics, tracker and robot index (they share no data).
 use super::World;
 use crate::behaviour::{Observation, WheelCommand};
-use crate::field::GridPrefetcher;
+use crate::field::{FieldBackend, GridPrefetcher, Pheromone};
 use crate::robot::ColiasParams;
 use crate::sensors::SENSOR_RADIUS;
 use crate::sensors::sensor_positions;
 use rayon::prelude::*;
 
-/// Below this many robots a world steps its robots on one thread: rayon's overhead would dominate (at
-/// 100 robots two threads already pay: 0.56 -> 0.43 ms a step on the idle 2-core machine),
-/// and batched environments parallelise over worlds instead.
+/// Below this many robots a world steps its robots on one thread: rayon's overhead would dominate, and
+/// batched environments parallelise over worlds instead. (At 100 robots one thread and two were even in
+/// session 7: 0.33 ms a step either way, alternated 6 times; two threads used twice the CPU time.)
 const PARALLEL_ROBOTS: usize = 64;
 
 /// Robot `slot` takes wheel command `cmd` (a non-finite one is a stop): its drive's lag advances by
@@ -29,6 +29,21 @@ fn drive(
     slot.command = cmd;
     slot.drive.update(cmd, params, dt);
     slot.drive.body_velocity(params)
+}
+
+/// Advances every field by `dt`: on `backend` when there is one, else each field's own pass, the fields
+/// side by side when `parallel` (each large field's pass also splits into bands itself).
+fn step_fields(
+    pheromones: &mut [Pheromone],
+    backend: &mut Option<Box<dyn FieldBackend>>,
+    dt: f32,
+    parallel: bool,
+) {
+    match backend.as_mut() {
+        Some(backend) => backend.step(pheromones, dt),
+        None if parallel => pheromones.par_iter_mut().for_each(|p| p.step(dt)),
+        None => pheromones.iter_mut().for_each(|p| p.step(dt)),
+    }
 }
 
 impl World {
@@ -98,20 +113,13 @@ impl World {
         // the other writes, so the results are those of running them one after the other.
         let mut pheromones = std::mem::take(&mut self.pheromones);
         let mut backend = self.field_backend.take();
-        if self.robots.len() >= PARALLEL_ROBOTS {
-            // Fields step side by side too: each field's pass is its own (and splits into bands
-            // itself when large).
-            let step_fields = || match backend.as_mut() {
-                Some(backend) => backend.step(&mut pheromones, dt),
-                None => pheromones.par_iter_mut().for_each(|p| p.step(dt)),
-            };
+        let parallel = self.robots.len() >= PARALLEL_ROBOTS;
+        let mut step_fields = || step_fields(&mut pheromones, &mut backend, dt, parallel);
+        if parallel {
             rayon::join(|| self.move_robots(), step_fields);
         } else {
             self.move_robots();
-            match backend.as_mut() {
-                Some(backend) => backend.step(&mut pheromones, dt),
-                None => pheromones.iter_mut().for_each(|p| p.step(dt)),
-            }
+            step_fields();
         }
         self.pheromones = pheromones;
         self.field_backend = backend;
