@@ -154,17 +154,16 @@ pub fn adapters() -> Vec<wgpu::AdapterInfo> {
 }
 
 fn rank(info: &wgpu::AdapterInfo) -> u32 {
-    if is_software(info) {
-        return 9;
-    }
     let t = match info.device_type {
+        _ if is_software(info) => 9,
         wgpu::DeviceType::DiscreteGpu => 0,
         wgpu::DeviceType::IntegratedGpu => 1,
         wgpu::DeviceType::VirtualGpu => 2,
         wgpu::DeviceType::Other => 3,
         wgpu::DeviceType::Cpu => 9,
     };
-    // Prefer Vulkan/Metal/DX12 over GL for compute.
+    // Prefer Vulkan/Metal/DX12 over GL for compute, software adapters included: Mesa's GL llvmpipe
+    // (present wherever Mesa's GL is) has no SHADER_F64, its Vulkan lavapipe has.
     t * 2 + u32::from(info.backend == wgpu::Backend::Gl)
 }
 
@@ -403,4 +402,50 @@ pub(crate) fn check_size(ctx: &GpuContext, what: &str, bytes: u64) -> Result<()>
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rank;
+    use wgpu::{AdapterInfo, Backend, DeviceType};
+
+    fn adapter(name: &str, device_type: DeviceType, backend: Backend) -> AdapterInfo {
+        AdapterInfo {
+            name: name.into(),
+            ..AdapterInfo::new(device_type, backend)
+        }
+    }
+
+    /// Hardware first (discrete before integrated), Vulkan before GL, and among software adapters
+    /// lavapipe (Vulkan, with SHADER_F64) before llvmpipe's GL (without it).
+    #[test]
+    fn adapters_rank_hardware_then_vulkan_before_gl() {
+        let mut list = [
+            adapter(
+                "llvmpipe (LLVM 15.0.6, 256 bits)",
+                DeviceType::Cpu,
+                Backend::Gl,
+            ),
+            adapter(
+                "llvmpipe (LLVM 15.0.6, 256 bits)",
+                DeviceType::Cpu,
+                Backend::Vulkan,
+            ),
+            adapter("Intel UHD", DeviceType::IntegratedGpu, Backend::Gl),
+            adapter("Intel UHD", DeviceType::IntegratedGpu, Backend::Vulkan),
+            adapter("NVIDIA H200", DeviceType::DiscreteGpu, Backend::Vulkan),
+        ];
+        list.sort_by_key(rank);
+        let order: Vec<_> = list.iter().map(|a| (a.device_type, a.backend)).collect();
+        assert_eq!(
+            order,
+            [
+                (DeviceType::DiscreteGpu, Backend::Vulkan),
+                (DeviceType::IntegratedGpu, Backend::Vulkan),
+                (DeviceType::IntegratedGpu, Backend::Gl),
+                (DeviceType::Cpu, Backend::Vulkan),
+                (DeviceType::Cpu, Backend::Gl),
+            ]
+        );
+    }
 }

@@ -121,28 +121,41 @@ fn check_screen_and_sensors(name: &str, text: &str, steps: usize, sizes: &[(u32,
     }
     let (grids, scene) = upload(ctx.clone(), &world);
     let mut gs = GpuScreen::new(ctx.clone()).expect("screen pipelines");
+    // With SHADER_F64 the GPU evaluates Gaussian sources in f64 as the CPU does, and the images are
+    // identical. Without it (Mesa's GL llvmpipe, some GPUs) it evaluates them in f32: a last-bit
+    // difference moves a level by one where `k * value` sits on a rounding boundary (x.5), a few pixels
+    // in a million (6 of 933,195 lit in case II on llvmpipe's GL), never more than one level.
+    let exact = ctx.f64;
     for &(w, h) in sizes {
         let cpu = screen::render(world.pheromones(), world.screen(), w, h);
         let gpu = gs
             .render(grids.as_ref(), &scene, 0, world.screen(), w, h)
             .unwrap();
-        let differ = cpu
-            .pixels()
-            .zip(gpu.pixels())
-            .filter(|(a, b)| a != b)
-            .count();
+        let mut differ = 0;
+        for (a, b) in cpu.pixels().zip(gpu.pixels()) {
+            if a != b {
+                differ += 1;
+                let off = a.0.iter().zip(b.0).map(|(&x, y)| x.abs_diff(y)).max();
+                assert!(
+                    !exact && off <= Some(1),
+                    "{name}: CPU pixel {:?}, GPU {:?} at {w}x{h} (SHADER_F64: {exact})",
+                    a.0,
+                    b.0
+                );
+            }
+        }
         let lit = cpu.pixels().filter(|p| p.0 != [0, 0, 0]).count();
-        assert_eq!(
-            differ,
-            0,
-            "{name}: {differ} of {} pixels differ at {w}x{h} ({lit} lit)",
+        // (6 in a million expected; a small image may draw one or two of them.)
+        assert!(
+            differ <= 3 + lit / 10_000,
+            "{name}: {differ} of {} pixels differ by one level at {w}x{h} ({lit} lit)",
             w * h
         );
         assert!(
             lit > 100,
             "{name}: the screen is almost black ({lit} lit pixels): a weak test"
         );
-        eprintln!("{name}: {w}x{h} screen identical ({lit} lit pixels)");
+        eprintln!("{name}: {w}x{h} screen, {differ} pixels differ ({lit} lit pixels)");
     }
     // Sensors: every robot's four footprints, plus a grid of probes over the arena.
     let sensor = world.sensor().clone();
@@ -169,21 +182,30 @@ fn check_screen_and_sensors(name: &str, text: &str, steps: usize, sizes: &[(u32,
     let sums = gs
         .sense(grids.as_ref(), &scene, world.screen(), &queries)
         .unwrap();
-    let mut nonzero = 0;
+    let (mut nonzero, mut differ) = (0, 0);
     for (c, s) in centres.iter().zip(&sums) {
         let cpu = sensor.screen_levels(world.pheromones(), world.screen(), *c);
         let gpu = mean_levels(*s);
-        assert_eq!(
-            cpu, gpu,
-            "{name}: sensor at {c} reads {cpu:?} on the CPU, {gpu:?} on the GPU"
-        );
+        if cpu != gpu {
+            differ += 1;
+            // A mean of footprint levels that each moved by at most one (see `exact` above).
+            let off = cpu.iter().zip(gpu).map(|(&x, y)| (x - y).abs());
+            assert!(
+                !exact && off.fold(0f32, f32::max) <= 1.0,
+                "{name}: sensor at {c} reads {cpu:?} on the CPU, {gpu:?} on the GPU"
+            );
+        }
         if cpu != [0.0; 3] {
             nonzero += 1;
         }
     }
     assert!(nonzero > 20, "{name}: only {nonzero} sensors see anything");
+    assert!(
+        differ <= 3 + nonzero / 100,
+        "{name}: {differ} of {nonzero} non-zero sensor readings differ"
+    );
     eprintln!(
-        "{name}: {} sensor readings identical ({nonzero} non-zero)",
+        "{name}: {} sensor readings, {differ} differ ({nonzero} non-zero)",
         centres.len()
     );
 }
