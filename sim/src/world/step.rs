@@ -10,7 +10,8 @@ use rayon::prelude::*;
 
 /// Below this many robots a world steps its robots on one thread: rayon's overhead would dominate, and
 /// batched environments parallelise over worlds instead. (At 100 robots one thread and two were even in
-/// session 7: 0.33 ms a step either way, alternated 6 times; two threads used twice the CPU time.)
+/// session 7: 0.33 ms a step either way, alternated 6 times; on session 8's faster host two threads
+/// paid: 0.13 against 0.29 ms, `RAYON_NUM_THREADS=1|2 profile_swarm "bench: 100"` alternated 3 times.)
 const PARALLEL_ROBOTS: usize = 64;
 
 /// Robot `slot` takes wheel command `cmd` (a non-finite one is a stop): its drive's lag advances by
