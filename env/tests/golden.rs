@@ -1,0 +1,112 @@
+//! Golden outputs of the batched environment: observations, rewards, terminations and global state of
+//! every task, under fixed actions and under a baseline policy, hash to exactly these values. A
+//! refactoring that changes any of them changes behaviour.
+//! `COLCOS_GOLDEN_PRINT=1 cargo test --release -p colcos-env --test golden -- --nocapture` prints them.
+use colcos_env::baseline::BaselinePolicy;
+use colcos_env::{Actions, EnvConfig, VecEnv};
+
+/// FNV-1a, 64-bit, over the bytes of every value fed to it.
+struct Fnv(u64);
+impl Fnv {
+    fn bytes(&mut self, b: &[u8]) {
+        for &x in b {
+            self.0 = (self.0 ^ x as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    fn floats(&mut self, v: &[f32]) {
+        v.iter().for_each(|x| self.bytes(&x.to_le_bytes()));
+    }
+    fn flags(&mut self, v: &[bool]) {
+        v.iter().for_each(|&x| self.bytes(&[x as u8]));
+    }
+}
+
+fn record(env: &VecEnv, h: &mut Fnv) {
+    h.floats(env.obs());
+    h.floats(env.rewards());
+    h.flags(env.terminated());
+    h.flags(env.truncated());
+    h.floats(env.state());
+    h.floats(env.final_obs());
+    h.flags(env.final_mask());
+}
+
+fn config(task: &str) -> EnvConfig {
+    let mut c = EnvConfig::new(task);
+    c.num_envs = 4;
+    c.max_cycles = 40;
+    c.seed = 11;
+    c.num_threads = Some(2);
+    c
+}
+
+/// Fixed, varied actions (a sine over world, agent, wheel and step) through two episodes.
+fn scripted_actions(task: &str) -> u64 {
+    let mut env = VecEnv::new(&config(task)).unwrap();
+    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    env.reset(Some(11), None).unwrap();
+    record(&env, &mut h);
+    let len = env.spec().num_envs * env.spec().num_agents * 2;
+    for t in 0..90 {
+        let a: Vec<f32> = (0..len)
+            .map(|k| ((k * 7 + t * 3) as f32 * 0.37).sin())
+            .collect();
+        env.step(Actions::Continuous(&a)).unwrap();
+        record(&env, &mut h);
+    }
+    h.0
+}
+
+/// The task's scenario behaviour as a baseline policy, through two episodes.
+fn baseline(task: &str, behaviour: &str, params: serde_json::Value) -> u64 {
+    let mut env = VecEnv::new(&config(task)).unwrap();
+    env.reset(Some(5), None).unwrap();
+    let mut policy = BaselinePolicy::new(&env, behaviour, &params, 5).unwrap();
+    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    let mut a = vec![0.0; env.spec().num_envs * env.spec().num_agents * 2];
+    for _ in 0..90 {
+        policy.act(&env, &mut a).unwrap();
+        h.floats(&a);
+        env.step(Actions::Continuous(&a)).unwrap();
+        record(&env, &mut h);
+    }
+    h.0
+}
+
+fn check(label: &str, got: u64, want: u64) {
+    if std::env::var("COLCOS_GOLDEN_PRINT").is_ok_and(|v| v == "1") {
+        println!("{label}: {got:#018x}");
+    } else {
+        assert_eq!(got, want, "{label}: outputs changed ({got:#018x})");
+    }
+}
+
+#[test]
+fn every_task_under_fixed_actions() {
+    for (task, want) in [
+        ("aggregation", 0xadf11341867d8529u64),
+        ("foraging", 0xe84fe0d65f7cb0d5),
+        ("trail", 0x673dabe31bf0b339),
+    ] {
+        check(task, scripted_actions(task), want);
+    }
+}
+
+#[test]
+fn baselines() {
+    check(
+        "aggregation/aggregation_follower",
+        baseline("aggregation", "aggregation_follower", serde_json::json!({})),
+        0xaa4d94bce0cff459,
+    );
+    check(
+        "foraging/forage",
+        baseline("foraging", "forage", serde_json::json!({})),
+        0x0f924c66bd414548,
+    );
+    check(
+        "trail/follow",
+        baseline("trail", "follow", serde_json::json!({"channel": "b"})),
+        0x137cf18b419c7b0f,
+    );
+}

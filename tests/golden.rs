@@ -1,0 +1,157 @@
+//! Golden outputs: the default scenario and both case studies, run by the `colcos` binary with a fixed
+//! seed, write exactly these bytes. A refactoring that changes any of them changes behaviour.
+//! `COLCOS_GOLDEN_PRINT=1 cargo test --release --test golden -- --nocapture` prints the current hashes.
+use std::path::Path;
+use std::process::Command;
+
+/// FNV-1a, 64-bit: stable across Rust versions (std's hasher is not).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// Every file under `dir` that a run writes deterministically, with its hash, sorted by path.
+fn hashes(dir: &Path) -> Vec<(String, u64)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path
+                .strip_prefix(dir)
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
+            if path.is_dir() {
+                stack.push(path);
+            } else if !name.ends_with(".json") && !name.ends_with(".md") {
+                // summary.json holds wall-clock times; report.md quotes them.
+                out.push((name, fnv1a(&std::fs::read(&path).unwrap())));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn colcos(args: &[&str], out: &Path) -> Vec<(String, u64)> {
+    let status = Command::new(env!("CARGO_BIN_EXE_colcos"))
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "colcos {args:?}: {}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    hashes(out)
+}
+
+fn check(label: &str, got: Vec<(String, u64)>, want: &[(&str, u64)]) {
+    if std::env::var("COLCOS_GOLDEN_PRINT").is_ok_and(|v| v == "1") {
+        println!("// {label}");
+        for (name, h) in &got {
+            println!("(\"{name}\", {h:#018x}),");
+        }
+        return;
+    }
+    let got: Vec<(&str, u64)> = got.iter().map(|(n, h)| (n.as_str(), *h)).collect();
+    assert_eq!(got, want, "{label}: outputs changed");
+}
+
+#[test]
+fn default_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    let got = colcos(
+        &[
+            "run",
+            "scenarios/three_trails.toml",
+            "--duration",
+            "6",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    check("three_trails", got, THREE_TRAILS);
+}
+
+#[test]
+fn case_studies_as_scenarios() {
+    for (file, want) in [
+        ("scenarios/case1_g3.toml", CASE1_G3),
+        ("scenarios/case1_layout_b_g2.toml", CASE1_B_G2),
+        ("scenarios/case2_alarm.toml", CASE2),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let got = colcos(&["run", file, "--duration", "40", "--quiet"], dir.path());
+        check(file, got, want);
+    }
+}
+
+#[test]
+fn case_studies_as_experiments() {
+    let dir = tempfile::tempdir().unwrap();
+    let got = colcos(
+        &[
+            "experiment",
+            "all",
+            "--trials",
+            "2",
+            "--runs",
+            "1",
+            "--seed",
+            "3",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    check("experiment all", got, EXPERIMENTS);
+}
+
+const THREE_TRAILS: &[(&str, u64)] = &[
+    ("fields/blue.npy", 0x84f3375c62076cfa),
+    ("fields/green.npy", 0x441ef8aaab1f4688),
+    ("fields/red.npy", 0x2e0af3a9c1f520c6),
+    ("run.gif", 0xc9fbc8e2b51e279b),
+    ("scenario.toml", 0x74f711f92dc9113d),
+    ("screen.png", 0xe56a857e55daf0dc),
+    ("trajectory.csv", 0x79ed9155e378aec3),
+];
+const CASE1_G3: &[(&str, u64)] = &[
+    ("fields/LAP.npy", 0xe8cb475867314762),
+    ("fields/SAP.npy", 0xcc50079de2c6e3a2),
+    ("fields/SRP.npy", 0x59f90e33281bf1e2),
+    ("scenario.toml", 0xc8ca8ddd11a4a1fb),
+    ("screen.png", 0x8d50e96e7620b236),
+    ("trajectory.csv", 0xb67dd32ded6ef012),
+];
+const CASE1_B_G2: &[(&str, u64)] = &[
+    ("fields/LAP.npy", 0xbb38b73bead5efa2),
+    ("fields/SAP.npy", 0x3064cab20eeb52a2),
+    ("scenario.toml", 0x8800dd7c0ed3ecb2),
+    ("screen.png", 0x9dafe67cdf6df998),
+    ("trajectory.csv", 0x856a2281a0fb01cb),
+];
+const CASE2: &[(&str, u64)] = &[
+    ("fields/AGP.npy", 0x17190009229fb89e),
+    ("fields/ALP.npy", 0x38f58f51f25a8a7d),
+    ("run.gif", 0xd55da362af9a84d4),
+    ("scenario.toml", 0xa5510f9a43eda2bf),
+    ("screen.png", 0xbbf28eb896d3b7f8),
+    ("trajectory.csv", 0x1d4d917a7f639f11),
+];
+const EXPERIMENTS: &[(&str, u64)] = &[
+    ("case1/arrivals.csv", 0x2b8abca265e0d18c),
+    ("case1/fig5_arrivals.png", 0xa0b4dca6654b7cbf),
+    ("case1/fig6_g3_trajectories.png", 0x3244cd256df5d44f),
+    ("case1/trajectories_all_groups.png", 0x82f003ab3f49aa7f),
+    ("case1/trials.csv", 0x5cf0e3ea7a11874a),
+    ("case2/fig7_snapshots.png", 0x82aa2691c6011d39),
+    ("case2/fig8_s_t.png", 0x5b86c92d5477e0b9),
+    ("case2/s_t.csv", 0x292c5b6fcdc98acd),
+    ("case2/trajectories.png", 0xa95b43dc93f02470),
+];
