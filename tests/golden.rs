@@ -92,6 +92,49 @@ fn case_studies_as_scenarios() {
     }
 }
 
+/// Enough robots and deposits that every parallel path is taken (robots, banded deposits, field rows).
+const LARGE_SWARM: &str = r#"
+duration = 0.4
+seed = 7
+[screen]
+resolution = [3840, 2160]
+size = [2.4, 1.35]
+[field]
+cell = 0.003
+[output]
+gif_interval = 0.2
+[[pheromones]]
+name = "red"
+colour = [255, 0, 0]
+evaporation = 5.0
+diffusion = 1e-5
+[[pheromones]]
+name = "blue"
+colour = [0, 0, 255]
+evaporation = 5.0
+diffusion = 1e-6
+maps = [{ polyline = [[0.2, 0.2], [2.2, 1.1]], width = 0.05, rate = 0.2 }]
+[[robots]]
+count = 200
+behaviour = "follow"
+params = { channel = "b" }
+deposits = [{ pheromone = "red", kernel = { shape = "cone", radius = 0.01 }, rate = 5.0 }]
+[[robots]]
+count = 150
+behaviour = "avoid"
+deposits = [{ pheromone = "blue", kernel = { shape = "disc", radius = 0.01 }, rate = 5.0 }]
+"#;
+
+#[test]
+fn large_swarm() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("large.toml");
+    std::fs::write(&scenario, LARGE_SWARM).unwrap();
+    let out = dir.path().join("out");
+    let got = colcos(&["run", scenario.to_str().unwrap(), "--quiet"], &out);
+    check("large swarm", got, LARGE);
+}
+
 #[test]
 fn case_studies_as_experiments() {
     let dir = tempfile::tempdir().unwrap();
@@ -112,6 +155,14 @@ fn case_studies_as_experiments() {
     check("experiment all", got, EXPERIMENTS);
 }
 
+const LARGE: &[(&str, u64)] = &[
+    ("fields/blue.npy", 0x8d908e5e874be824),
+    ("fields/red.npy", 0xf65ce95708c8a76c),
+    ("run.gif", 0x9be7d5aea1abc257),
+    ("scenario.toml", 0x2dab784f4a77cac8),
+    ("screen.png", 0x746a412740df9e7d),
+    ("trajectory.csv", 0x110c39510366a265),
+];
 const THREE_TRAILS: &[(&str, u64)] = &[
     ("fields/blue.npy", 0x84f3375c62076cfa),
     ("fields/green.npy", 0x441ef8aaab1f4688),

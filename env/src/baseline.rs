@@ -4,14 +4,14 @@ use crate::encoding::command_to_action;
 use crate::error::{EnvError, Result};
 use crate::vec_env::VecEnv;
 use colcos_sim::behaviour::{Behaviour, registry};
-use colcos_sim::rng::{self, SimRng};
-
-/// Random streams of baseline policies sit far above the world's own.
-const STREAM_BASELINE: u64 = 1 << 40;
+use colcos_sim::rng::{self, SimRng, Stream};
+use colcos_sim::robot::ColiasParams;
 
 pub struct BaselinePolicy {
     name: String,
     params: toml::Table,
+    /// The body of the env's robots (the scenario's `[robot]`).
+    robot: ColiasParams,
     seed: u64,
     /// Per (world, agent): behaviour, random stream; rebuilt when the world starts a new episode.
     slots: Vec<(Box<dyn Behaviour>, SimRng)>,
@@ -31,11 +31,13 @@ impl BaselinePolicy {
                 )
             })?,
         };
+        let robot = env.scenario().spec.robot;
         // Build once to check the name and parameters.
-        registry::build(name, &params, "baseline")?;
+        registry::build_with(name, &params, "baseline", &robot)?;
         let mut policy = BaselinePolicy {
             name: name.into(),
             params,
+            robot,
             seed,
             slots: Vec::new(),
             seen: Vec::new(),
@@ -51,15 +53,9 @@ impl BaselinePolicy {
     }
 
     fn make(&self, w: usize, i: usize, episode: u64) -> Result<(Box<dyn Behaviour>, SimRng)> {
-        let b = registry::build(&self.name, &self.params, "baseline")?;
-        Ok((
-            b,
-            rng::stream(
-                self.seed,
-                crate::world_slot::world_index(w, episode),
-                STREAM_BASELINE + i as u64,
-            ),
-        ))
+        let b = registry::build_with(&self.name, &self.params, "baseline", &self.robot)?;
+        let world = crate::world_slot::world_index(w, episode);
+        Ok((b, rng::stream_of(self.seed, world, Stream::Baseline(i))))
     }
 
     /// Continuous actions `[E, N, 2]` for the env's current observations.

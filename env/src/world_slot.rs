@@ -3,12 +3,9 @@ use crate::backend::EnvBackend;
 use crate::error::Result;
 use crate::task::Task;
 use colcos_sim::behaviour::{Behaviour, WheelCommand, registry};
-use colcos_sim::rng::{self, SimRng};
+use colcos_sim::rng::{self, SimRng, Stream};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
-
-/// Random stream of scripted robot `i` (above the streams the world itself uses).
-const STREAM_SCRIPTED0: u64 = 1 << 20;
 
 /// The world index passed to [`World::with_index`] for episode `episode` of batch world `w`: every
 /// (world, episode) pair has its own random streams, whatever the order worlds are reset in.
@@ -52,13 +49,10 @@ impl WorldSlot {
         for (g, group) in scenario.spec.robots.iter().enumerate() {
             for i in first..first + group.count {
                 if !agents.contains(&i) {
-                    let behaviour =
-                        registry::build(&group.behaviour, &group.params, &format!("robots[{g}]"))?;
-                    scripted.push((
-                        i,
-                        behaviour,
-                        rng::stream(scenario.spec.seed, index, STREAM_SCRIPTED0 + i as u64),
-                    ));
+                    let key = format!("robots[{g}]");
+                    let behaviour = registry::build_for_group(group, &scenario.spec.robot, &key)?;
+                    let rng = rng::stream_of(scenario.spec.seed, index, Stream::Scripted(i));
+                    scripted.push((i, behaviour, rng));
                 }
             }
             first += group.count;

@@ -17,6 +17,46 @@ pub fn stream(seed: u64, world: u64, stream: u64) -> SimRng {
     SimRng::seed_from_u64(mix64(mix64(mix64(seed) ^ world) ^ stream))
 }
 
+/// Every random stream of a world, and the id it derives from: the one table of stream ids, so that
+/// no two users of a world's streams draw from the same one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stream {
+    /// Initial placement of the robots.
+    Placement,
+    /// The tracker model's noise and dropouts.
+    Tracker,
+    /// Robot `i`'s own stream: its sensor noise and its behaviour's choices.
+    Robot(usize),
+    /// The behaviour of a scripted (non-agent) robot `i` of a batched environment.
+    Scripted(usize),
+    /// The baseline policy of agent `i` of a batched environment.
+    Baseline(usize),
+}
+
+impl Stream {
+    /// First id of the scripted robots' streams: above every robot stream of a world of up to
+    /// `SCRIPTED0 - 2` robots.
+    const SCRIPTED0: u64 = 1 << 20;
+    /// First id of the baseline policies' streams.
+    const BASELINE0: u64 = 1 << 40;
+
+    /// The stream's id under [`stream`].
+    pub fn id(self) -> u64 {
+        match self {
+            Stream::Placement => 0,
+            Stream::Tracker => 1,
+            Stream::Robot(i) => 2 + i as u64,
+            Stream::Scripted(i) => Self::SCRIPTED0 + i as u64,
+            Stream::Baseline(i) => Self::BASELINE0 + i as u64,
+        }
+    }
+}
+
+/// The random stream `which` of world `world` under `seed`.
+pub fn stream_of(seed: u64, world: u64, which: Stream) -> SimRng {
+    stream(seed, world, which.id())
+}
+
 /// A standard normal sample: Marsaglia and Tsang's ziggurat with 128 layers in f32 (see [`Ziggurat`]).
 /// One 64-bit draw, a table lookup and a multiply in 98.8 % of calls. rand_distr's `StandardNormal`
 /// (the same method in f64 with generic plumbing) cost about 60 instructions a draw, and a robot's
@@ -122,6 +162,17 @@ impl Ziggurat {
 mod tests {
     use super::*;
     use rand::RngExt;
+
+    /// The ranges of the stream table do not overlap for any world a scenario can describe.
+    #[test]
+    fn stream_ids_do_not_collide() {
+        let last_robot = Stream::Robot(Stream::SCRIPTED0 as usize - 3).id();
+        assert!(last_robot < Stream::Scripted(0).id());
+        assert!(Stream::Scripted(1 << 30).id() < Stream::Baseline(0).id());
+        assert_eq!(Stream::Placement.id(), 0);
+        assert_eq!(Stream::Tracker.id(), 1);
+        assert_eq!(Stream::Robot(0).id(), 2);
+    }
 
     #[test]
     fn streams_differ_and_repeat() {

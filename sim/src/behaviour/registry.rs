@@ -3,10 +3,14 @@
 use super::follow::{FollowParams, channel_index};
 use super::{Avoid, Behaviour, Follow, Wander};
 use crate::error::{Result, SimError};
+use crate::robot::ColiasParams;
+use crate::scenario::RobotGroupSpec;
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
-type Builder = fn(&toml::Table, &str) -> Result<Box<dyn Behaviour>>;
+/// Builds a behaviour from its `params` table (`key` names it in errors) for a robot with `robot`'s
+/// body (a behaviour that turns at a set yaw rate needs its wheel base).
+type Builder = fn(&toml::Table, &str, &ColiasParams) -> Result<Box<dyn Behaviour>>;
 
 /// Every registered behaviour: name, one-line description, builder.
 const REGISTRY: &[(&str, &str, Builder)] = &[
@@ -47,10 +51,31 @@ pub fn list() -> impl Iterator<Item = (&'static str, &'static str)> {
     REGISTRY.iter().map(|(n, d, _)| (*n, *d))
 }
 
-/// Builds behaviour `name` from its parameter table; `key` is the scenario key path used in errors.
+/// Builds behaviour `name` from its parameter table for a robot with the default Colias body; `key` is
+/// the scenario key path used in errors.
 pub fn build(name: &str, params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+    build_with(name, params, key, &ColiasParams::default())
+}
+
+/// The behaviour of every robot of `group` (`key`, e.g. `robots[2]`, names it in errors), for a robot
+/// with the scenario's body `robot`: the one constructor of scenario behaviours, whoever runs them.
+pub fn build_for_group(
+    group: &RobotGroupSpec,
+    robot: &ColiasParams,
+    key: &str,
+) -> Result<Box<dyn Behaviour>> {
+    build_with(&group.behaviour, &group.params, key, robot)
+}
+
+/// Builds behaviour `name` from its parameter table for a robot with body `robot`.
+pub fn build_with(
+    name: &str,
+    params: &toml::Table,
+    key: &str,
+    robot: &ColiasParams,
+) -> Result<Box<dyn Behaviour>> {
     match REGISTRY.iter().find(|(n, _, _)| *n == name) {
-        Some((_, _, builder)) => builder(params, key),
+        Some((_, _, builder)) => builder(params, key, robot),
         None => {
             let known: Vec<_> = REGISTRY.iter().map(|(n, _, _)| *n).collect();
             Err(SimError::invalid(
@@ -101,19 +126,19 @@ fn speed_checked(key: &str, speed: f32) -> Result<f32> {
     }
 }
 
-fn build_wander(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+fn build_wander(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box<dyn Behaviour>> {
     let p: WanderParams = parse_params(params, key)?;
     Ok(Box::new(Wander::new(speed_checked(key, p.speed)?)))
 }
 
-fn build_avoid(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+fn build_avoid(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box<dyn Behaviour>> {
     let p: WanderParams = parse_params(params, key)?;
     Ok(Box::new(Avoid::new(Wander::new(speed_checked(
         key, p.speed,
     )?))))
 }
 
-fn build_follow(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+fn build_follow(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box<dyn Behaviour>> {
     let p: FollowParams = parse_params(params, key)?;
     let channel = channel_index(&p.channel).ok_or_else(|| {
         SimError::invalid(
@@ -145,18 +170,32 @@ fn build_follow(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
     ))))
 }
 
-fn build_forage(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+fn build_forage(
+    params: &toml::Table,
+    key: &str,
+    robot: &ColiasParams,
+) -> Result<Box<dyn Behaviour>> {
     let p: super::paper::ForagingParams = parse_params(params, key)?;
     p.validate(key)?;
-    Ok(Box::new(super::paper::Foraging::new(p)))
+    let mut forage = super::paper::Foraging::new(p);
+    forage.wheel_base = robot.wheel_base;
+    Ok(Box::new(forage))
 }
 
-fn build_aggregation_leader(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+fn build_aggregation_leader(
+    params: &toml::Table,
+    key: &str,
+    _: &ColiasParams,
+) -> Result<Box<dyn Behaviour>> {
     let p: super::paper::LeaderParams = parse_params(params, key)?;
     Ok(Box::new(super::paper::Leader::new(p.validate(key)?)))
 }
 
-fn build_aggregation_follower(params: &toml::Table, key: &str) -> Result<Box<dyn Behaviour>> {
+fn build_aggregation_follower(
+    params: &toml::Table,
+    key: &str,
+    _: &ColiasParams,
+) -> Result<Box<dyn Behaviour>> {
     let p: super::paper::FollowerParams = parse_params(params, key)?;
     Ok(Box::new(super::paper::Follower::new(p.validate(key)?)))
 }

@@ -305,7 +305,7 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
     let mut footprint = 0.0f64;
     for (g, group) in s.robots.iter().enumerate() {
         let k = |f: &str| format!("robots[{g}].{f}");
-        registry::build(&group.behaviour, &group.params, &format!("robots[{g}]"))?;
+        registry::build_for_group(group, &s.robot, &format!("robots[{g}]"))?;
         let region = group.region.unwrap_or([0.0, 0.0, arena.x, arena.y]);
         for (n, v) in region.iter().enumerate() {
             finite(&format!("robots[{g}].region[{n}]"), *v)?;

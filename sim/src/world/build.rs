@@ -1,22 +1,18 @@
 //! Building a world from a scenario: fields with their static maps, robots, emitters.
-use super::{Deposit, Emitter, RobotSlot, World};
-use crate::behaviour::{Observation, WheelCommand, registry};
+use super::inject::{Deposit, Emitter};
+use super::{FieldSet, Injection, RobotSet, RobotSlot, Sensing, Tracking, World};
+use crate::behaviour::{WheelCommand, registry};
 use crate::error::Result;
 use crate::field::{
     FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec, Pheromone,
     image_map, polyline_map,
 };
-use crate::rng;
+use crate::rng::{self, Stream};
 use crate::robot::{ArenaPhysics, DriveState, Pose};
 use crate::scenario::{EmitWhen, MapSpec, ModelKind, PheromoneSpec, Scenario};
-use crate::sensors::{BumperRays, ColourSensor, NeighbourIndex};
+use crate::sensors::ColourSensor;
 use crate::tracker::Tracker;
 use glam::Vec2;
-
-/// Random streams of a world: 0 placement, 1 tracker, 2.. one per robot.
-const STREAM_PLACEMENT: u64 = 0;
-const STREAM_TRACKER: u64 = 1;
-const STREAM_ROBOT0: u64 = 2;
 
 impl World {
     /// A world for `scenario`, world index 0.
@@ -37,7 +33,7 @@ impl World {
             .map(|(i, p)| build_pheromone(scenario, i, p, grid))
             .collect::<Result<Vec<_>>>()?;
 
-        let mut placement_rng = rng::stream(spec.seed, world_index, STREAM_PLACEMENT);
+        let mut placement_rng = rng::stream_of(spec.seed, world_index, Stream::Placement);
         let mut poses: Vec<Pose> = Vec::with_capacity(scenario.robot_count());
         let mut robots = Vec::with_capacity(scenario.robot_count());
         let mut deposits = Vec::new();
@@ -57,8 +53,8 @@ impl World {
                 poses.push(pose);
                 robots.push(RobotSlot {
                     group: g,
-                    behaviour: registry::build(&group.behaviour, &group.params, &key)?,
-                    rng: rng::stream(spec.seed, world_index, STREAM_ROBOT0 + index as u64),
+                    behaviour: registry::build_for_group(group, &spec.robot, &key)?,
+                    rng: rng::stream_of(spec.seed, world_index, Stream::Robot(index)),
                     drive: DriveState::default(),
                     command: WheelCommand::STOP,
                 });
@@ -102,41 +98,38 @@ impl World {
             }
         }
         let physics = ArenaPhysics::with_backend(arena, &spec.robot, &poses, spec.physics);
-        let mut tracker = Tracker::new(spec.tracker, poses.len());
-        let mut tracker_rng = rng::stream(spec.seed, world_index, STREAM_TRACKER);
-        let tracked = tracker.update(0.0, &poses, &mut tracker_rng).to_vec();
+        let tracking = Tracking::new(
+            Tracker::new(spec.tracker, poses.len()),
+            rng::stream_of(spec.seed, world_index, Stream::Tracker),
+            &poses,
+        );
+        let count = robots.len();
         let mut world = World {
             scenario: scenario.clone(),
             time: 0.0,
             tick: 0,
             dt: spec.dt,
             arena,
-            robot_params: spec.robot,
-            bumper_params: spec.bumper,
-            bumper_rays: BumperRays::new(&spec.bumper),
             screen: spec.screen,
-            inject_at: spec.field.inject_at,
-            pheromones,
-            physics,
-            observations: vec![Observation::default(); robots.len()],
-            last_injection: vec![None; robots.len()],
-            segments: Vec::new(),
-            band_segments: Vec::new(),
-            robots,
-            tracker,
-            tracker_rng,
-            tracked,
-            neighbours: NeighbourIndex::default(),
-            sensor: ColourSensor::new(spec.sensor),
-            deposits,
-            emitters,
-            velocities: Vec::new(),
-            positions: Vec::new(),
-            sensor_points: Vec::new(),
-            frozen: Default::default(),
-            field_backend: None,
+            fields: FieldSet::new(pheromones),
+            robots: RobotSet::new(spec.robot, physics, robots),
+            tracking,
+            injection: Injection::new(spec.field.inject_at, deposits, emitters, count),
+            sensing: Sensing::new(
+                ColourSensor::new(spec.sensor),
+                spec.bumper,
+                spec.robot.radius,
+                arena,
+                count,
+            ),
         };
-        world.inject();
+        super::stages::inject(
+            &mut world.injection,
+            &mut world.fields,
+            world.robots.poses(),
+            world.tracking.tracked(),
+            world.dt,
+        );
         world.observe();
         Ok(world)
     }
@@ -224,16 +217,4 @@ fn build_map(scenario: &Scenario, _key: &str, map: &MapSpec, grid: &GridSpec) ->
         _ => None,
     };
     image_map(grid, &path, channel, map.rate)
-}
-
-impl World {
-    /// Replaces the behaviour of robot `i` (e.g. with a learned policy).
-    pub fn set_behaviour(&mut self, i: usize, behaviour: Box<dyn crate::behaviour::Behaviour>) {
-        self.robots[i].behaviour = behaviour;
-    }
-
-    /// A fresh neighbour index (used by tests that probe bumpers directly).
-    pub fn neighbour_index(&self) -> &NeighbourIndex {
-        &self.neighbours
-    }
 }

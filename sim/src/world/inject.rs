@@ -1,7 +1,7 @@
-//! Injection: robots lay trails on grid pheromones along their path and move their Gaussian sources,
-//! at their tracked poses (as the real host does) or their true ones.
-use super::World;
-use crate::field::{FieldModel, GridBand, GridSpec, Kernel};
+//! Injection: the rules by which robots lay trails on grid pheromones along their path and move their
+//! Gaussian sources, at their tracked poses (as the real host does) or their true ones. Stage `inject`.
+use super::FieldSet;
+use crate::field::{FieldModel, GridBand, GridSpec, Kernel, Pheromone};
 use crate::robot::Pose;
 use crate::scenario::InjectAt;
 use crate::tracker::TrackedPose;
@@ -16,7 +16,7 @@ const BANDED_DEPOSITS: usize = 256;
 const BANDS: usize = 4;
 
 /// One robot's trail deposit of this step: the segment from where it injected last to where it is.
-pub(super) struct Segment {
+struct Segment {
     pheromone: usize,
     kernel: Kernel,
     from: Vec2,
@@ -24,7 +24,7 @@ pub(super) struct Segment {
     amount: f32,
 }
 
-/// Where the host believes robot `i` is (see [`World::injection_point`]).
+/// Where the host believes robot `i` is: its true pose, or its tracked one once the tracker has seen it.
 fn injection_point_of(
     inject_at: InjectAt,
     poses: &[Pose],
@@ -57,117 +57,177 @@ fn bands_reached(
     Some((lo, hi))
 }
 
-impl World {
-    /// Where the host believes robot `i` is, or `None` if the tracker has not seen it yet.
-    pub fn injection_point(&self, i: usize) -> Option<Vec2> {
-        injection_point_of(self.inject_at, self.physics.poses(), &self.tracked, i)
+/// A trail deposit rule of one robot.
+pub(super) struct Deposit {
+    pub robot: usize,
+    pub pheromone: usize,
+    pub kernel: Kernel,
+    /// Units per second at the kernel's peak.
+    pub rate: f32,
+}
+
+/// A Gaussian source attached to one robot.
+pub(super) struct Emitter {
+    pub robot: usize,
+    pub pheromone: usize,
+    /// Index of the source in the pheromone's [`crate::field::GaussianField`].
+    pub source: usize,
+    /// `None`: follow always; `Some((targets, distance))`: refresh when near one of `targets`.
+    pub near: Option<(Vec<usize>, f32)>,
+}
+
+pub struct Injection {
+    inject_at: InjectAt,
+    deposits: Vec<Deposit>,
+    emitters: Vec<Emitter>,
+    /// Where each robot injected last (None before its first tracked pose).
+    last_injection: Vec<Option<Vec2>>,
+    /// Scratch: this step's trail segments.
+    segments: Vec<Segment>,
+    /// Scratch: for each band of rows of each grid field (in field order), the indices of the segments
+    /// that may reach it.
+    band_segments: Vec<Vec<u32>>,
+}
+
+impl Injection {
+    pub(super) fn new(
+        inject_at: InjectAt,
+        deposits: Vec<Deposit>,
+        emitters: Vec<Emitter>,
+        robots: usize,
+    ) -> Self {
+        Injection {
+            inject_at,
+            deposits,
+            emitters,
+            last_injection: vec![None; robots],
+            segments: Vec::new(),
+            band_segments: Vec::new(),
+        }
     }
 
-    pub(super) fn inject(&mut self) {
-        let dt = self.dt;
-        // This step's trail segments, in scenario order.
-        self.segments.clear();
-        for dep in &self.deposits {
-            let robot = dep.robot;
-            let Some(to) =
-                injection_point_of(self.inject_at, self.physics.poses(), &self.tracked, robot)
-            else {
-                continue;
-            };
-            self.segments.push(Segment {
-                pheromone: dep.pheromone,
-                kernel: dep.kernel,
-                from: self.last_injection[robot].unwrap_or(to),
-                to,
-                amount: dep.rate * dt,
-            });
+    /// Where the host believes robot `i` is, or `None` if the tracker has not seen it yet.
+    pub fn point(&self, poses: &[Pose], tracked: &[TrackedPose], i: usize) -> Option<Vec2> {
+        injection_point_of(self.inject_at, poses, tracked, i)
+    }
+}
+
+/// Stage `inject`: every robot's trail deposits of this step (the segment from where it injected last
+/// to where the host believes it is now) and its Gaussian sources moved or refreshed there.
+///
+/// Reads `poses` (true) and `tracked`; writes the grid pheromones' values, the Gaussian sources'
+/// centres and start times, and where each robot injected last.
+pub fn inject(
+    injection: &mut Injection,
+    fields: &mut FieldSet,
+    poses: &[Pose],
+    tracked: &[TrackedPose],
+    dt: f32,
+) {
+    let inject_at = injection.inject_at;
+    let point = |i: usize| injection_point_of(inject_at, poses, tracked, i);
+    // This step's trail segments, in scenario order.
+    injection.segments.clear();
+    for dep in &injection.deposits {
+        let robot = dep.robot;
+        let Some(to) = point(robot) else {
+            continue;
+        };
+        injection.segments.push(Segment {
+            pheromone: dep.pheromone,
+            kernel: dep.kernel,
+            from: injection.last_injection[robot].unwrap_or(to),
+            to,
+            amount: dep.rate * dt,
+        });
+    }
+    deposit_segments(injection, fields.pheromones_mut());
+    for (i, last) in injection.last_injection.iter_mut().enumerate() {
+        if let Some(p) = point(i) {
+            *last = Some(p);
         }
-        // A cell's value depends on the order of its own deposits only: each field is cut into bands
-        // of rows, every band takes the segments that may reach it in scenario order, and bands run in
-        // parallel.
-        let segments = &self.segments;
-        if self.deposits.len() >= PARALLEL_DEPOSITS {
-            let bands_per_field = if self.deposits.len() >= BANDED_DEPOSITS {
-                BANDS
-            } else {
-                1
-            };
-            let band_rows = |spec: &GridSpec| spec.ny.div_ceil(bands_per_field).max(1);
-            // First the lists of segments per band (reading the grids' geometry only) ...
-            let lists = &mut self.band_segments;
-            lists.iter_mut().for_each(Vec::clear);
-            let mut first_list = 0;
-            for (index, ph) in self.pheromones.iter().enumerate() {
-                if let FieldModel::Grid(grid) = &ph.model {
-                    let spec = *grid.spec();
-                    let rows = band_rows(&spec);
-                    let count = spec.ny.div_ceil(rows).max(1);
-                    if lists.len() < first_list + count {
-                        lists.resize_with(first_list + count, Vec::new);
-                    }
-                    for (k, s) in segments.iter().enumerate() {
-                        if s.pheromone == index
-                            && let Some((lo, hi)) = bands_reached(s, &spec, rows, count)
-                        {
-                            for list in &mut lists[first_list + lo..=first_list + hi] {
-                                list.push(k as u32);
-                            }
+    }
+    for e in &injection.emitters {
+        let Some(pos) = point(e.robot) else {
+            continue;
+        };
+        let refresh = match &e.near {
+            None => true,
+            Some((targets, distance)) => targets
+                .iter()
+                .any(|&t| point(t).is_some_and(|q| q.distance(pos) <= *distance)),
+        };
+        if refresh && let FieldModel::Gaussian(g) = &mut fields.pheromones_mut()[e.pheromone].model
+        {
+            g.sources[e.source].centre = pos;
+            // The field's own clock, not the world's: the two are summed differently in f32, and a
+            // start a hair in the future would read as "not yet emitted".
+            g.sources[e.source].start = g.time;
+        }
+    }
+}
+
+/// This step's segments deposited into the grid pheromones. A cell's value depends on the order of its
+/// own deposits only: each field is cut into bands of rows, every band takes the segments that may
+/// reach it in scenario order, and bands run in parallel.
+fn deposit_segments(injection: &mut Injection, pheromones: &mut [Pheromone]) {
+    let segments = &injection.segments;
+    let deposits = injection.deposits.len();
+    if deposits >= PARALLEL_DEPOSITS {
+        let bands_per_field = if deposits >= BANDED_DEPOSITS {
+            BANDS
+        } else {
+            1
+        };
+        let band_rows = |spec: &GridSpec| spec.ny.div_ceil(bands_per_field).max(1);
+        // First the lists of segments per band (reading the grids' geometry only) ...
+        let lists = &mut injection.band_segments;
+        lists.iter_mut().for_each(Vec::clear);
+        let mut first_list = 0;
+        for (index, ph) in pheromones.iter().enumerate() {
+            if let FieldModel::Grid(grid) = &ph.model {
+                let spec = *grid.spec();
+                let rows = band_rows(&spec);
+                let count = spec.ny.div_ceil(rows).max(1);
+                if lists.len() < first_list + count {
+                    lists.resize_with(first_list + count, Vec::new);
+                }
+                for (k, s) in segments.iter().enumerate() {
+                    if s.pheromone == index
+                        && let Some((lo, hi)) = bands_reached(s, &spec, rows, count)
+                    {
+                        for list in &mut lists[first_list + lo..=first_list + hi] {
+                            list.push(k as u32);
                         }
                     }
-                    first_list += count;
                 }
+                first_list += count;
             }
-            // ... then the bands themselves, in the same order, each with its list.
-            let mut lists = self.band_segments.iter();
-            let mut bands: Vec<(GridBand, &[u32])> = Vec::new();
-            for ph in &mut self.pheromones {
-                if let FieldModel::Grid(grid) = &mut ph.model {
-                    let rows = band_rows(grid.spec());
-                    let with_lists = grid.bands_mut(rows).zip(&mut lists);
-                    bands.extend(with_lists.map(|(band, list)| (band, list.as_slice())));
-                }
+        }
+        // ... then the bands themselves, in the same order, each with its list.
+        let mut lists = injection.band_segments.iter();
+        let mut bands: Vec<(GridBand, &[u32])> = Vec::new();
+        for ph in pheromones.iter_mut() {
+            if let FieldModel::Grid(grid) = &mut ph.model {
+                let rows = band_rows(grid.spec());
+                let with_lists = grid.bands_mut(rows).zip(&mut lists);
+                bands.extend(with_lists.map(|(band, list)| (band, list.as_slice())));
             }
-            bands.par_iter_mut().for_each(|(band, list)| {
-                for &k in *list {
-                    let s = &segments[k as usize];
+        }
+        bands.par_iter_mut().for_each(|(band, list)| {
+            for &k in *list {
+                let s = &segments[k as usize];
+                band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
+            }
+        });
+    } else {
+        // A small world (a batched environment's): the whole grid as one band, nothing allocated.
+        for (index, ph) in pheromones.iter_mut().enumerate() {
+            if let FieldModel::Grid(grid) = &mut ph.model {
+                let ny = grid.spec().ny;
+                let mut band = grid.band_mut(0, ny);
+                for s in segments.iter().filter(|s| s.pheromone == index) {
                     band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
-                }
-            });
-        } else {
-            // A small world (a batched environment's): the whole grid as one band, nothing allocated.
-            for (index, ph) in self.pheromones.iter_mut().enumerate() {
-                if let FieldModel::Grid(grid) = &mut ph.model {
-                    let ny = grid.spec().ny;
-                    let mut band = grid.band_mut(0, ny);
-                    for s in segments.iter().filter(|s| s.pheromone == index) {
-                        band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
-                    }
-                }
-            }
-        }
-        for i in 0..self.robots.len() {
-            if let Some(p) = self.injection_point(i) {
-                self.last_injection[i] = Some(p);
-            }
-        }
-        for e in 0..self.emitters.len() {
-            let Some(pos) = self.injection_point(self.emitters[e].robot) else {
-                continue;
-            };
-            let refresh = match &self.emitters[e].near {
-                None => true,
-                Some((targets, distance)) => targets.iter().any(|&t| {
-                    self.injection_point(t)
-                        .is_some_and(|q| q.distance(pos) <= *distance)
-                }),
-            };
-            if refresh {
-                let (pheromone, source) = (self.emitters[e].pheromone, self.emitters[e].source);
-                if let FieldModel::Gaussian(g) = &mut self.pheromones[pheromone].model {
-                    g.sources[source].centre = pos;
-                    // The field's own clock, not the world's: the two are summed differently in f32,
-                    // and a start a hair in the future would read as "not yet emitted".
-                    g.sources[source].start = g.time;
                 }
             }
         }

@@ -230,7 +230,8 @@ struct Commit {
 /// Algorithm 1 as a behaviour (registered as `forage`).
 pub struct Foraging {
     pub params: ForagingParams,
-    /// The robot's wheel base, m (to turn at a given yaw rate; the Colias default).
+    /// The robot's wheel base, m (to turn at a given yaw rate): the Colias default, or the scenario's
+    /// `[robot] wheel_base` when built from a scenario.
     pub wheel_base: f32,
     avoid: Avoid<Wander>,
     commit: Option<Commit>,

@@ -1,0 +1,114 @@
+//! What a world shows of itself: clocks, parameters, poses, observations and field values.
+use super::{FieldSet, RobotSet, RobotSlot, Sensing, Tracking, World};
+use crate::behaviour::Observation;
+use crate::field::{FieldBackend, Pheromone};
+use crate::robot::{ColiasParams, Pose};
+use crate::scenario::Scenario;
+use crate::screen::ScreenSpec;
+use crate::sensors::{ColourSensor, NeighbourIndex};
+use crate::tracker::TrackedPose;
+use glam::Vec2;
+
+impl World {
+    /// Simulation time, s.
+    pub fn time(&self) -> f32 {
+        self.time
+    }
+    /// Number of steps taken.
+    pub fn tick(&self) -> u64 {
+        self.tick
+    }
+    pub fn dt(&self) -> f32 {
+        self.dt
+    }
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+    /// Arena size, m.
+    pub fn arena(&self) -> Vec2 {
+        self.arena
+    }
+    pub fn screen(&self) -> &ScreenSpec {
+        &self.screen
+    }
+    pub fn pheromones(&self) -> &[Pheromone] {
+        self.fields.pheromones()
+    }
+    pub fn pheromones_mut(&mut self) -> &mut [Pheromone] {
+        self.fields.pheromones_mut()
+    }
+    pub fn robot_count(&self) -> usize {
+        self.robots.len()
+    }
+    pub fn robots(&self) -> &[RobotSlot] {
+        &self.robots.slots
+    }
+    pub fn robot_params(&self) -> &ColiasParams {
+        &self.robots.params
+    }
+    /// True poses.
+    pub fn poses(&self) -> &[Pose] {
+        self.robots.poses()
+    }
+    /// Poses as the tracker last delivered them.
+    pub fn tracked(&self) -> &[TrackedPose] {
+        self.tracking.tracked()
+    }
+    /// What each robot senses now.
+    pub fn observations(&self) -> &[Observation] {
+        self.sensing.observations()
+    }
+    /// Role of robot `i` (its group's `role`).
+    pub fn role(&self, i: usize) -> &str {
+        &self.scenario.spec.robots[self.robots.slots[i].group].role
+    }
+    /// Pheromone `index`'s value at `p` as of the current observations (see
+    /// [`FieldSet::value_observed`]).
+    pub fn pheromone_value_observed(&self, index: usize, p: Vec2) -> f32 {
+        self.fields.value_observed(index, p)
+    }
+    /// [`World::pheromone_value_observed`] and its gradient at `p` (see
+    /// [`FieldSet::value_and_gradient_observed`]).
+    pub fn pheromone_value_and_gradient_observed(
+        &self,
+        index: usize,
+        p: Vec2,
+        step: f32,
+    ) -> (f32, Vec2) {
+        self.fields.value_and_gradient_observed(index, p, step)
+    }
+    /// The colour sensor model shared by all robots.
+    pub fn sensor(&self) -> &ColourSensor {
+        self.sensing.sensor()
+    }
+    /// The neighbour index of the current poses (tests probe bumpers through it).
+    pub fn neighbour_index(&self) -> &NeighbourIndex {
+        self.sensing.neighbours()
+    }
+    /// Where the host believes robot `i` is, or `None` if the tracker has not seen it yet.
+    pub fn injection_point(&self, i: usize) -> Option<Vec2> {
+        self.injection
+            .point(self.robots.poses(), self.tracking.tracked(), i)
+    }
+    /// Installs a field backend that steps the pheromones from now on (`None`: the CPU).
+    pub fn set_field_backend(&mut self, backend: Option<Box<dyn FieldBackend>>) {
+        self.fields.set_backend(backend);
+    }
+    /// The installed field backend's description, or `None` for the CPU.
+    pub fn field_backend(&self) -> Option<String> {
+        self.fields.backend_description()
+    }
+    /// Replaces the behaviour of robot `i` (e.g. with a learned policy).
+    pub fn set_behaviour(&mut self, i: usize, behaviour: Box<dyn crate::behaviour::Behaviour>) {
+        self.robots.slots[i].behaviour = behaviour;
+    }
+    /// Steps until the scenario's duration is reached.
+    pub fn is_finished(&self) -> bool {
+        self.tick >= self.scenario.steps()
+    }
+
+    /// The data sets, for hosts that run stages on their own.
+    pub fn sets(&self) -> (&FieldSet, &RobotSet, &Tracking, &Sensing) {
+        (&self.fields, &self.robots, &self.tracking, &self.sensing)
+    }
+}

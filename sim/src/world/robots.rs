@@ -1,0 +1,133 @@
+//! The robot set: bodies (rapier or discs), and per robot its group, behaviour, random stream, drive
+//! state and last command. Stages `decide_and_drive`, `drive` and `physics`.
+use super::PARALLEL_ROBOTS;
+use crate::behaviour::{Behaviour, Observation, WheelCommand};
+use crate::rng::SimRng;
+use crate::robot::{ArenaPhysics, ColiasParams, DriveState, Pose};
+use rayon::prelude::*;
+
+/// Per-robot state that the world keeps apart from physics.
+pub struct RobotSlot {
+    /// Index of the scenario's robot group this robot comes from.
+    pub group: usize,
+    pub behaviour: Box<dyn Behaviour>,
+    /// This robot's own random stream (sensor noise, behaviour choices).
+    pub rng: SimRng,
+    pub drive: DriveState,
+    /// Command applied in the last step.
+    pub command: WheelCommand,
+}
+
+pub struct RobotSet {
+    pub(super) params: ColiasParams,
+    pub(super) physics: ArenaPhysics,
+    pub(super) slots: Vec<RobotSlot>,
+    /// Scratch: each robot's body velocity (forward, yaw rate) from its drive, for physics.
+    velocities: Vec<(f32, f32)>,
+}
+
+impl RobotSet {
+    pub fn new(params: ColiasParams, physics: ArenaPhysics, slots: Vec<RobotSlot>) -> Self {
+        RobotSet {
+            params,
+            physics,
+            slots,
+            velocities: Vec::new(),
+        }
+    }
+    pub fn len(&self) -> usize {
+        self.slots.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.slots.is_empty()
+    }
+    pub fn params(&self) -> &ColiasParams {
+        &self.params
+    }
+    /// True poses.
+    pub fn poses(&self) -> &[Pose] {
+        self.physics.poses()
+    }
+    pub fn slots(&self) -> &[RobotSlot] {
+        &self.slots
+    }
+    pub fn slots_mut(&mut self) -> &mut [RobotSlot] {
+        &mut self.slots
+    }
+}
+
+/// Robot `slot` takes wheel command `cmd` (a non-finite one is a stop): its drive's lag advances by
+/// `dt`, and the body velocity (forward, yaw rate) it gives is returned.
+fn drive_one(
+    slot: &mut RobotSlot,
+    cmd: WheelCommand,
+    params: &ColiasParams,
+    dt: f32,
+) -> (f32, f32) {
+    let cmd = if cmd.left.is_finite() && cmd.right.is_finite() {
+        cmd
+    } else {
+        WheelCommand::STOP
+    };
+    slot.command = cmd;
+    slot.drive.update(cmd, params, dt);
+    slot.drive.body_velocity(params)
+}
+
+/// Stages `decide` and `drive` in one pass over the robots (one parallel region, not two): every
+/// robot's behaviour decides from its observation, and its drive takes the command.
+///
+/// Reads `observations`; writes each slot's behaviour state, random stream, drive and command, and the
+/// body velocities that [`physics`] reads.
+pub fn decide_and_drive(robots: &mut RobotSet, observations: &[Observation], dt: f32) {
+    let params = &robots.params;
+    let decide_and_drive = |(slot, obs): (&mut RobotSlot, &Observation)| {
+        let cmd = slot.behaviour.act(obs, &mut slot.rng);
+        drive_one(slot, cmd, params, dt)
+    };
+    robots.velocities.clear();
+    if robots.slots.len() >= PARALLEL_ROBOTS {
+        robots
+            .slots
+            .par_iter_mut()
+            .zip(observations.par_iter())
+            .map(decide_and_drive)
+            .collect_into_vec(&mut robots.velocities);
+    } else {
+        let velocities = robots
+            .slots
+            .iter_mut()
+            .zip(observations.iter())
+            .map(decide_and_drive);
+        robots.velocities.extend(velocities);
+    }
+}
+
+/// Stage `drive` with given wheel commands (one per robot, m/s; non-finite ones are a stop).
+///
+/// Reads `commands`; writes each slot's drive and command, and the body velocities that [`physics`]
+/// reads.
+pub fn drive(robots: &mut RobotSet, commands: &[WheelCommand], dt: f32) {
+    let params = &robots.params;
+    let drive = |(slot, cmd): (&mut RobotSlot, &WheelCommand)| drive_one(slot, *cmd, params, dt);
+    robots.velocities.clear();
+    if robots.slots.len() >= PARALLEL_ROBOTS {
+        robots
+            .slots
+            .par_iter_mut()
+            .zip(commands)
+            .map(drive)
+            .collect_into_vec(&mut robots.velocities);
+    } else {
+        let velocities = robots.slots.iter_mut().zip(commands).map(drive);
+        robots.velocities.extend(velocities);
+    }
+}
+
+/// Stage `physics`: moves the bodies by `dt` at the velocities the last drive stage set (walls and
+/// contacts included).
+///
+/// Reads the body velocities; writes the bodies (true poses).
+pub fn physics(robots: &mut RobotSet, dt: f32) {
+    robots.physics.step(&robots.velocities, dt);
+}

@@ -1,0 +1,129 @@
+//! The sensing state: the colour sensor model, the bumper rays, the neighbour index of the current
+//! poses, every robot's sensor positions and its latest observation. Stages `index` and `sense`.
+use super::{FieldSet, PARALLEL_ROBOTS, RobotSlot};
+use crate::behaviour::Observation;
+use crate::field::GridPrefetcher;
+use crate::robot::Pose;
+use crate::screen::ScreenSpec;
+use crate::sensors::{
+    BumperParams, BumperRays, ColourSensor, NeighbourIndex, SENSOR_RADIUS, sensor_positions,
+};
+use glam::Vec2;
+use rayon::prelude::*;
+
+pub struct Sensing {
+    sensor: ColourSensor,
+    bumper_params: BumperParams,
+    bumper_rays: BumperRays,
+    /// Robot radius, m (bumper rays start at the rim).
+    radius: f32,
+    /// Arena size, m (bumpers see its walls).
+    arena: Vec2,
+    neighbours: NeighbourIndex,
+    /// Scratch: robot positions for the neighbour index.
+    positions: Vec<Vec2>,
+    /// The four sensor positions of every robot at the indexed poses.
+    sensor_points: Vec<[Vec2; 4]>,
+    observations: Vec<Observation>,
+}
+
+impl Sensing {
+    pub fn new(
+        sensor: ColourSensor,
+        bumper_params: BumperParams,
+        radius: f32,
+        arena: Vec2,
+        robots: usize,
+    ) -> Self {
+        Sensing {
+            sensor,
+            bumper_rays: BumperRays::new(&bumper_params),
+            bumper_params,
+            radius,
+            arena,
+            neighbours: NeighbourIndex::default(),
+            positions: Vec::new(),
+            sensor_points: Vec::new(),
+            observations: vec![Observation::default(); robots],
+        }
+    }
+    /// The colour sensor model shared by all robots.
+    pub fn sensor(&self) -> &ColourSensor {
+        &self.sensor
+    }
+    /// The neighbour index of the last indexed poses.
+    pub fn neighbours(&self) -> &NeighbourIndex {
+        &self.neighbours
+    }
+    /// What each robot sensed last.
+    pub fn observations(&self) -> &[Observation] {
+        &self.observations
+    }
+}
+
+/// Stage `index`: the bumpers' neighbour index and every robot's sensor positions, from `poses`.
+///
+/// Reads `poses`; writes the neighbour index and the sensor positions.
+pub fn index(sensing: &mut Sensing, poses: &[Pose]) {
+    let cell = 2.0 * sensing.radius + sensing.bumper_params.range;
+    sensing.positions.clear();
+    sensing.positions.extend(poses.iter().map(|p| p.pos));
+    sensing
+        .neighbours
+        .rebuild(sensing.arena, cell, &sensing.positions);
+    // Sensor positions once per robot: sensing reads robot i's, prefetching robot i + 1's.
+    sensing.sensor_points.clear();
+    sensing
+        .sensor_points
+        .extend(poses.iter().map(|p| sensor_positions(p, SENSOR_RADIUS)));
+}
+
+/// Stage `sense`: every robot's observation at `time` from the screen that `fields` draw, at the poses
+/// last given to [`index`] (which must be `poses`).
+///
+/// Reads the pheromones, `screen`, `poses` and each slot's last command; writes the frozen Gaussian
+/// sources, each slot's random stream (sensor noise) and the observations.
+pub fn sense(
+    sensing: &mut Sensing,
+    fields: &mut FieldSet,
+    screen: &ScreenSpec,
+    poses: &[Pose],
+    slots: &mut [RobotSlot],
+    time: f32,
+) {
+    fields.freeze();
+    let sensor_points = &sensing.sensor_points;
+    let (pheromones, frozen) = (fields.pheromones(), fields.frozen());
+    let (sensor, neighbours, bumper) = (&sensing.sensor, &sensing.neighbours, &sensing.bumper_rays);
+    let (radius, arena) = (sensing.radius, sensing.arena);
+    let prefetcher = GridPrefetcher::new(pheromones);
+    let sense = |(i, (slot, obs)): (usize, (&mut RobotSlot, &mut Observation))| {
+        // The grid cells under the next robot's sensors are scattered over large fields: ask for
+        // them now so that their cache misses overlap with this robot's work.
+        if let (Some(prefetcher), Some(next)) = (&prefetcher, sensor_points.get(i + 1)) {
+            prefetcher.prefetch(next);
+        }
+        let mut o = Observation {
+            time,
+            last_command: slot.command,
+            ..Observation::default()
+        };
+        o.counts = sensor.read_all(pheromones, frozen, screen, &sensor_points[i], &mut slot.rng);
+        o.intensity = sensor.intensities(&o.counts);
+        o.bumpers = neighbours.bumpers(i, poses, radius, arena, bumper);
+        *obs = o;
+    };
+    if slots.len() >= PARALLEL_ROBOTS {
+        slots
+            .par_iter_mut()
+            .zip(sensing.observations.par_iter_mut())
+            .enumerate()
+            .for_each(sense);
+    } else {
+        slots
+            .iter_mut()
+            .zip(sensing.observations.iter_mut())
+            .enumerate()
+            .for_each(sense);
+    }
+}
