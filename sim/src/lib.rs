@@ -19,6 +19,7 @@ pub mod robot;
 pub mod scenario;
 pub mod screen;
 pub mod sensors;
+pub mod spatial;
 pub mod tracker;
 pub mod world;
 

@@ -11,6 +11,7 @@ mod grid_sampler;
 mod kernel;
 mod pheromone;
 mod static_map;
+mod step_plan;
 
 pub use backend::{BackendChoice, FieldBackend};
 pub use cells::CellBuffer;
@@ -26,3 +27,4 @@ pub(crate) use grid_sampler::GridSampler;
 pub use kernel::Kernel;
 pub use pheromone::{FieldModel, Pheromone};
 pub use static_map::{image_map, polyline_map};
+pub use step_plan::{Diffusion, EXPLICIT_MAX_R, ONE_SIDED_MAX_S, StepPlan, WIND_MAX_CFL, Wind};

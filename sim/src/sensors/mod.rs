@@ -5,9 +5,9 @@ mod colour;
 mod layout;
 mod pow_unit;
 
-pub use bumper::{
-    BumperParams, BumperRays, NeighbourIndex, ray_disc, ray_walls, reading_for_distance,
-};
+/// The spatial index the bumpers query (it lives in [`crate::spatial`]).
+pub use crate::spatial::NeighbourIndex;
+pub use bumper::{BumperParams, BumperRays, ray_disc, ray_walls, reading_for_distance};
 pub use colour::{ColourSensor, ColourSensorParams, RING_FRACTION, RING_POINTS, invert3};
 pub use layout::{SENSOR_RADIUS, sensor_positions};
 pub use pow_unit::pow_unit;
