@@ -1,7 +1,7 @@
 //! One 20 ms step of three pheromone grid fields, against the memory floor.
 //!
 //! ```text
-//! CARGO_TARGET_DIR=/work/target-field cargo bench -p colcos-sim --bench field_step
+//! cargo bench -p colcos-sim --bench field_step
 //! ```
 //!
 //! Cases: (a) 3840x2160x3, Auto (one fused explicit pass, d dt / h^2 = 0.14); (b) the same with the
