@@ -2,6 +2,7 @@
 
 mod bumper;
 mod colour;
+mod frame;
 mod layout;
 mod pow_unit;
 
@@ -9,5 +10,6 @@ mod pow_unit;
 pub use crate::spatial::NeighbourIndex;
 pub use bumper::{BumperParams, BumperRays, ray_disc, ray_walls, reading_for_distance};
 pub use colour::{ColourSensor, ColourSensorParams, RING_FRACTION, RING_POINTS, invert3};
+pub use frame::frame_pixel;
 pub use layout::{SENSOR_RADIUS, sensor_positions};
 pub use pow_unit::pow_unit;

@@ -1,4 +1,5 @@
-//! Building a world from a scenario: fields with their static maps, robots, emitters.
+//! Building a world from a scenario: fields with their static maps, robots, emitters; and the same
+//! parts without bodies or a tracker model, for a host whose robots and tracker are real.
 use super::inject::{Deposit, Emitter};
 use super::{FieldSet, Injection, RobotSet, RobotSlot, Sensing, Tracking, World};
 use crate::behaviour::{WheelCommand, registry};
@@ -14,6 +15,18 @@ use crate::sensors::ColourSensor;
 use crate::tracker::Tracker;
 use glam::Vec2;
 
+/// Every data set of a world but its bodies and tracker model: the fields, the robots' behaviours and
+/// random streams, the injection rules and the sensing state, with the robots' initial poses. A host
+/// whose arena and tracker are real steps these with the stages.
+pub struct WorldParts {
+    pub fields: FieldSet,
+    pub slots: Vec<RobotSlot>,
+    pub injection: Injection,
+    pub sensing: Sensing,
+    /// Where the scenario places each robot at the start.
+    pub poses: Vec<Pose>,
+}
+
 impl World {
     /// A world for `scenario`, world index 0.
     pub fn new(scenario: &Scenario) -> Result<World> {
@@ -23,6 +36,43 @@ impl World {
     /// A world for `scenario` whose random streams derive from `(seed, world_index)`: the worlds of a
     /// batch differ, and none depends on how many threads step them.
     pub fn with_index(scenario: &Scenario, world_index: u64) -> Result<World> {
+        let spec = &scenario.spec;
+        let arena = scenario.arena_size();
+        let parts = WorldParts::build(scenario, world_index)?;
+        let physics = ArenaPhysics::with_backend(arena, &spec.robot, &parts.poses, spec.physics);
+        let tracking = Tracking::new(
+            Tracker::new(spec.tracker, parts.poses.len()),
+            rng::stream_of(spec.seed, world_index, Stream::Tracker),
+            &parts.poses,
+        );
+        let mut world = World {
+            scenario: scenario.clone(),
+            time: 0.0,
+            tick: 0,
+            dt: spec.dt,
+            arena,
+            screen: spec.screen,
+            fields: parts.fields,
+            robots: RobotSet::new(spec.robot, physics, parts.slots),
+            tracking,
+            injection: parts.injection,
+            sensing: parts.sensing,
+        };
+        super::stages::inject(
+            &mut world.injection,
+            &mut world.fields,
+            world.robots.poses(),
+            world.tracking.tracked(),
+            world.dt,
+        );
+        world.observe();
+        Ok(world)
+    }
+}
+
+impl WorldParts {
+    /// The parts of world `world_index` of `scenario` (random streams as [`World::with_index`]'s).
+    pub fn build(scenario: &Scenario, world_index: u64) -> Result<WorldParts> {
         let spec = &scenario.spec;
         let arena = scenario.arena_size();
         let grid = GridSpec::covering(arena, spec.field.cell);
@@ -35,7 +85,7 @@ impl World {
 
         let mut placement_rng = rng::stream_of(spec.seed, world_index, Stream::Placement);
         let mut poses: Vec<Pose> = Vec::with_capacity(scenario.robot_count());
-        let mut robots = Vec::with_capacity(scenario.robot_count());
+        let mut slots = Vec::with_capacity(scenario.robot_count());
         let mut deposits = Vec::new();
         let mut emitters = Vec::new();
         for (g, group) in spec.robots.iter().enumerate() {
@@ -51,7 +101,7 @@ impl World {
             for pose in placed {
                 let index = poses.len();
                 poses.push(pose);
-                robots.push(RobotSlot {
+                slots.push(RobotSlot {
                     group: g,
                     behaviour: registry::build_for_group(group, &spec.robot, &key)?,
                     rng: rng::stream_of(spec.seed, world_index, Stream::Robot(index)),
@@ -97,23 +147,10 @@ impl World {
                 }
             }
         }
-        let physics = ArenaPhysics::with_backend(arena, &spec.robot, &poses, spec.physics);
-        let tracking = Tracking::new(
-            Tracker::new(spec.tracker, poses.len()),
-            rng::stream_of(spec.seed, world_index, Stream::Tracker),
-            &poses,
-        );
-        let count = robots.len();
-        let mut world = World {
-            scenario: scenario.clone(),
-            time: 0.0,
-            tick: 0,
-            dt: spec.dt,
-            arena,
-            screen: spec.screen,
+        let count = slots.len();
+        Ok(WorldParts {
             fields: FieldSet::new(pheromones),
-            robots: RobotSet::new(spec.robot, physics, robots),
-            tracking,
+            slots,
             injection: Injection::new(spec.field.inject_at, deposits, emitters, count),
             sensing: Sensing::new(
                 ColourSensor::new(spec.sensor),
@@ -122,16 +159,8 @@ impl World {
                 arena,
                 count,
             ),
-        };
-        super::stages::inject(
-            &mut world.injection,
-            &mut world.fields,
-            world.robots.poses(),
-            world.tracking.tracked(),
-            world.dt,
-        );
-        world.observe();
-        Ok(world)
+            poses,
+        })
     }
 }
 

@@ -20,6 +20,7 @@ mod sensing;
 mod step;
 mod tracking;
 
+pub use build::WorldParts;
 pub use fields::FieldSet;
 pub use inject::Injection;
 pub use robots::{RobotSet, RobotSlot};
@@ -31,7 +32,7 @@ pub use tracking::Tracking;
 pub mod stages {
     pub use super::fields::step_fields;
     pub use super::inject::inject;
-    pub use super::robots::{decide_and_drive, drive, physics};
+    pub use super::robots::{decide, decide_and_drive, drive, physics};
     pub use super::sensing::{index, sense};
     pub use super::tracking::track;
 }

@@ -131,3 +131,25 @@ pub fn drive(robots: &mut RobotSet, commands: &[WheelCommand], dt: f32) {
 pub fn physics(robots: &mut RobotSet, dt: f32) {
     robots.physics.step(&robots.velocities, dt);
 }
+
+/// Stage `decide` alone, for a host whose robots drive themselves (the rig): every robot's behaviour
+/// decides from its observation; the command (a stop if not finite) goes to `commands` and is kept as
+/// the slot's last command, which the next observation reports.
+///
+/// Reads `observations`; writes each slot's behaviour state, random stream and command, and `commands`.
+pub fn decide(
+    slots: &mut [RobotSlot],
+    observations: &[Observation],
+    commands: &mut [WheelCommand],
+) {
+    for ((slot, obs), out) in slots.iter_mut().zip(observations).zip(commands) {
+        let cmd = slot.behaviour.act(obs, &mut slot.rng);
+        let cmd = if cmd.left.is_finite() && cmd.right.is_finite() {
+            cmd
+        } else {
+            WheelCommand::STOP
+        };
+        slot.command = cmd;
+        *out = cmd;
+    }
+}

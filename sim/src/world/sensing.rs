@@ -59,6 +59,10 @@ impl Sensing {
     pub fn observations(&self) -> &[Observation] {
         &self.observations
     }
+    /// The observations, for a host whose robots report their own readings (real sensors).
+    pub fn observations_mut(&mut self) -> &mut [Observation] {
+        &mut self.observations
+    }
 }
 
 /// Stage `index`: the bumpers' neighbour index and every robot's sensor positions, from `poses`.
