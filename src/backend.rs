@@ -5,22 +5,26 @@ use colcos_sim::world::World;
 
 /// Installs the backend `choice` in `world`; returns what was chosen, for the log (`cpu (...)` or
 /// `gpu: <adapter>`). `gpu` without an adapter is an error; `auto` falls back to the CPU and says why.
-#[cfg(feature = "gpu")]
 pub fn install(world: &mut World, choice: BackendChoice) -> Result<String> {
-    Ok(colcos_gpu::install(world, choice)
-        .map_err(|e| anyhow::anyhow!("field backend {choice}: {e}"))?
-        .to_string())
+    try_install(world, choice).map_err(|e| anyhow::anyhow!("field backend {choice}: {e}"))
+}
+
+/// [`install`] with the bare reason on failure, for callers that name the backend themselves (the run
+/// library's error says `field backend <choice>: ...`).
+#[cfg(feature = "gpu")]
+pub fn try_install(world: &mut World, choice: BackendChoice) -> Result<String, String> {
+    colcos_gpu::install(world, choice)
+        .map(|s| s.to_string())
+        .map_err(|e| e.to_string())
 }
 
 /// Without the `gpu` feature only the CPU backend exists.
 #[cfg(not(feature = "gpu"))]
-pub fn install(world: &mut World, choice: BackendChoice) -> Result<String> {
+pub fn try_install(world: &mut World, choice: BackendChoice) -> Result<String, String> {
     world.set_field_backend(None);
     match choice {
         BackendChoice::Cpu => Ok("cpu (asked for)".into()),
         BackendChoice::Auto => Ok("cpu (auto: built without the `gpu` feature)".into()),
-        BackendChoice::Gpu => {
-            anyhow::bail!("field backend gpu: this colcos was built without the `gpu` feature")
-        }
+        BackendChoice::Gpu => Err("this colcos was built without the `gpu` feature".into()),
     }
 }

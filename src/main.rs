@@ -56,6 +56,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    init_logging();
     match real_main() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -63,6 +64,19 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The libraries report through the `log` crate; their messages reach the terminal (stderr) at info
+/// level unless `RUST_LOG` says otherwise. Dependencies such as wgpu stay quiet by default.
+fn init_logging() {
+    use std::io::Write as _;
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("colcos=info"))
+        .format(|buf, record| match record.level() {
+            log::Level::Info => writeln!(buf, "{}", record.args()),
+            log::Level::Warn => writeln!(buf, "warning: {}", record.args()),
+            level => writeln!(buf, "{}: {}", level.as_str().to_lowercase(), record.args()),
+        })
+        .init();
 }
 
 fn real_main() -> Result<()> {

@@ -1,32 +1,10 @@
-//! `colcos run`: one scenario from start to end, writing the trajectory log, the final screen, the
-//! GIF, the final fields and a summary.
-use anyhow::{Context, Result};
-use colcos_sim::field::{FieldModel, GridSpec};
-use colcos_sim::output::{GifRecorder, TrajectoryLog, npy};
+//! `colcos run`: the run library of `colcos-sim` ([`colcos_sim::run`]) with this crate's field backend
+//! choice (GPU when built with the `gpu` feature) and a progress bar on the terminal.
+use anyhow::Result;
 use colcos_sim::prelude::*;
-use colcos_sim::screen;
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::path::Path;
 
-/// What a finished run wrote and how fast it went.
-#[derive(Debug, Clone)]
-pub struct RunReport {
-    pub out_dir: PathBuf,
-    pub steps: u64,
-    pub robots: usize,
-    pub sim_seconds: f32,
-    pub wall_seconds: f64,
-    pub files: Vec<PathBuf>,
-    /// The field backend that stepped the grids (`cpu (...)` or `gpu: <adapter>`).
-    pub backend: String,
-}
-
-impl RunReport {
-    /// Simulated seconds per wall-clock second (steps only, not the final files).
-    pub fn real_time_factor(&self) -> f64 {
-        self.sim_seconds as f64 / self.wall_seconds.max(1e-9)
-    }
-}
+pub use colcos_sim::run::RunReport;
 
 /// Options of one run beyond the scenario.
 #[derive(Debug, Clone, Default)]
@@ -37,100 +15,34 @@ pub struct RunOptions {
     pub no_gif: bool,
 }
 
-/// Runs `scenario` to its end, writing into `out_dir`.
+/// Runs `scenario` to its end, writing into `out_dir`, with the backend the scenario's `field.backend`
+/// asks for.
 pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<RunReport> {
-    std::fs::create_dir_all(out_dir)
-        .with_context(|| format!("creating output directory {}", out_dir.display()))?;
-    let mut files = Vec::new();
-    let scenario_copy = out_dir.join("scenario.toml");
-    std::fs::write(&scenario_copy, scenario.to_toml())
-        .with_context(|| format!("writing {}", scenario_copy.display()))?;
-    files.push(scenario_copy);
-
-    let mut world = World::new(scenario)?;
-    let backend = crate::backend::install(&mut world, scenario.spec.field.backend)?;
-    let log_path = out_dir.join("trajectory.csv");
-    let mut log = TrajectoryLog::create(&log_path)?;
-    files.push(log_path);
-    log.record(&world)?;
-
-    let out = &scenario.spec.output;
-    let gif_path = out_dir.join("run.gif");
-    let mut gif = if out.gif_interval > 0.0 && !opts.no_gif {
-        Some(GifRecorder::create(
-            &gif_path,
-            &world,
-            out.gif_width,
-            out.gif_interval,
-        )?)
-    } else {
-        None
-    };
-    let gif_every = ((out.gif_interval / scenario.spec.dt).round() as u64).max(1);
-    if let Some(g) = gif.as_mut() {
-        g.frame(&world)?;
-        files.push(gif_path);
-    }
-
-    let steps = scenario.steps();
+    let choice = scenario.spec.field.backend;
     let bar = if opts.progress {
-        progress_bar(steps)
+        progress_bar(scenario.steps())
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let started = Instant::now();
-    let mut stepping = 0.0f64;
-    for _ in 0..steps {
-        let t0 = Instant::now();
-        world.step();
-        stepping += t0.elapsed().as_secs_f64();
-        if world.tick() % out.log_every as u64 == 0 {
-            log.record(&world)?;
+    let mut on_step = |done: u64, total: u64| {
+        bar.set_position(done);
+        if done == total {
+            bar.finish_and_clear();
         }
-        if let Some(g) = gif.as_mut()
-            && world.tick() % gif_every == 0
-        {
-            g.frame(&world)?;
-        }
-        bar.inc(1);
-    }
-    drop(gif);
-    bar.finish_and_clear();
-
-    let s = world.screen();
-    let (width, height) = png_size(s.resolution);
-    let img = screen::render(world.pheromones(), s, width, height);
-    let png = out_dir.join("screen.png");
-    screen::save_png(&img, &png)?;
-    files.push(png);
-    files.extend(write_fields(&world, scenario, out_dir)?);
-
-    let report = RunReport {
-        out_dir: out_dir.to_path_buf(),
-        steps,
-        robots: world.robot_count(),
-        sim_seconds: world.time(),
-        wall_seconds: stepping,
-        files,
-        backend,
     };
-    let summary = out_dir.join("summary.json");
-    let json = format!(
-        "{{\n  \"scenario\": {:?},\n  \"seed\": {},\n  \"steps\": {},\n  \"robots\": {},\n  \"sim_seconds\": {},\n  \"step_wall_seconds\": {:.4},\n  \"real_time_factor\": {:.2},\n  \"total_wall_seconds\": {:.3},\n  \"backend\": {:?}\n}}\n",
-        scenario.spec.name,
-        scenario.spec.seed,
-        steps,
-        report.robots,
-        report.sim_seconds,
-        report.wall_seconds,
-        report.real_time_factor(),
-        started.elapsed().as_secs_f64(),
-        report.backend
+    let report = colcos_sim::run::run(
+        scenario,
+        out_dir,
+        colcos_sim::run::RunOptions {
+            no_gif: opts.no_gif,
+            backend: Some(Box::new(move |world: &mut World| {
+                crate::backend::try_install(world, choice).map_err(Into::into)
+            })),
+            on_step: Some(&mut on_step),
+        },
     );
-    std::fs::write(&summary, json).with_context(|| format!("writing {}", summary.display()))?;
-    let mut report = report;
-    report.files.push(summary);
-    Ok(report)
+    bar.finish_and_clear();
+    Ok(report?)
 }
 
 fn progress_bar(steps: u64) -> indicatif::ProgressBar {
@@ -141,83 +53,4 @@ fn progress_bar(steps: u64) -> indicatif::ProgressBar {
             .progress_chars("=> "),
     );
     bar
-}
-
-/// One `.npy` per pheromone, shape (ny, nx), row 0 at y = 0: grid fields as they are, Gaussian fields
-/// evaluated at the centres of the scenario's field grid.
-fn write_fields(world: &World, scenario: &Scenario, out_dir: &Path) -> Result<Vec<PathBuf>> {
-    let dir = out_dir.join("fields");
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut files = Vec::new();
-    for p in world.pheromones() {
-        let path = dir.join(format!("{}.npy", sanitize(&p.name)));
-        match &p.model {
-            FieldModel::Grid(g) => {
-                npy::write_npy_f32(&path, &[g.spec().ny, g.spec().nx], g.values())?
-            }
-            FieldModel::Gaussian(g) => {
-                let spec = GridSpec::covering(world.arena(), scenario.spec.field.cell);
-                let values: Vec<f32> = (0..spec.ny)
-                    .flat_map(|j| (0..spec.nx).map(move |i| (i, j)))
-                    .map(|(i, j)| {
-                        g.value_at(Vec2::new(
-                            (i as f32 + 0.5) * spec.cell,
-                            (j as f32 + 0.5) * spec.cell,
-                        ))
-                    })
-                    .collect();
-                npy::write_npy_f32(&path, &[spec.ny, spec.nx], &values)?
-            }
-        }
-        files.push(path);
-    }
-    Ok(files)
-}
-
-/// A pheromone name made safe as a file name.
-fn sanitize(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
-}
-
-/// Largest final screen image written, in pixels: an 8K panel. A virtual screen beyond it (the
-/// 10,000-robot benchmark's arena is 38,400 x 21,600 pixels, 2.5 GB as RGB) is drawn scaled down to fit,
-/// with its aspect ratio.
-const MAX_PNG_PIXELS: u64 = 7680 * 4320;
-
-/// The size of `screen.png` for a panel of `resolution` pixels: the panel's own, or scaled down to at
-/// most [`MAX_PNG_PIXELS`].
-fn png_size(resolution: [u32; 2]) -> (u32, u32) {
-    let [w, h] = resolution.map(|r| r.max(1));
-    let pixels = u64::from(w) * u64::from(h);
-    if pixels <= MAX_PNG_PIXELS {
-        return (w, h);
-    }
-    let scale = (MAX_PNG_PIXELS as f64 / pixels as f64).sqrt();
-    let fit = |n: u32| ((f64::from(n) * scale).floor() as u32).max(1);
-    (fit(w), fit(h))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn screen_png_keeps_panels_up_to_8k_and_scales_larger_ones() {
-        assert_eq!(png_size([3840, 2160]), (3840, 2160));
-        assert_eq!(png_size([7680, 4320]), (7680, 4320));
-        assert_eq!(png_size([38_400, 21_600]), (7680, 4320));
-        let (w, h) = png_size([65_536, 100]);
-        assert!(
-            u64::from(w) * u64::from(h) <= MAX_PNG_PIXELS && h >= 1,
-            "{w} x {h}"
-        );
-    }
 }

@@ -16,6 +16,7 @@ pub mod output;
 mod prefetch;
 pub mod rng;
 pub mod robot;
+pub mod run;
 pub mod scenario;
 pub mod screen;
 pub mod sensors;

@@ -210,52 +210,58 @@ pub fn run(cfg: &Case1Config, tick: &(dyn Fn() + Sync)) -> Result<Case1Result> {
     })
 }
 
-/// `group,end_point,food,arrivals` rows, then one `group,timeout,,n` row per group.
+/// `group,pheromones,end_point,food,arrivals` rows, then one `group,pheromones,timeout,0,n` row per
+/// group.
 pub fn arrivals_csv(r: &Case1Result) -> String {
-    let mut s = String::from("group,pheromones,end_point,food,arrivals\n");
+    let mut w = super::csv_writer(&["group", "pheromones", "end_point", "food", "arrivals"]);
     for g in &r.groups {
         let ph = g.pheromones.join("+");
         for (k, n) in g.counts.per_point.iter().enumerate() {
             let food = r.config.foods.contains(&(k + 1));
-            s.push_str(&format!(
-                "{},{},{},{},{}\n",
-                g.name,
-                ph,
-                k + 1,
-                food as u8,
-                n
-            ));
+            let point = (k + 1).to_string();
+            let row: [&str; 5] = [&g.name, &ph, &point, food_flag(food), &n.to_string()];
+            w.write_record(row).expect("writing to memory");
         }
-        s.push_str(&format!(
-            "{},{},timeout,0,{}\n",
-            g.name, ph, g.counts.timeouts
-        ));
+        let timeouts = g.counts.timeouts.to_string();
+        w.write_record([g.name.as_str(), &ph, "timeout", "0", &timeouts])
+            .expect("writing to memory");
     }
-    s
+    super::csv_text(w)
 }
 
 /// One row per trial: group, trial, end point (or empty on timeout), time.
 pub fn trials_csv(r: &Case1Result) -> String {
-    let mut s = String::from("group,trial,end_point,food,time\n");
+    let mut w = super::csv_writer(&["group", "trial", "end_point", "food", "time"]);
     for g in &r.groups {
         for (t, trial) in g.trials.iter().enumerate() {
-            match trial.outcome {
+            let t = t.to_string();
+            let row = match trial.outcome {
                 TrialOutcome::Arrived { point, time } => {
                     let food = r.config.foods.contains(&(point + 1));
-                    s.push_str(&format!(
-                        "{},{},{},{},{:.2}\n",
-                        g.name,
+                    let point = (point + 1).to_string();
+                    [
+                        g.name.clone(),
                         t,
-                        point + 1,
-                        food as u8,
-                        time
-                    ));
+                        point,
+                        food_flag(food).into(),
+                        format!("{time:.2}"),
+                    ]
                 }
-                TrialOutcome::TimedOut => {
-                    s.push_str(&format!("{},{},,0,{:.2}\n", g.name, t, r.config.timeout))
-                }
-            }
+                TrialOutcome::TimedOut => [
+                    g.name.clone(),
+                    t,
+                    String::new(),
+                    "0".into(),
+                    format!("{:.2}", r.config.timeout),
+                ],
+            };
+            w.write_record(&row).expect("writing to memory");
         }
     }
-    s
+    super::csv_text(w)
+}
+
+/// The `food` column: 1 where the end point is a food source.
+fn food_flag(food: bool) -> &'static str {
+    if food { "1" } else { "0" }
 }

@@ -186,7 +186,7 @@ pub fn run(cfg: &Case2Config, tick: &(dyn Fn() + Sync)) -> Result<Case2Result> {
 
 /// `run,time,s,alarm,phase` rows.
 pub fn s_t_csv(r: &Case2Result) -> String {
-    let mut out = String::from("run,time,s,alarm,phase\n");
+    let mut w = super::csv_writer(&["run", "time", "s", "alarm", "phase"]);
     for (k, run) in r.runs.iter().enumerate() {
         for (j, ((t, s), a)) in run.times.iter().zip(&run.s).zip(&run.alarm).enumerate() {
             let phase = run
@@ -197,8 +197,16 @@ pub fn s_t_csv(r: &Case2Result) -> String {
                     PhaseKind::Aggregation => "aggregation",
                     PhaseKind::Dispersion => "dispersion",
                 });
-            out.push_str(&format!("{k},{t:.2},{s:.4},{},{phase}\n", *a as u8));
+            let alarm = if *a { "1" } else { "0" };
+            let row: [&str; 5] = [
+                &k.to_string(),
+                &format!("{t:.2}"),
+                &format!("{s:.4}"),
+                alarm,
+                phase,
+            ];
+            w.write_record(row).expect("writing to memory");
         }
     }
-    out
+    super::csv_text(w)
 }

@@ -181,6 +181,22 @@ pub fn run(opts: &Options) -> Result<Report> {
     })
 }
 
+/// A CSV writer into memory with its header row written (`\n` line ends, fields quoted only where
+/// they must be).
+fn csv_writer(header: &[&str]) -> csv::Writer<Vec<u8>> {
+    let mut w = csv::WriterBuilder::new()
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(Vec::new());
+    w.write_record(header).expect("writing to memory");
+    w
+}
+
+/// The text a [`csv_writer`] holds.
+fn csv_text(w: csv::Writer<Vec<u8>>) -> String {
+    let bytes = w.into_inner().expect("flushing to memory");
+    String::from_utf8(bytes).expect("CSV of UTF-8 fields is UTF-8")
+}
+
 fn write_case1(r: &case1::Case1Result, dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut files = Vec::new();

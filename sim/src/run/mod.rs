@@ -1,0 +1,268 @@
+//! One scenario from start to end, writing what a run leaves behind: `scenario.toml`,
+//! `trajectory.csv`, `run.gif`, `screen.png`, `fields/<name>.npy` and `summary.json`.
+//!
+//! The command line, a sweep runner and the hardware bridge all call [`run`]; what differs between
+//! them comes in through [`RunOptions`]: the field backend (the GPU one lives in `colcos-gpu`, which
+//! depends on this crate) and a progress callback (the command line draws a bar with it).
+mod summary;
+
+use crate::error::SimError;
+use crate::field::{BackendChoice, FieldModel, GridSpec};
+use crate::output::{GifRecorder, TrajectoryLog, npy};
+use crate::scenario::Scenario;
+use crate::screen;
+use crate::world::World;
+use glam::Vec2;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Installs a field backend in the run's world once it is built (a GPU backend needs the world's
+/// pheromones) and describes it for the summary (`gpu: <adapter>`, `cpu (<reason>)`).
+pub type BackendSetup<'a> =
+    Box<dyn FnOnce(&mut World) -> Result<String, Box<dyn std::error::Error + Send + Sync>> + 'a>;
+
+/// Options of one run beyond the scenario.
+#[derive(Default)]
+pub struct RunOptions<'a> {
+    /// Skip the GIF (runs that only compare logs do not need it).
+    pub no_gif: bool,
+    /// Sets up the field backend; `None`: the CPU, and an error if the scenario asks for `gpu`.
+    pub backend: Option<BackendSetup<'a>>,
+    /// Called after every step with (steps done, steps in all).
+    pub on_step: Option<&'a mut dyn FnMut(u64, u64)>,
+}
+
+/// What a finished run wrote and how fast it went.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    pub out_dir: PathBuf,
+    pub steps: u64,
+    pub robots: usize,
+    pub sim_seconds: f32,
+    /// Wall time of the steps alone, s.
+    pub wall_seconds: f64,
+    pub files: Vec<PathBuf>,
+    /// The field backend that stepped the grids (`cpu (...)` or `gpu: <adapter>`).
+    pub backend: String,
+}
+
+impl RunReport {
+    /// Simulated seconds per wall-clock second (steps only, not the final files).
+    pub fn real_time_factor(&self) -> f64 {
+        self.sim_seconds as f64 / self.wall_seconds.max(1e-9)
+    }
+}
+
+/// Why a run stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// The field backend the scenario asks for could not be set up.
+    #[error("field backend {choice}: {error}")]
+    Backend {
+        choice: BackendChoice,
+        error: Box<dyn std::error::Error + Send + Sync>,
+    },
+}
+
+/// Runs `scenario` to its end, writing into `out_dir` (created if missing).
+pub fn run(
+    scenario: &Scenario,
+    out_dir: &Path,
+    opts: RunOptions<'_>,
+) -> Result<RunReport, RunError> {
+    let RunOptions {
+        no_gif,
+        backend,
+        mut on_step,
+    } = opts;
+    std::fs::create_dir_all(out_dir).map_err(|e| {
+        SimError::io(
+            format!("creating output directory {}", out_dir.display()),
+            e,
+        )
+    })?;
+    let mut files = Vec::new();
+    let scenario_copy = out_dir.join("scenario.toml");
+    std::fs::write(&scenario_copy, scenario.to_toml())
+        .map_err(|e| SimError::io(format!("writing {}", scenario_copy.display()), e))?;
+    files.push(scenario_copy);
+
+    let mut world = World::new(scenario)?;
+    let choice = scenario.spec.field.backend;
+    let backend = match backend {
+        Some(setup) => setup(&mut world).map_err(|error| RunError::Backend { choice, error })?,
+        None => cpu_backend(choice)?,
+    };
+    log::debug!("field backend: {backend}");
+    let log_path = out_dir.join("trajectory.csv");
+    let mut log = TrajectoryLog::create(&log_path)?;
+    files.push(log_path);
+    log.record(&world)?;
+
+    let out = &scenario.spec.output;
+    let gif_path = out_dir.join("run.gif");
+    let mut gif = if out.gif_interval > 0.0 && !no_gif {
+        Some(GifRecorder::create(
+            &gif_path,
+            &world,
+            out.gif_width,
+            out.gif_interval,
+        )?)
+    } else {
+        None
+    };
+    let gif_every = ((out.gif_interval / scenario.spec.dt).round() as u64).max(1);
+    if let Some(g) = gif.as_mut() {
+        g.frame(&world)?;
+        files.push(gif_path);
+    }
+
+    let steps = scenario.steps();
+    let started = Instant::now();
+    let mut stepping = 0.0f64;
+    for done in 1..=steps {
+        let t0 = Instant::now();
+        world.step();
+        stepping += t0.elapsed().as_secs_f64();
+        if world.tick() % out.log_every as u64 == 0 {
+            log.record(&world)?;
+        }
+        if let Some(g) = gif.as_mut()
+            && world.tick() % gif_every == 0
+        {
+            g.frame(&world)?;
+        }
+        if let Some(f) = on_step.as_mut() {
+            f(done, steps);
+        }
+    }
+    drop(gif);
+
+    let s = world.screen();
+    let (width, height) = png_size(s.resolution);
+    let img = screen::render(world.pheromones(), s, width, height);
+    let png = out_dir.join("screen.png");
+    screen::save_png(&img, &png)?;
+    files.push(png);
+    files.extend(write_fields(&world, scenario, out_dir)?);
+
+    let mut report = RunReport {
+        out_dir: out_dir.to_path_buf(),
+        steps,
+        robots: world.robot_count(),
+        sim_seconds: world.time(),
+        wall_seconds: stepping,
+        files,
+        backend,
+    };
+    let summary = out_dir.join("summary.json");
+    summary::write(&summary, scenario, &report, started.elapsed().as_secs_f64())?;
+    report.files.push(summary);
+    Ok(report)
+}
+
+/// The backend of a run given none: the CPU, which `cpu` and `auto` accept and `gpu` does not.
+fn cpu_backend(choice: BackendChoice) -> Result<String, RunError> {
+    match choice {
+        BackendChoice::Cpu => Ok("cpu (asked for)".into()),
+        BackendChoice::Auto => Ok("cpu (auto: no GPU backend given to this run)".into()),
+        BackendChoice::Gpu => Err(RunError::Backend {
+            choice,
+            error: "no GPU backend given to this run".into(),
+        }),
+    }
+}
+
+/// One `.npy` per pheromone, shape (ny, nx), row 0 at y = 0: grid fields as they are, Gaussian fields
+/// evaluated at the centres of the scenario's field grid.
+fn write_fields(
+    world: &World,
+    scenario: &Scenario,
+    out_dir: &Path,
+) -> Result<Vec<PathBuf>, SimError> {
+    let dir = out_dir.join("fields");
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| SimError::io(format!("creating {}", dir.display()), e))?;
+    let mut files = Vec::new();
+    for p in world.pheromones() {
+        let path = dir.join(format!("{}.npy", sanitize(&p.name)));
+        match &p.model {
+            FieldModel::Grid(g) => {
+                npy::write_npy_f32(&path, &[g.spec().ny, g.spec().nx], g.values())?
+            }
+            FieldModel::Gaussian(g) => {
+                let spec = GridSpec::covering(world.arena(), scenario.spec.field.cell);
+                let values: Vec<f32> = (0..spec.ny)
+                    .flat_map(|j| (0..spec.nx).map(move |i| (i, j)))
+                    .map(|(i, j)| {
+                        g.value_at(Vec2::new(
+                            (i as f32 + 0.5) * spec.cell,
+                            (j as f32 + 0.5) * spec.cell,
+                        ))
+                    })
+                    .collect();
+                npy::write_npy_f32(&path, &[spec.ny, spec.nx], &values)?
+            }
+        }
+        files.push(path);
+    }
+    Ok(files)
+}
+
+/// A pheromone name made safe as a file name.
+fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Largest final screen image written, in pixels: an 8K panel. A virtual screen beyond it (the
+/// 10,000-robot benchmark's arena is 38,400 x 21,600 pixels, 2.5 GB as RGB) is drawn scaled down to fit,
+/// with its aspect ratio.
+const MAX_PNG_PIXELS: u64 = 7680 * 4320;
+
+/// The size of `screen.png` for a panel of `resolution` pixels: the panel's own, or scaled down to at
+/// most [`MAX_PNG_PIXELS`].
+fn png_size(resolution: [u32; 2]) -> (u32, u32) {
+    let [w, h] = resolution.map(|r| r.max(1));
+    let pixels = u64::from(w) * u64::from(h);
+    if pixels <= MAX_PNG_PIXELS {
+        return (w, h);
+    }
+    let scale = (MAX_PNG_PIXELS as f64 / pixels as f64).sqrt();
+    let fit = |n: u32| ((f64::from(n) * scale).floor() as u32).max(1);
+    (fit(w), fit(h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn screen_png_keeps_panels_up_to_8k_and_scales_larger_ones() {
+        assert_eq!(png_size([3840, 2160]), (3840, 2160));
+        assert_eq!(png_size([7680, 4320]), (7680, 4320));
+        assert_eq!(png_size([38_400, 21_600]), (7680, 4320));
+        let (w, h) = png_size([65_536, 100]);
+        assert!(
+            u64::from(w) * u64::from(h) <= MAX_PNG_PIXELS && h >= 1,
+            "{w} x {h}"
+        );
+    }
+
+    #[test]
+    fn without_a_backend_gpu_is_refused_and_auto_takes_the_cpu() {
+        assert!(cpu_backend(BackendChoice::Cpu).is_ok());
+        assert!(cpu_backend(BackendChoice::Auto).unwrap().starts_with("cpu"));
+        let e = cpu_backend(BackendChoice::Gpu).unwrap_err().to_string();
+        assert!(e.starts_with("field backend gpu: "), "{e}");
+    }
+}
