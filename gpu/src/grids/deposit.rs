@@ -1,0 +1,158 @@
+//! Trail deposits on a batch, in rounds: the k-th deposit of every field in round k, so a field's
+//! deposits are summed in the order given.
+use super::GpuGrids;
+use super::record::{Dispatch, Grown, Kind, MAX_GROUPS, PassUniform, groups};
+use crate::{GpuError, Result};
+use bytemuck::{Pod, Zeroable};
+use colcos_sim::field::{GridSpec, Kernel};
+use glam::Vec2;
+
+/// One trail deposit: `amount * kernel(distance to segment a-b)` added to every cell near the segment
+/// of field `field`, exactly as
+/// [`GridField::deposit_segment`](colcos_sim::field::GridField::deposit_segment).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Deposit {
+    pub field: usize,
+    pub kernel: Kernel,
+    pub a: Vec2,
+    pub b: Vec2,
+    pub amount: f32,
+}
+
+/// One deposit as the shader reads it: the cells of its box and the kernel's segment.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+struct DepRecord {
+    field: u32,
+    slot: u32,
+    i0: u32,
+    j0: u32,
+    w: u32,
+    h: u32,
+    kind: u32,
+    _pad: u32,
+    ax: f32,
+    ay: f32,
+    abx: f32,
+    aby: f32,
+    len2: f32,
+    support: f32,
+    param: f32,
+    amount: f32,
+}
+
+impl GpuGrids {
+    /// Adds trail deposits, in order (deposits on one field are summed in the order given, as a
+    /// sequence of [`GridField::deposit_segment`](colcos_sim::field::GridField::deposit_segment)
+    /// calls would).
+    pub fn deposit(&mut self, deposits: &[Deposit]) -> Result<()> {
+        let ctx = self.ctx.clone();
+        ctx.scoped("depositing trails", || self.deposit_inner(deposits))?
+    }
+
+    fn deposit_inner(&mut self, deposits: &[Deposit]) -> Result<()> {
+        let GridSpec { nx, ny, cell } = self.spec;
+        let mut per_field_count = vec![0usize; self.fields.len()];
+        let mut rounds: Vec<Vec<DepRecord>> = Vec::new();
+        for d in deposits {
+            if d.field >= self.fields.len() {
+                return Err(GpuError::Invalid(format!(
+                    "deposit on field {} of {}",
+                    d.field,
+                    self.fields.len()
+                )));
+            }
+            let support = d.kernel.support();
+            if support.is_nan() || support < 0.0 || !d.a.is_finite() || !d.b.is_finite() {
+                continue;
+            }
+            let (a, b) = (d.a, d.b);
+            let (i0, i1) = self
+                .spec
+                .cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
+            let (j0, j1) = self
+                .spec
+                .cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
+            if i1 <= i0 || j1 <= j0 {
+                continue;
+            }
+            let ab = b - a;
+            let (kind, param) = match d.kernel {
+                Kernel::Disc { radius } => (0, radius),
+                Kernel::Cone { radius } => (1, radius),
+                Kernel::Gaussian { sigma } => (2, sigma),
+            };
+            let rec = DepRecord {
+                field: d.field as u32,
+                slot: self.fields[d.field].slot,
+                i0: i0 as u32,
+                j0: j0 as u32,
+                w: (i1 - i0) as u32,
+                h: (j1 - j0) as u32,
+                kind,
+                _pad: 0,
+                ax: a.x,
+                ay: a.y,
+                abx: ab.x,
+                aby: ab.y,
+                len2: ab.length_squared(),
+                support,
+                param,
+                amount: d.amount,
+            };
+            let r = per_field_count[d.field];
+            per_field_count[d.field] += 1;
+            if rounds.len() <= r {
+                rounds.push(Vec::new());
+            }
+            rounds[r].push(rec);
+        }
+        if rounds.is_empty() {
+            return Ok(());
+        }
+        if rounds.iter().any(|r| r.len() > MAX_GROUPS as usize) {
+            return Err(GpuError::Invalid(format!(
+                "more than {MAX_GROUPS} fields with a deposit in one call: split the call"
+            )));
+        }
+        let recs: Vec<DepRecord> = rounds.iter().flatten().copied().collect();
+        self.ensure(
+            Grown::Deposits,
+            std::mem::size_of_val(recs.as_slice()) as u64,
+        );
+        self.ctx
+            .queue
+            .write_buffer(&self.deps, 0, bytemuck::cast_slice(&recs));
+        let mut first = 0u32;
+        let dispatches: Vec<Dispatch> = rounds
+            .iter()
+            .map(|round| {
+                let cells = round
+                    .iter()
+                    .map(|r| (r.w * r.h) as usize)
+                    .max()
+                    .unwrap_or(0);
+                let (gx, gy) = groups(cells, 256);
+                let count = round.len() as u32;
+                let uniform = PassUniform {
+                    index: first,
+                    nfields: self.fields.len() as u32,
+                    nx: nx as u32,
+                    ny: ny as u32,
+                    groups_x: gx,
+                    count,
+                    cell,
+                    _pad: 0,
+                };
+                first += count;
+                Dispatch {
+                    kind: Kind::Deposit,
+                    uniform,
+                    groups: [gx, gy, count],
+                }
+            })
+            .collect();
+        self.record("colcos deposits", &dispatches);
+        Ok(())
+    }
+}
