@@ -6,9 +6,8 @@
 #   rllib venv (requirements-rllib.txt): RLlib ParallelPettingZooEnv (ray pins gymnasium 1.2.2)
 # Both requirement files are complete locks installed with --no-deps (no resolver); the main venv gets
 # PyPI's torch without its CUDA libraries, made loadable by torch_cpu_stubs.py (see requirements.txt).
-# From empty venvs (no pip cache) on the shared 2-core machine at load average ~7: wheel 825 s (cold
-# cargo build; ~4-5 min idle), main venv 129 s, rllib venv 74 s, tests 82 s: 18.5 min in all;
-# ~2.4 GB on disk, ~760 MB downloaded. A rerun reuses the venvs and the cargo target: ~2 min.
+# The first run builds the wheel from a cold cargo target and fills both venvs (tens of minutes on
+# two cores, ~760 MB downloaded, ~2.4 GB on disk); a rerun reuses the venvs and the cargo target.
 # Usage: python-tests/run.sh [pytest args]       (from anywhere; uses python3 from PATH)
 # Env: COLCOS_PY_WORK (default: <repo>/target/python) holds the venvs, wheel and cargo target dir.
 #      COLCOS_PY_PEERS=0 runs only the core suites in a small venv (requirements-core.txt, ~1 min).

@@ -11,6 +11,9 @@ mod window;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // Rust's `log` messages go to Python's `logging` (logger names follow the Rust module paths,
+    // `colcos_gpu.backend`). Another extension may have installed a logger first: then it keeps them.
+    let _ = pyo3_log::Logger::new(m.py(), pyo3_log::Caching::LoggersAndLevels)?.install();
     errors::register(m)?;
     vec_env::register(m)?;
     baseline::register(m)?;
