@@ -5,6 +5,7 @@
 //!
 //! cargo bench --bench swarm_step
 use colcos::sim::prelude::*;
+use colcos::sim::robot::PhysicsBackend::{Discs, Rapier};
 #[path = "common/swarm_scenario.rs"]
 mod swarm_scenario;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -48,9 +49,9 @@ fn report(label: &str, step_s: f64, dt: f64, target: f64, peer: Option<(&str, f6
 }
 
 fn bench(c: &mut Criterion) {
-    let big = scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, "discs");
-    let big_rapier = scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, "rapier");
-    let small = scenario(100, [1.439, 0.809], [3840, 2160], 0.005, "rapier");
+    let big = scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Discs);
+    let big_rapier = scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Rapier);
+    let small = scenario(100, [1.439, 0.809], [3840, 2160], 0.005, Rapier);
     let mut w_big = World::new(&big).unwrap();
     let mut w_big_rapier = World::new(&big_rapier).unwrap();
     let mut w_small = World::new(&small).unwrap();

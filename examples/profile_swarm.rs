@@ -1,13 +1,16 @@
 //! Where a large swarm's step goes: times whole steps of the 10,000-robot benchmark scenario with
 //! parts switched off. `cargo run --release --example profile_swarm [LABEL-WORD]` (environment:
 //! `PROFILE_STEPS=N` to time N steps per case instead of 60).
+use colcos::sim::field::Kernel;
 use colcos::sim::prelude::*;
+use colcos::sim::robot::PhysicsBackend::{self, Discs, Rapier};
+use colcos::sim::scenario::{PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
 use std::time::Instant;
 #[path = "../benches/common/swarm_scenario.rs"]
 mod swarm_scenario;
 
-fn time(label: &str, text: &str) {
-    time_scenario(label, || Scenario::from_toml_str(text, ".").unwrap());
+fn time(label: &str, scenario: ScenarioBuilder) {
+    time_scenario(label, || scenario.build().unwrap());
 }
 
 fn time_scenario(label: &str, scenario: impl FnOnce() -> Scenario) {
@@ -57,66 +60,70 @@ fn process_cpu_seconds() -> Option<f64> {
     Some(ticks / 100.0)
 }
 
-const PHEROMONES: &str = "[[pheromones]]\nname = \"red\"\ncolour = [255, 0, 0]\nevaporation = 20.0\ndiffusion = 1e-6\n[[pheromones]]\nname = \"green\"\ncolour = [0, 255, 0]\nevaporation = 20.0\n[[pheromones]]\nname = \"blue\"\ncolour = [0, 0, 255]\nevaporation = 20.0\n";
-const DEPOSITS: &str = "deposits = [{ pheromone = \"red\", kernel = { shape = \"disc\", radius = 0.01 }, rate = 3.0 }]";
+/// `robots` running `behaviour` in the 10,000-robot benchmark's arena on a 1 cm grid, with or without
+/// the three pheromones (red diffusing) and a red trail behind every robot.
+fn case(
+    robots: usize,
+    behaviour: &str,
+    pheromones: bool,
+    deposits: bool,
+    physics: PhysicsBackend,
+) -> ScenarioBuilder {
+    let mut b = ScenarioBuilder::new()
+        .duration(10.0)
+        .physics(physics)
+        .screen([38_400, 21_600], [14.4, 8.1])
+        .cell(0.01);
+    if pheromones {
+        let pheromone =
+            |name: &str, colour| PheromoneSpec::grid(name, colour).with_evaporation(20.0);
+        b = b
+            .pheromone(pheromone("red", [255.0, 0.0, 0.0]).with_diffusion(1e-6))
+            .pheromone(pheromone("green", [0.0, 255.0, 0.0]))
+            .pheromone(pheromone("blue", [0.0, 0.0, 255.0]));
+    }
+    let mut group = RobotGroupSpec::new(robots, behaviour);
+    if deposits {
+        group = group.with_deposit("red", Kernel::Disc { radius: 0.01 }, 3.0);
+    }
+    b.robots(group)
+}
 
 fn main() {
-    let base_cell = |robots: usize,
-                     behaviour: &str,
-                     pheromones: bool,
-                     deposits: bool,
-                     physics: &str,
-                     cell: f32| {
-        let ph = if pheromones {
-            "[[pheromones]]\nname = \"red\"\ncolour = [255, 0, 0]\nevaporation = 20.0\ndiffusion = 1e-6\n[[pheromones]]\nname = \"green\"\ncolour = [0, 255, 0]\nevaporation = 20.0\n[[pheromones]]\nname = \"blue\"\ncolour = [0, 0, 255]\nevaporation = 20.0\n"
-        } else {
-            ""
-        };
-        let dep = if deposits {
-            "deposits = [{ pheromone = \"red\", kernel = { shape = \"disc\", radius = 0.01 }, rate = 3.0 }]"
-        } else {
-            ""
-        };
-        format!(
-            "duration = 10.0\nphysics = \"{physics}\"\n[screen]\nresolution = [38400, 21600]\nsize = [14.4, 8.1]\n[field]\ncell = {cell}\n{ph}\n[[robots]]\ncount = {robots}\nbehaviour = \"{behaviour}\"\n{dep}\n"
-        )
-    };
-    let base = |robots: usize, behaviour: &str, pheromones: bool, deposits: bool, physics: &str| {
-        base_cell(robots, behaviour, pheromones, deposits, physics, 0.01)
-    };
     // Exactly what `cargo bench --bench swarm_step` steps.
     time_scenario("bench: 10,000 robots, discs", || {
-        swarm_scenario::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, "discs")
+        swarm_scenario::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Discs)
     });
     time_scenario("bench: 100 robots, 65-inch, 5 mm, rapier", || {
-        swarm_scenario::scenario(100, [1.439, 0.809], [3840, 2160], 0.005, "rapier")
+        swarm_scenario::scenario(100, [1.439, 0.809], [3840, 2160], 0.005, Rapier)
     });
     time(
         "full (follow, 3 fields, deposits, discs)",
-        &base(10_000, "follow", true, true, "discs"),
+        case(10_000, "follow", true, true, Discs),
     );
     time(
         "full on a 10 cm grid (fields in cache)",
-        &base_cell(10_000, "follow", true, true, "discs", 0.1),
+        case(10_000, "follow", true, true, Discs).cell(0.1),
     );
-    time("no deposits", &base(10_000, "follow", true, false, "discs"));
+    time("no deposits", case(10_000, "follow", true, false, Discs));
     time(
         "no pheromones (sensing empty list)",
-        &base(10_000, "avoid", false, false, "discs"),
+        case(10_000, "avoid", false, false, Discs),
     );
     time(
         "full with rapier",
-        &base(10_000, "follow", true, true, "rapier"),
+        case(10_000, "follow", true, true, Rapier),
     );
-    let small = |physics: &str| {
-        format!(
-            "duration = 10.0\nphysics = \"{physics}\"\n[field]\ncell = 0.005\n{PHEROMONES}\n[[robots]]\ncount = 100\nbehaviour = \"follow\"\n{DEPOSITS}\n"
-        )
+    // The 65-inch screen of the scenario files' default.
+    let small = |physics| {
+        case(100, "follow", true, true, physics)
+            .screen([3840, 2160], [1.439, 0.809])
+            .cell(0.005)
     };
-    time("100 robots, 65-inch, 5 mm, rapier", &small("rapier"));
-    time("100 robots, 65-inch, 5 mm, discs", &small("discs"));
+    time("100 robots, 65-inch, 5 mm, rapier", small(Rapier));
+    time("100 robots, 65-inch, 5 mm, discs", small(Discs));
     time(
         "1,000 robots full discs",
-        &base(1_000, "follow", true, true, "discs"),
+        case(1_000, "follow", true, true, Discs),
     );
 }

@@ -1,42 +1,44 @@
 //! Same scenario and seed give byte-identical logs, whatever the number of threads.
 use colcos::run::{RunOptions, run};
+use colcos::sim::field::Kernel;
 use colcos::sim::prelude::*;
+use colcos::sim::scenario::{MapSpec, PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
 
 /// Enough robots and a large enough grid that the parallel paths (robots and field rows) are taken.
-const SCENARIO: &str = r#"
-duration = 0.6
-seed = 7
-[screen]
-resolution = [3840, 2160]
-size = [2.4, 1.35]
-[field]
-cell = 0.003
-[output]
-gif_interval = 0
-[[pheromones]]
-name = "red"
-colour = [255, 0, 0]
-evaporation = 5.0
-diffusion = 1e-5
-[[pheromones]]
-name = "blue"
-colour = [0, 0, 255]
-evaporation = 5.0
-diffusion = 1e-6
-maps = [{ polyline = [[0.2, 0.2], [2.2, 1.1]], width = 0.05, rate = 0.2 }]
-[[robots]]
-count = 200
-behaviour = "follow"
-params = { channel = "b" }
-deposits = [{ pheromone = "red", kernel = { shape = "cone", radius = 0.01 }, rate = 5.0 }]
-[[robots]]
-count = 150
-behaviour = "avoid"
-deposits = [{ pheromone = "blue", kernel = { shape = "disc", radius = 0.01 }, rate = 5.0 }]
-"#;
+fn scenario() -> Scenario {
+    ScenarioBuilder::new()
+        .duration(0.6)
+        .seed(7)
+        .screen([3840, 2160], [2.4, 1.35])
+        .cell(0.003)
+        .gif_interval(0.0)
+        .pheromone(
+            PheromoneSpec::grid("red", [255.0, 0.0, 0.0])
+                .with_evaporation(5.0)
+                .with_diffusion(1e-5),
+        )
+        .pheromone(
+            PheromoneSpec::grid("blue", [0.0, 0.0, 255.0])
+                .with_evaporation(5.0)
+                .with_diffusion(1e-6)
+                .with_map(MapSpec::polyline(vec![[0.2, 0.2], [2.2, 1.1]], 0.05, 0.2)),
+        )
+        .robots(
+            RobotGroupSpec::new(200, "follow")
+                .with_param("channel", "b")
+                .with_deposit("red", Kernel::Cone { radius: 0.01 }, 5.0),
+        )
+        .robots(RobotGroupSpec::new(150, "avoid").with_deposit(
+            "blue",
+            Kernel::Disc { radius: 0.01 },
+            5.0,
+        ))
+        .build()
+        .unwrap()
+}
 
 fn run_with_threads(threads: usize) -> (Vec<u8>, Vec<u8>) {
-    let sc = Scenario::from_toml_str(SCENARIO, ".").unwrap();
+    let sc = scenario();
     let dir = tempfile::tempdir().unwrap();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -71,7 +73,7 @@ fn logs_are_identical_across_thread_counts() {
 
 #[test]
 fn a_different_seed_gives_a_different_run() {
-    let a = Scenario::from_toml_str(SCENARIO, ".").unwrap();
+    let a = scenario();
     let b = a.clone().with_overrides(Some(8), None).unwrap();
     let (wa, wb) = (World::new(&a).unwrap(), World::new(&b).unwrap());
     assert_ne!(wa.poses()[0], wb.poses()[0]);

@@ -1,7 +1,9 @@
 //! The trajectory log: rows as `{:.N}` formats them, in robot order, for a swarm large enough to be
 //! formatted in parallel chunks.
+use colcos_sim::field::Kernel;
 use colcos_sim::output::TrajectoryLog;
 use colcos_sim::prelude::*;
+use colcos_sim::scenario::{PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
 use std::fmt::Write as _;
 
 /// One row the obvious way (the log's format written with `write!`).
@@ -39,28 +41,19 @@ fn reference_row(world: &World, i: usize) -> String {
 
 #[test]
 fn a_large_swarm_logs_every_row_in_order_as_std_formats_it() {
-    let sc = Scenario::from_toml_str(
-        r#"
-duration = 1.0
-[screen]
-resolution = [3840, 2160]
-size = [3.2, 1.8]
-[field]
-cell = 0.01
-[output]
-gif_interval = 0
-[[pheromones]]
-name = "red"
-colour = [255, 0, 0]
-[[robots]]
-count = 1300
-behaviour = "wander"
-role = "walker"
-deposits = [{ pheromone = "red", kernel = { shape = "disc", radius = 0.01 }, rate = 5.0 }]
-"#,
-        ".",
-    )
-    .unwrap();
+    let sc = ScenarioBuilder::new()
+        .duration(1.0)
+        .screen([3840, 2160], [3.2, 1.8])
+        .cell(0.01)
+        .gif_interval(0.0)
+        .pheromone(PheromoneSpec::grid("red", [255.0, 0.0, 0.0]))
+        .robots(
+            RobotGroupSpec::new(1300, "wander")
+                .with_role("walker")
+                .with_deposit("red", Kernel::Disc { radius: 0.01 }, 5.0),
+        )
+        .build()
+        .unwrap();
     let mut world = World::new(&sc).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("trajectory.csv");

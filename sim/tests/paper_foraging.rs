@@ -4,6 +4,7 @@ use colcos_sim::behaviour::paper::*;
 use colcos_sim::behaviour::{Behaviour, Observation};
 use colcos_sim::prelude::*;
 use colcos_sim::rng;
+use colcos_sim::scenario::{MapSpec, PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
 
 const OFF: [f32; 3] = [0.0, 0.0, 0.0];
 const BLUE_: [f32; 3] = [0.0, 0.0, 1.0];
@@ -255,31 +256,24 @@ fn params_are_checked() {
 /// follows it.
 #[test]
 fn converges_onto_a_straight_trail() {
-    let toml = r#"
-        duration = 6.0
-        seed = 3
-        [screen]
-        resolution = [1440, 810]
-        size = [1.439, 0.809]
-        [field]
-        cell = 0.005
-        [tracker]
-        rate_hz = 50.0
-        [[pheromones]]
-        name = "LAP"
-        colour = [0, 0, 255]
-        evaporation = 50.0
-        [[pheromones.maps]]
-        polyline = [[0.05, 0.4], [1.39, 0.4]]
-        width = 0.06
-        rate = 0.02
-        [[robots]]
-        count = 1
-        behaviour = "forage"
-        placement = "explicit"
-        poses = [[0.15, 0.44, -20.0]]
-    "#;
-    let sc = Scenario::from_toml_str(toml, ".").unwrap();
+    let sc = ScenarioBuilder::new()
+        .duration(6.0)
+        .seed(3)
+        .screen([1440, 810], [1.439, 0.809])
+        .cell(0.005)
+        .with(|s| s.tracker.rate_hz = 50.0)
+        .pheromone(
+            PheromoneSpec::grid("LAP", [0.0, 0.0, 255.0])
+                .with_evaporation(50.0)
+                .with_map(MapSpec::polyline(
+                    vec![[0.05, 0.4], [1.39, 0.4]],
+                    0.06,
+                    0.02,
+                )),
+        )
+        .robots(RobotGroupSpec::new(1, "forage").at_poses(vec![[0.15, 0.44, -20.0]]))
+        .build()
+        .unwrap();
     let mut w = World::new(&sc).unwrap();
     // Steady state e J = 1 at once.
     for p in w.pheromones_mut() {

@@ -15,9 +15,7 @@
 //! * SRP (red): at every bifurcation on those paths whose other branch leads to no food, a short piece of
 //!   that branch from `srp_start` to `srp_end` metres along it (magenta over the blue).
 use colcos_sim::Vec2;
-use colcos_sim::scenario::{
-    MapSpec, ModelKind, PheromoneSpec, Placement, RobotGroupSpec, ScenarioSpec,
-};
+use colcos_sim::scenario::{MapSpec, PheromoneSpec, RobotGroupSpec, ScenarioBuilder, ScenarioSpec};
 
 /// One node of a trail tree.
 #[derive(Clone, Debug, PartialEq)]
@@ -333,14 +331,18 @@ impl TrailLayout {
         cell: f32,
     ) -> ScenarioSpec {
         let rate = 1.0 / 50.0;
-        let map = |points: Vec<Vec2>, width: f32| MapSpec {
-            polyline: Some(points.iter().map(|p| [round5(p.x), round5(p.y)]).collect()),
-            width: Some(width),
-            image: None,
-            channel: None,
-            rate,
+        let map = |points: Vec<Vec2>, width: f32| {
+            let points = points.iter().map(|p| [round5(p.x), round5(p.y)]).collect();
+            MapSpec::polyline(points, width, rate)
         };
-        let mut ph = Vec::new();
+        let nest = self.nest();
+        let mut scenario = ScenarioBuilder::new()
+            .name(format!("case1_{}_{}", self.name, pheromones.join("_")))
+            .duration(duration)
+            .seed(seed)
+            .with(|s| s.screen.size = SCREEN)
+            .cell(cell)
+            .gif_interval(0.0);
         for &name in pheromones {
             let (colour, maps) = match name {
                 "LAP" => (
@@ -360,40 +362,18 @@ impl TrailLayout {
                 ),
                 other => panic!("unknown case-I pheromone {other:?}"),
             };
-            ph.push(PheromoneSpec {
-                name: name.into(),
-                colour,
-                model: ModelKind::Grid,
-                evaporation: Some(50.0),
-                diffusion: 0.0,
-                scheme: Default::default(),
-                wind: [0.0, 0.0],
+            scenario = scenario.pheromone(PheromoneSpec {
                 maps,
-                sources: Vec::new(),
+                ..PheromoneSpec::grid(name, colour).with_evaporation(50.0)
             });
         }
-        let nest = self.nest();
-        let mut spec: ScenarioSpec =
-            colcos_sim::scenario::parse_spec("duration = 1.0").expect("minimal spec");
-        spec.name = format!("case1_{}_{}", self.name, pheromones.join("_"));
-        spec.duration = duration;
-        spec.seed = seed;
-        spec.screen.size = SCREEN;
-        spec.field.cell = cell;
-        spec.output.gif_interval = 0.0;
-        spec.pheromones = ph;
-        spec.robots = vec![RobotGroupSpec {
-            count: 1,
-            role: "forager".into(),
-            behaviour: "forage".into(),
-            params: Default::default(),
-            placement: Placement::Explicit,
-            region: None,
-            poses: vec![[nest.pos.x, nest.pos.y, nest.heading_deg]],
-            deposits: Vec::new(),
-            emits: Vec::new(),
-        }];
-        spec
+        scenario
+            .robots(
+                RobotGroupSpec::new(1, "forage")
+                    .with_role("forager")
+                    .at_poses(vec![[nest.pos.x, nest.pos.y, nest.heading_deg]]),
+            )
+            .spec()
     }
 }
 

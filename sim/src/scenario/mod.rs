@@ -1,9 +1,11 @@
 //! Scenario files: TOML parsed into a [`ScenarioSpec`] (unknown keys rejected, errors with the key path),
-//! then validated before anything runs.
+//! then validated before anything runs; or built in code with [`ScenarioBuilder`].
 
+mod builder;
 mod spec;
 mod validate;
 
+pub use builder::ScenarioBuilder;
 pub use spec::*;
 
 use crate::error::{Result, SimError};
