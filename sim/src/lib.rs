@@ -20,6 +20,7 @@ pub mod run;
 pub mod scenario;
 pub mod screen;
 pub mod sensors;
+pub mod shield;
 pub mod spatial;
 pub mod tracker;
 pub mod world;

@@ -1,0 +1,168 @@
+//! The safety shield: the same last word on every wheel command in every plant (simulator, twin, rig),
+//! so that training sees what deployment does. It caps the wheel speeds and keeps a robot inside
+//! virtual walls a margin inside the arena: a command that would carry the robot past a wall within a
+//! short horizon loses its forward part and turns in place instead.
+use crate::behaviour::WheelCommand;
+use crate::robot::Pose;
+use glam::Vec2;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ShieldParams {
+    /// Largest wheel speed let through, m/s.
+    pub max_wheel_speed: f32,
+    /// Distance of the virtual walls inside the arena's edges, m (measured from the robot's centre).
+    pub margin: f32,
+    /// How far ahead a command is followed to see whether it crosses a virtual wall, s.
+    pub horizon: f32,
+}
+
+impl Default for ShieldParams {
+    fn default() -> Self {
+        ShieldParams {
+            max_wheel_speed: 0.35,
+            margin: 0.03,
+            horizon: 0.15,
+        }
+    }
+}
+
+/// What the shield changed in one command.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Intervention {
+    /// A wheel speed was above the cap.
+    pub capped: bool,
+    /// The command would have crossed a virtual wall.
+    pub walled: bool,
+}
+
+impl Intervention {
+    pub fn any(&self) -> bool {
+        self.capped || self.walled
+    }
+}
+
+/// Running counts of interventions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct ShieldCounts {
+    pub capped: u64,
+    pub walled: u64,
+}
+
+impl ShieldCounts {
+    pub fn add(&mut self, i: Intervention) {
+        self.capped += i.capped as u64;
+        self.walled += i.walled as u64;
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Shield {
+    pub params: ShieldParams,
+    arena: Vec2,
+}
+
+impl Shield {
+    /// A shield for an arena of `arena` m.
+    pub fn new(params: ShieldParams, arena: Vec2) -> Shield {
+        Shield { params, arena }
+    }
+
+    /// The command a robot at `pose` may take in place of `cmd` (a non-finite command is a stop).
+    pub fn apply(&self, pose: &Pose, cmd: WheelCommand) -> (WheelCommand, Intervention) {
+        let mut out = Intervention::default();
+        if !(cmd.left.is_finite() && cmd.right.is_finite()) {
+            return (WheelCommand::STOP, out);
+        }
+        let cap = self.params.max_wheel_speed.max(0.0);
+        let (left, right) = (cmd.left.clamp(-cap, cap), cmd.right.clamp(-cap, cap));
+        out.capped = left != cmd.left || right != cmd.right;
+        let forward = 0.5 * (left + right);
+        let ahead = pose.pos + Vec2::from_angle(pose.heading) * forward * self.params.horizon;
+        let m = self.params.margin.max(0.0);
+        let (lo, hi) = (Vec2::splat(m), self.arena - Vec2::splat(m));
+        let outward = |now: f32, then: f32, lo: f32, hi: f32| {
+            (then < lo && then < now) || (then > hi && then > now)
+        };
+        if outward(pose.pos.x, ahead.x, lo.x, hi.x) || outward(pose.pos.y, ahead.y, lo.y, hi.y) {
+            out.walled = true;
+            // Keep the turn, drop the forward part; a pure forward command turns left in place.
+            let turn = 0.5 * (right - left);
+            let turn = if turn.abs() < 1e-6 { 0.5 * cap } else { turn };
+            return (
+                WheelCommand {
+                    left: -turn,
+                    right: turn,
+                },
+                out,
+            );
+        }
+        (WheelCommand { left, right }, out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn shield() -> Shield {
+        Shield::new(ShieldParams::default(), Vec2::new(1.0, 0.5))
+    }
+
+    #[test]
+    fn speeds_are_capped_and_non_finite_commands_stop() {
+        let (c, i) = shield().apply(
+            &Pose::new(0.5, 0.25, 0.0),
+            WheelCommand {
+                left: 1.0,
+                right: -0.1,
+            },
+        );
+        assert_eq!(
+            c,
+            WheelCommand {
+                left: 0.35,
+                right: -0.1
+            }
+        );
+        assert!(i.capped && !i.walled);
+        let (c, i) = shield().apply(
+            &Pose::new(0.5, 0.25, 0.0),
+            WheelCommand {
+                left: f32::NAN,
+                right: 0.1,
+            },
+        );
+        assert_eq!(c, WheelCommand::STOP);
+        assert!(!i.any());
+    }
+
+    #[test]
+    fn a_robot_driving_at_a_wall_turns_in_place_and_may_drive_away() {
+        let s = shield();
+        let fwd = WheelCommand {
+            left: 0.3,
+            right: 0.3,
+        };
+        // Heading +x, 2 cm from the right virtual wall: 0.3 m/s for 0.15 s crosses it.
+        let near = Pose::new(0.95, 0.25, 0.0);
+        let (c, i) = s.apply(&near, fwd);
+        assert!(i.walled);
+        assert_eq!(c.left, -c.right);
+        // Facing away from the wall the same command passes.
+        let away = Pose::new(0.95, 0.25, std::f32::consts::PI);
+        assert_eq!(s.apply(&away, fwd), (fwd, Intervention::default()));
+        // Far from the walls nothing changes.
+        assert_eq!(s.apply(&Pose::new(0.5, 0.25, 0.0), fwd).0, fwd);
+        // Reversing into the bottom wall is caught too.
+        let (_, i) = s.apply(
+            &Pose::new(0.5, 0.04, std::f32::consts::FRAC_PI_2),
+            WheelCommand {
+                left: -0.3,
+                right: -0.3,
+            },
+        );
+        assert!(i.walled);
+    }
+}
