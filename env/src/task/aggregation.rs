@@ -179,54 +179,35 @@ impl Task for Aggregation {
 mod tests {
     use super::*;
     use colcos_sim::behaviour::WheelCommand;
+    use colcos_sim::scenario::{EmitSpec, PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
 
     /// Leader at (1.0, 0.4), one follower at (0.5, 0.4) with heading `heading` (degrees) driving forward
     /// for 10 steps; with `predator`, the predator is next to the leader, which makes the leader release
     /// the alarm pheromone, else in a far corner.
     fn reward_after(heading: f32, predator: bool) -> f32 {
-        let mut text = format!(
-            r#"
-name = "t"
-duration = 10.0
-dt = 0.02
-seed = 0
-[screen]
-resolution = [384, 216]
-size = [1.439, 0.809]
-[[pheromones]]
-name = "agp"
-colour = [0, 255, 0]
-model = "gaussian"
-evaporation = 10.0
-[[pheromones]]
-name = "alp"
-colour = [255, 0, 0]
-model = "gaussian"
-evaporation = 5.0
-[[robots]]
-count = 1
-role = "leader"
-behaviour = "avoid"
-placement = "explicit"
-poses = [[1.0, 0.4, 0.0]]
-emits = [
-  {{ pheromone = "agp", k = 0.7884, sigma = [0.4, 0.4], evaporation = 10.0, when = "follow" }},
-  {{ pheromone = "alp", k = 1.7740, sigma = [0.6, 0.6], evaporation = 5.0, when = {{ near = {{ role = "predator", distance = 0.2 }} }} }},
-]
-[[robots]]
-count = 1
-role = "follower"
-behaviour = "avoid"
-placement = "explicit"
-poses = [[0.5, 0.4, {heading}]]
-"#
-        );
+        let avoid_at = |role: &str, pose: [f32; 3]| {
+            RobotGroupSpec::new(1, "avoid")
+                .with_role(role)
+                .at_poses(vec![pose])
+        };
         // Far from everyone (no alarm), or next to the leader.
-        let at = if predator { "1.1, 0.4" } else { "0.1, 0.75" };
-        text.push_str(&format!(
-            "[[robots]]\ncount = 1\nrole = \"predator\"\nbehaviour = \"avoid\"\nplacement = \"explicit\"\nposes = [[{at}, 0.0]]\n"
-        ));
-        let scenario = Scenario::from_toml_str(&text, ".").unwrap();
+        let predator_at = if predator { [1.1, 0.4] } else { [0.1, 0.75] };
+        let scenario = ScenarioBuilder::new()
+            .name("t")
+            .screen([384, 216], [1.439, 0.809])
+            .pheromone(PheromoneSpec::gaussian("agp", [0.0, 255.0, 0.0]).with_evaporation(10.0))
+            .pheromone(PheromoneSpec::gaussian("alp", [255.0, 0.0, 0.0]).with_evaporation(5.0))
+            .robots(
+                avoid_at("leader", [1.0, 0.4, 0.0])
+                    .with_emit(EmitSpec::follow("agp", 0.7884, [0.4, 0.4], 10.0))
+                    .with_emit(
+                        EmitSpec::follow("alp", 1.7740, [0.6, 0.6], 5.0).when_near("predator", 0.2),
+                    ),
+            )
+            .robots(avoid_at("follower", [0.5, 0.4, heading]))
+            .robots(avoid_at("predator", [predator_at[0], predator_at[1], 0.0]))
+            .build()
+            .unwrap();
         let task = build(&scenario, &serde_json::Value::Null).unwrap();
         let mut world = World::new(&scenario).unwrap();
         let mut commands = vec![WheelCommand::STOP; world.robot_count()];

@@ -21,8 +21,8 @@
 //! assert_eq!(scenario.robot_count(), 10);
 //! ```
 use super::{
-    DepositSpec, EmitSpec, MapSpec, ModelKind, PheromoneSpec, Placement, RobotGroupSpec, Scenario,
-    ScenarioSpec, SourceSpec, parse_spec,
+    DepositSpec, EmitSpec, EmitWhen, MapSpec, ModelKind, PheromoneSpec, Placement, RobotGroupSpec,
+    Scenario, ScenarioSpec, SourceSpec, parse_spec,
 };
 use crate::error::Result;
 use crate::field::{BackendChoice, Kernel};
@@ -206,6 +206,30 @@ impl MapSpec {
             channel: None,
             rate,
         }
+    }
+}
+
+impl EmitSpec {
+    /// A source of `k` units, `sigma` (m) wide, evaporating in `evaporation` s, on pheromone
+    /// `pheromone`, that follows its robot.
+    pub fn follow(pheromone: impl Into<String>, k: f32, sigma: [f32; 2], evaporation: f32) -> Self {
+        EmitSpec {
+            pheromone: pheromone.into(),
+            k,
+            sigma,
+            rho: 0.0,
+            evaporation,
+            when: EmitWhen::Follow,
+        }
+    }
+
+    /// Refreshed at the robot only while it is within `distance` (m) of a robot of role `role`.
+    pub fn when_near(mut self, role: impl Into<String>, distance: f32) -> Self {
+        self.when = EmitWhen::Near {
+            role: role.into(),
+            distance,
+        };
+        self
     }
 }
 
