@@ -82,7 +82,7 @@ impl StepPlan {
         dt: f32,
         decay_carry: &mut f64,
     ) -> Option<StepPlan> {
-        if !(dt > 0.0) || spec.is_empty() {
+        if dt.is_nan() || dt <= 0.0 || spec.is_empty() {
             return None;
         }
         let GridSpec { nx, ny, cell } = *spec;
