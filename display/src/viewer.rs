@@ -80,7 +80,7 @@ fn proxy() -> Result<Proxy> {
                     el.set_control_flow(ControlFlow::Wait);
                     let mut app = ViewerApp::default();
                     if let Err(e) = el.run_app(&mut app) {
-                        eprintln!("colcos-display: the display thread stopped: {e}");
+                        log::error!("colcos-display: the display thread stopped: {e}");
                     }
                 }
             }
@@ -234,7 +234,7 @@ impl ApplicationHandler<Cmd> for ViewerApp {
                         match st.set_frame(Frame::Rgba(rgba), size, None) {
                             Ok(()) => st.window.request_redraw(),
                             Err(e) => {
-                                eprintln!("colcos-display: {e}; closing the window");
+                                log::warn!("colcos-display: {e}; closing the window");
                                 self.remove(id);
                             }
                         }

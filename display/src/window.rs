@@ -39,7 +39,7 @@ pub(crate) fn open_window(
         })?),
         None => el.primary_monitor().or_else(|| monitors.first().cloned()),
     };
-    eprintln!("colcos-display: monitors [{names}]");
+    log::info!("colcos-display: monitors [{names}]");
     let wsize = opts.window_size.unwrap_or(size);
     let mut attrs = Window::default_attributes().with_title(opts.title.clone());
     if opts.fullscreen {
@@ -80,7 +80,7 @@ pub(crate) fn open_window(
         })
     });
     if shared.is_some() && on_shared.is_none() {
-        eprintln!(
+        log::info!(
             "colcos-display: the source's GPU cannot present to this window; its images are read back through the CPU"
         );
     }
@@ -103,7 +103,7 @@ pub(crate) fn open_window(
             (surface, adapter, device, queue)
         }
     };
-    eprintln!(
+    log::info!(
         "colcos-display: adapter {} ({:?}, {:?}){}",
         adapter.get_info().name,
         adapter.get_info().device_type,

@@ -211,7 +211,7 @@ impl FieldBackend for GpuWorldBackend {
             match self.try_step(pheromones, dt) {
                 Ok(()) => return,
                 Err(e) => {
-                    eprintln!("colcos-gpu: {e}; the CPU steps the fields from now on");
+                    log::warn!("colcos-gpu: {e}; the CPU steps the fields from now on");
                     self.failed = true;
                 }
             }

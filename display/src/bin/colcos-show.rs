@@ -48,6 +48,15 @@ fn pair<T: std::str::FromStr, const SEP: char>(s: &str) -> Result<(T, T), String
 }
 
 fn main() -> ExitCode {
+    // The library's messages (monitors, adapter) reach the terminal as before it logged through `log`.
+    env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or("colcos_display=info"),
+    )
+    .format(|buf, record| {
+        use std::io::Write as _;
+        writeln!(buf, "{}", record.args())
+    })
+    .init();
     match real_main(Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
