@@ -2,10 +2,12 @@
 //! then validated before anything runs; or built in code with [`ScenarioBuilder`].
 
 mod builder;
+mod rig;
 mod spec;
 mod validate;
 
 pub use builder::ScenarioBuilder;
+pub use rig::{BROADCAST_ID, Firmware, RigSpec, SensorSource};
 pub use spec::*;
 
 use crate::error::{Result, SimError};

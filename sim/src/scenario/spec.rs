@@ -46,6 +46,9 @@ pub struct ScenarioSpec {
     pub pheromones: Vec<PheromoneSpec>,
     #[serde(default)]
     pub robots: Vec<RobotGroupSpec>,
+    /// How the scenario runs on the lab's hardware (`colcos bridge`) and its twin.
+    #[serde(default, skip_serializing_if = "super::rig::RigSpec::is_default")]
+    pub rig: super::rig::RigSpec,
 }
 
 fn default_dt() -> f32 {

@@ -66,6 +66,7 @@ pub(super) fn validate(sc: &Scenario) -> Result<()> {
     validate_robot_params(s)?;
     validate_pheromones(s)?;
     validate_robots(sc)?;
+    s.rig.validate(sc.robot_count())?;
     Ok(())
 }
 

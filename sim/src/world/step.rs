@@ -52,33 +52,29 @@ impl World {
             move_robots();
             step_fields();
         }
-        let poses = self.robots.physics.poses();
         inject(
             &mut self.injection,
             &mut self.fields,
-            poses,
+            self.robots.physics.poses(),
             self.tracking.tracked(),
             dt,
         );
-        sense(
-            &mut self.sensing,
-            &mut self.fields,
-            &self.screen,
-            poses,
-            &mut self.robots.slots,
-            time,
-        );
+        self.sense();
     }
 
     /// Every robot's observation from the current screen and poses (after building or moving robots).
     pub(super) fn observe(&mut self) {
-        let poses = self.robots.physics.poses();
-        index(&mut self.sensing, poses);
+        index(&mut self.sensing, self.robots.physics.poses());
+        self.sense();
+    }
+
+    /// Stage `sense` over this world's sets, at the poses last indexed.
+    fn sense(&mut self) {
         sense(
             &mut self.sensing,
             &mut self.fields,
             &self.screen,
-            poses,
+            self.robots.physics.poses(),
             &mut self.robots.slots,
             self.time,
         );
