@@ -42,7 +42,9 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
         },
     );
     bar.finish_and_clear();
-    Ok(report?)
+    // The run error's message already ends with its cause: as an anyhow chain the CLI's `{:#}` would
+    // print the cause twice.
+    report.map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 fn progress_bar(steps: u64) -> indicatif::ProgressBar {
