@@ -2,3 +2,4 @@
 //! JSON pose datagrams, the Colias serial protocol, and the transports that carry them.
 
 pub mod swarmcon;
+pub mod udp_pose;
