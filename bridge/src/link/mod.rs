@@ -1,0 +1,143 @@
+//! Robot links behind one trait: commands go out through an airtime scheduler, telemetry comes back
+//! through a resynchronising frame decoder, over a serial port or UDP.
+
+mod scheduler;
+mod serial;
+mod udp;
+
+pub use scheduler::{AirtimeScheduler, SchedulerCounters};
+pub use serial::SerialWire;
+pub use udp::UdpWire;
+
+use crate::colias::{CommandPacket, Telemetry, TelemetryDecoder};
+use crate::url::{LinkUrl, UrlError};
+use std::time::Instant;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum LinkError {
+    #[error(transparent)]
+    Url(#[from] UrlError),
+    #[error("serial port: {0}")]
+    Serial(#[from] serialport::Error),
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// Running totals of a link.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LinkCounters {
+    pub scheduler: SchedulerCounters,
+    /// Commands waiting for airtime.
+    pub pending: usize,
+    pub bytes_in: u64,
+    pub telemetry: u64,
+    /// Received bytes that were not part of a valid telemetry frame.
+    pub skipped_bytes: u64,
+}
+
+/// The robots as the live loop sees them. Nothing blocks for longer than one frame's write.
+pub trait RobotLink: Send {
+    /// Queues a command; an unsent older command for the same robot is replaced.
+    fn send(&mut self, packet: CommandPacket);
+    /// Writes what the airtime budget allows now and reads whatever has arrived; returns the number
+    /// of frames written. Call it every tick.
+    fn pump(&mut self) -> Result<usize, LinkError>;
+    /// Telemetry decoded since the last call.
+    fn take_telemetry(&mut self) -> Vec<Telemetry>;
+    fn counters(&self) -> LinkCounters;
+}
+
+/// A byte channel to the robots.
+pub trait Wire: Send {
+    /// Writes one whole frame.
+    fn write_frame(&mut self, frame: &[u8]) -> std::io::Result<()>;
+    /// Appends whatever bytes are available without waiting.
+    fn read_available(&mut self, buf: &mut Vec<u8>) -> std::io::Result<()>;
+}
+
+/// The [`RobotLink`] over any [`Wire`].
+pub struct Link<W: Wire> {
+    wire: W,
+    scheduler: AirtimeScheduler,
+    decoder: TelemetryDecoder,
+    rx: Vec<u8>,
+    telemetry: Vec<Telemetry>,
+    bytes_in: u64,
+    received: u64,
+}
+
+/// Telemetry kept for the live loop if it stops reading: about ten seconds of a full channel.
+const MAX_TELEMETRY: usize = 1024;
+
+impl<W: Wire> Link<W> {
+    pub fn new(wire: W, scheduler: AirtimeScheduler) -> Self {
+        Link {
+            wire,
+            scheduler,
+            decoder: TelemetryDecoder::new(),
+            rx: Vec::new(),
+            telemetry: Vec::new(),
+            bytes_in: 0,
+            received: 0,
+        }
+    }
+
+    pub fn wire_mut(&mut self) -> &mut W {
+        &mut self.wire
+    }
+}
+
+impl<W: Wire> RobotLink for Link<W> {
+    fn send(&mut self, packet: CommandPacket) {
+        self.scheduler.submit(packet);
+    }
+
+    fn pump(&mut self) -> Result<usize, LinkError> {
+        let mut written = 0;
+        while let Some(p) = self.scheduler.next_due(Instant::now()) {
+            self.wire.write_frame(&p.to_frame())?;
+            written += 1;
+        }
+        self.rx.clear();
+        self.wire.read_available(&mut self.rx)?;
+        self.bytes_in += self.rx.len() as u64;
+        let mut frames = Vec::new();
+        self.decoder.feed_into(&self.rx, &mut frames);
+        self.received += frames.len() as u64;
+        self.telemetry.extend(frames.iter().map(Telemetry::decode));
+        if self.telemetry.len() > MAX_TELEMETRY {
+            let excess = self.telemetry.len() - MAX_TELEMETRY;
+            self.telemetry.drain(..excess);
+        }
+        Ok(written)
+    }
+
+    fn take_telemetry(&mut self) -> Vec<Telemetry> {
+        std::mem::take(&mut self.telemetry)
+    }
+
+    fn counters(&self) -> LinkCounters {
+        LinkCounters {
+            scheduler: self.scheduler.counters(),
+            pending: self.scheduler.pending(),
+            bytes_in: self.bytes_in,
+            telemetry: self.received,
+            skipped_bytes: self.decoder.counters().skipped,
+        }
+    }
+}
+
+/// Opens the link a URL names.
+pub fn open_robot_link(url: &str) -> Result<Box<dyn RobotLink>, LinkError> {
+    Ok(match url.parse::<LinkUrl>()? {
+        LinkUrl::Serial { device, baud } => Box::new(Link::new(
+            SerialWire::open(&device, baud)?,
+            AirtimeScheduler::new(baud),
+        )),
+        LinkUrl::Udp { host, port, baud } => Box::new(Link::new(
+            UdpWire::connect(&format!("{host}:{port}"))?,
+            AirtimeScheduler::new(baud),
+        )),
+    })
+}
