@@ -87,9 +87,29 @@ impl RigSpec {
         self.tracker_ids.get(i).copied().unwrap_or(i as i32)
     }
 
-    /// Radio address of robot `i`.
-    pub fn radio_id(&self, i: usize) -> u8 {
-        self.radio_ids.get(i).copied().unwrap_or((i + 1) as u8)
+    /// Radio address of robot `i` (`None`: the default addresses run out at 199).
+    pub fn radio_id(&self, i: usize) -> Option<u8> {
+        match self.radio_ids.get(i) {
+            Some(id) => Some(*id),
+            None if i + 1 < BROADCAST_ID as usize => Some((i + 1) as u8),
+            None => None,
+        }
+    }
+
+    /// Every robot's radio address, for a rig of `robots` robots: an error naming `rig.radio_ids` when
+    /// the defaults run out (a radio reaches at most 199 robots).
+    pub fn radio_addresses(&self, robots: usize) -> Result<Vec<u8>> {
+        (0..robots)
+            .map(|i| {
+                self.radio_id(i).ok_or_else(|| {
+                    SimError::invalid(
+                        "rig.radio_ids",
+                        "(default)",
+                        format!("{robots} robots: the default addresses 1..=199 run out; a radio reaches at most 199 robots"),
+                    )
+                })
+            })
+            .collect()
     }
 
     /// Checks the section for a scenario of `robots` robots.
@@ -106,15 +126,6 @@ impl RigSpec {
         };
         count("tracker_ids", self.tracker_ids.len())?;
         count("radio_ids", self.radio_ids.len())?;
-        if self.radio_ids.is_empty() && robots >= BROADCAST_ID as usize {
-            return Err(SimError::invalid(
-                "rig.radio_ids",
-                "(default)",
-                format!(
-                    "{robots} robots: the default addresses 1..={robots} reach the broadcast 200; list them"
-                ),
-            ));
-        }
         for (i, id) in self.radio_ids.iter().enumerate() {
             if *id == BROADCAST_ID || self.radio_ids[..i].contains(id) {
                 return Err(SimError::invalid(
