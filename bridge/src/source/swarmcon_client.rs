@@ -38,18 +38,15 @@ fn run(shared: &Shared, addr: &str, opts: &SourceOptions) {
     let mut connected_before = false;
     while !shared.stopped() {
         shared.set_state(ConnectionState::Connecting);
-        match connect(addr, opts.connect_timeout) {
-            Ok(stream) => {
-                if connected_before {
-                    shared.lock().counters.reconnects += 1;
-                }
-                connected_before = true;
-                backoff = opts.backoff_initial;
-                parser.reset();
-                shared.set_state(ConnectionState::Connected);
-                serve(shared, stream, &mut parser, opts);
+        if let Ok(stream) = connect(addr, opts.connect_timeout) {
+            if connected_before {
+                shared.lock().counters.reconnects += 1;
             }
-            Err(_) => {}
+            connected_before = true;
+            backoff = opts.backoff_initial;
+            parser.reset();
+            shared.set_state(ConnectionState::Connected);
+            serve(shared, stream, &mut parser, opts);
         }
         if shared.stopped() {
             break;

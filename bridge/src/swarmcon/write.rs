@@ -47,7 +47,7 @@ pub fn write_frame(out: &mut String, frame: &TrackerFrame, form: HeaderForm) {
         HeaderForm::Plain => out.push_str(" \n"),
         HeaderForm::Dot => out.push_str(". \n"),
         HeaderForm::Updated => {
-            let _ = write!(out, ", {} updated. \n", frame.updated.unwrap_or(0));
+            let _ = writeln!(out, ", {} updated. ", frame.updated.unwrap_or(0));
         }
     }
     for r in &frame.robots {
@@ -58,7 +58,7 @@ pub fn write_frame(out: &mut String, frame: &TrackerFrame, form: HeaderForm) {
         push_c_f3(out, r.y);
         out.push(' ');
         push_c_f3(out, r.yaw_deg);
-        let _ = write!(out, " {} \n", r.last_seen_us);
+        let _ = writeln!(out, " {} ", r.last_seen_us);
     }
 }
 
