@@ -46,6 +46,9 @@ pub trait RobotLink: Send {
     /// Telemetry decoded since the last call.
     fn take_telemetry(&mut self) -> Vec<Telemetry>;
     fn counters(&self) -> LinkCounters;
+    /// Writes `packet` (a stop) at once, ahead of the airtime schedule, and drops every queued
+    /// command: a robot that was stopped must not be restarted by a command queued before the stop.
+    fn stop_now(&mut self, packet: CommandPacket) -> Result<(), LinkError>;
 }
 
 /// A byte channel to the robots.
@@ -115,6 +118,12 @@ impl<W: Wire> RobotLink for Link<W> {
 
     fn take_telemetry(&mut self) -> Vec<Telemetry> {
         std::mem::take(&mut self.telemetry)
+    }
+
+    fn stop_now(&mut self, packet: CommandPacket) -> Result<(), LinkError> {
+        self.scheduler.clear();
+        self.wire.write_frame(&packet.to_frame())?;
+        Ok(())
     }
 
     fn counters(&self) -> LinkCounters {

@@ -63,6 +63,14 @@ impl AirtimeScheduler {
         self.counters
     }
 
+    /// Drops every queued command (a safety stop goes out ahead of them, and none may follow it).
+    pub fn clear(&mut self) {
+        for slot in self.slots.iter_mut() {
+            *slot = None;
+        }
+        self.pending = 0;
+    }
+
     /// Queues a command, replacing any unsent one for the same robot.
     pub fn submit(&mut self, p: CommandPacket) {
         self.counters.submitted += 1;

@@ -1,0 +1,221 @@
+//! The host's side of one rig tick: the simulator's own injection, field, screen and sensing stages,
+//! run with the real arena: poses from a tracker in place of physics and the tracker model, and the
+//! robots' behaviours deciding the wheel commands that go out over the link.
+use colcos_sim::behaviour::{Observation, WheelCommand};
+use colcos_sim::error::Result;
+use colcos_sim::robot::Pose;
+use colcos_sim::scenario::{Scenario, SensorSource as SensorMode};
+use colcos_sim::screen::ScreenSpec;
+use colcos_sim::tracker::TrackedPose;
+use colcos_sim::world::{WorldParts, stages};
+use image::RgbImage;
+
+/// The data sets of a world without bodies or a tracker model, stepped tick by tick.
+pub struct Host {
+    screen: ScreenSpec,
+    parts: WorldParts,
+    /// Host time, s: the sum of the ticks' measured durations.
+    time: f32,
+    ticks: u64,
+    /// Latest tracked pose of every robot (`seen` false until the tracker has reported it).
+    tracked: Vec<TrackedPose>,
+    /// Scratch: the poses injection and sensing use this tick.
+    poses: Vec<Pose>,
+    commands: Vec<WheelCommand>,
+    mode: SensorMode,
+    /// Each pose is predicted forward by this much (s) from the robot's last command before pheromone
+    /// is injected or sensed there: the tracker's pose is this old when it is used.
+    latency: f32,
+    /// The robots' wheel base, m (for the prediction).
+    wheel_base: f32,
+}
+
+impl Host {
+    /// A host for `scenario`: its fields, injection rules, sensing state and behaviours, with no robot
+    /// seen yet.
+    pub fn new(scenario: &Scenario, mode: SensorMode) -> Result<Host> {
+        let parts = WorldParts::build(scenario, 0)?;
+        let n = parts.slots.len();
+        Ok(Host {
+            screen: scenario.spec.screen,
+            parts,
+            time: 0.0,
+            ticks: 0,
+            tracked: vec![TrackedPose::default(); n],
+            poses: vec![Pose::default(); n],
+            commands: vec![WheelCommand::STOP; n],
+            mode,
+            latency: 0.0,
+            wheel_base: scenario.spec.robot.wheel_base,
+        })
+    }
+
+    pub fn robot_count(&self) -> usize {
+        self.tracked.len()
+    }
+    pub fn time(&self) -> f32 {
+        self.time
+    }
+    pub fn ticks(&self) -> u64 {
+        self.ticks
+    }
+    pub fn screen(&self) -> &ScreenSpec {
+        &self.screen
+    }
+    pub fn mode(&self) -> SensorMode {
+        self.mode
+    }
+    /// Sets the latency compensation, s (clamped to [0, 1]).
+    pub fn set_latency(&mut self, latency: f32) {
+        self.latency = if latency.is_finite() {
+            latency.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+    }
+    /// The tracked poses as last given.
+    pub fn tracked(&self) -> &[TrackedPose] {
+        &self.tracked
+    }
+    /// The poses injection and sensing used in the last tick (latency-compensated).
+    pub fn poses(&self) -> &[Pose] {
+        &self.poses
+    }
+    pub fn observations(&self) -> &[Observation] {
+        self.parts.sensing.observations()
+    }
+    /// The commands the behaviours decided in the last tick.
+    pub fn commands(&self) -> &[WheelCommand] {
+        &self.commands
+    }
+    pub fn pheromones(&self) -> &[colcos_sim::field::Pheromone] {
+        self.parts.fields.pheromones()
+    }
+    /// Installs a field backend (`None`: the CPU).
+    pub fn set_field_backend(&mut self, backend: Option<Box<dyn colcos_sim::field::FieldBackend>>) {
+        self.parts.fields.set_backend(backend);
+    }
+
+    /// Robot `i` was seen at `pose` (our frame) in a frame captured at host time `stamp`.
+    pub fn set_pose(&mut self, i: usize, pose: Pose, stamp: f32) {
+        if let Some(t) = self.tracked.get_mut(i)
+            && pose.pos.is_finite()
+            && pose.heading.is_finite()
+        {
+            *t = TrackedPose {
+                pose,
+                stamp,
+                seen: true,
+            };
+        }
+    }
+
+    /// Robot `i`'s own readings (real sensors), in the simulator's sensor order: used by the next
+    /// tick's decisions in [`SensorMode::Robot`].
+    pub fn set_readings(&mut self, i: usize, counts: [[u16; 3]; 4], bumpers: [f32; 3]) {
+        let sensor = self.parts.sensing.sensor().clone();
+        if let Some(o) = self.parts.sensing.observations_mut().get_mut(i) {
+            o.counts = counts;
+            o.intensity = sensor.intensities(&counts);
+            o.bumpers = bumpers.map(|b| {
+                if b.is_finite() {
+                    b.clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            });
+        }
+    }
+
+    /// One tick of `dt` s (the measured time since the last): the fields step, pheromone is injected at
+    /// the tracked poses, every robot senses (virtually, or keeps its reported readings) and decides.
+    /// Returns the wheel commands, one per robot; a robot never seen gets a stop.
+    pub fn tick(&mut self, dt: f32) -> &[WheelCommand] {
+        let dt = if dt.is_finite() {
+            dt.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        self.ticks += 1;
+        self.time += dt;
+        let wheel_base = self.wheel_base;
+        let parts = &mut self.parts;
+        stages::step_fields(&mut parts.fields, dt, false);
+        for ((p, t), cmd) in self.poses.iter_mut().zip(&self.tracked).zip(&self.commands) {
+            *p = predict(t.pose, *cmd, self.latency, self.time - t.stamp, wheel_base);
+        }
+        let predicted: Vec<TrackedPose> = self
+            .tracked
+            .iter()
+            .zip(&self.poses)
+            .map(|(t, p)| TrackedPose { pose: *p, ..*t })
+            .collect();
+        stages::inject(
+            &mut parts.injection,
+            &mut parts.fields,
+            &self.poses,
+            &predicted,
+            dt,
+        );
+        let kept: Vec<Observation> = match self.mode {
+            SensorMode::Robot => parts.sensing.observations().to_vec(),
+            SensorMode::Virtual => Vec::new(),
+        };
+        stages::index(&mut parts.sensing, &self.poses);
+        stages::sense(
+            &mut parts.sensing,
+            &mut parts.fields,
+            &self.screen,
+            &self.poses,
+            &mut parts.slots,
+            self.time,
+        );
+        if self.mode == SensorMode::Robot {
+            for (o, k) in parts.sensing.observations_mut().iter_mut().zip(kept) {
+                o.counts = k.counts;
+                o.intensity = k.intensity;
+                o.bumpers = k.bumpers;
+            }
+        }
+        stages::decide(
+            &mut parts.slots,
+            parts.sensing.observations(),
+            &mut self.commands,
+        );
+        for (cmd, t) in self.commands.iter_mut().zip(&self.tracked) {
+            if !t.seen {
+                *cmd = WheelCommand::STOP;
+            }
+        }
+        &self.commands
+    }
+
+    /// The screen image, eq. (1), at `width x height` (the panel's resolution for the LCD).
+    pub fn render(&self, width: u32, height: u32) -> RgbImage {
+        colcos_sim::screen::render(self.parts.fields.pheromones(), &self.screen, width, height)
+    }
+}
+
+/// Where a robot captured at `pose` `age` s ago will be when pheromone injected now shows on the
+/// screen, `latency` s from now: driven on a circular arc by its last wheel command (differential
+/// drive, wheels `wheel_base` apart). No prediction without a latency to compensate.
+pub fn predict(pose: Pose, cmd: WheelCommand, latency: f32, age: f32, wheel_base: f32) -> Pose {
+    let t = (age.max(0.0) + latency).min(0.5);
+    if latency <= 0.0 || !cmd.left.is_finite() || !cmd.right.is_finite() || wheel_base <= 0.0 {
+        return pose;
+    }
+    let v = 0.5 * (cmd.left + cmd.right);
+    let w = (cmd.right - cmd.left) / wheel_base;
+    let (s, c) = pose.heading.sin_cos();
+    let mut p = pose;
+    if (w * t).abs() < 1e-6 {
+        p.pos.x += v * t * c;
+        p.pos.y += v * t * s;
+    } else {
+        let h = pose.heading + w * t;
+        p.pos.x += v / w * (h.sin() - s);
+        p.pos.y -= v / w * (h.cos() - c);
+        p.heading = h;
+    }
+    p
+}

@@ -1,0 +1,213 @@
+//! The bridge's live loop driving the digital twin end to end over loopback: SwarmCon over TCP, the
+//! robots' serial protocol over UDP and over a pseudo-terminal, the displayed frames over the frame
+//! stream; and the safety stops, measured from the twin's own record of what it received.
+use colcos_bridge::colias::{BROADCAST_ID, HostCommand};
+use colcos_bridge::frames::FrameServer;
+use colcos_bridge::live::{self, LiveOptions, LiveReport};
+use colcos_bridge::recorder::{Topic, read_log};
+use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::twin::{
+    ByteChannel, PtyChannel, TrackerFaults, TrackerServer, Twin, UdpChannel,
+};
+use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
+use colcos_sim::scenario::Scenario;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+fn scenario() -> Scenario {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/case2_alarm.toml");
+    Scenario::from_file(path).unwrap()
+}
+
+struct Rig {
+    twin: std::thread::JoinHandle<Twin>,
+    faults: Arc<Mutex<TrackerFaults>>,
+    report: LiveReport,
+    log: Vec<colcos_bridge::recorder::Recorded>,
+    bridge_stopped_at: Instant,
+}
+
+/// Runs the twin and the bridge side by side for `seconds`; `during` runs on the test thread
+/// meanwhile (to switch faults). The twin keeps running a little after the bridge ends.
+fn run_rig(
+    channel: Box<dyn ByteChannel>,
+    link_url: String,
+    seconds: f64,
+    during: impl FnOnce(&Arc<Mutex<TrackerFaults>>),
+) -> Rig {
+    let sc = scenario();
+    let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
+    let tracker_addr = tracker.local_addr();
+    let frames = FrameServer::bind("127.0.0.1:0").unwrap();
+    let frames_addr = frames.local_addr();
+    let mut twin = Twin::new(&sc, tracker, channel, Some(frames_addr)).unwrap();
+    let faults = twin.tracker().faults();
+    let twin_stop = Arc::new(AtomicBool::new(false));
+    let ts = twin_stop.clone();
+    let twin = std::thread::spawn(move || {
+        twin.run(Some(seconds + 1.0), &ts);
+        twin
+    });
+    let opts = SourceOptions::new(FrameTransform::new(sc.arena_size().y as f64));
+    let source = open_pose_source(&format!("swarmcon://{tracker_addr}"), &opts).unwrap();
+    let link = open_robot_link(&link_url).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let log_path = dir.path().join("rig.mcap");
+    let live_opts = LiveOptions {
+        duration: Some(seconds),
+        stream_width: 480,
+        log: Some(log_path.clone()),
+        ..LiveOptions::default()
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let bridge = {
+        let sc = sc.clone();
+        let stop = stop.clone();
+        std::thread::spawn(move || {
+            live::run(&sc, source, link, Some(frames), &live_opts, stop).unwrap()
+        })
+    };
+    during(&faults);
+    let report = bridge.join().unwrap();
+    let bridge_stopped_at = Instant::now();
+    let log = read_log(&std::fs::read(&log_path).unwrap());
+    Rig {
+        twin,
+        faults,
+        report,
+        log,
+        bridge_stopped_at,
+    }
+}
+
+fn wheel_speeds(p: &HostCommand) -> Option<(f32, f32)> {
+    match p {
+        HostCommand::WheelSpeeds { left, right } => Some((*left, *right)),
+        _ => None,
+    }
+}
+
+/// Case II's behaviours on the host drive the twin's five robots over UDP: every robot gets wheel
+/// commands and moves, poses and frames flow, the log holds what crossed the wires, and the loop
+/// keeps its 20 ms.
+#[test]
+fn case_two_drives_the_twin_over_udp() {
+    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let start_poses: Vec<_> = {
+        let sc = scenario();
+        colcos_sim::world::World::new(&sc).unwrap().poses().to_vec()
+    };
+    let rig = run_rig(Box::new(channel), url, 4.0, |_| {});
+    let twin = rig.twin.join().unwrap();
+    let r = &rig.report;
+    assert!(r.ticks >= 150, "{r:?}");
+    assert!(r.pose_blocks >= 60, "{r:?}");
+    assert!(r.stops.is_empty(), "no safety stop expected: {r:?}");
+    assert!(r.telemetry_received >= 10, "{r:?}");
+    // Every robot was driven, and moved.
+    let received = twin.received();
+    for (i, id) in (1..=5u8).enumerate() {
+        let moving = received
+            .iter()
+            .filter(|c| c.packet.id == id)
+            .filter_map(|c| wheel_speeds(&c.packet.command))
+            .any(|(l, r)| l != 0.0 || r != 0.0);
+        assert!(moving, "robot {id} never got a motion command");
+        let moved = twin.plant().poses()[i].pos.distance(start_poses[i].pos);
+        assert!(moved > 0.02, "robot {id} moved only {moved} m");
+    }
+    // The last thing sent is the exit guard's broadcast stop, and the twin's robots obey it.
+    let last = received.last().unwrap().packet;
+    assert_eq!(last.id, BROADCAST_ID);
+    assert_eq!(wheel_speeds(&last.command), Some((0.0, 0.0)));
+    for i in 0..5 {
+        assert_eq!(
+            twin.plant().command(i),
+            colcos_sim::behaviour::WheelCommand::STOP
+        );
+    }
+    // The rig log has every kind of traffic, the commands byte for byte as the twin received them.
+    let count = |t: Topic| rig.log.iter().filter(|m| m.topic == t).count();
+    assert!(
+        count(Topic::Poses) >= 60 && count(Topic::Frames) >= 100 && count(Topic::Telemetry) >= 10
+    );
+    let logged: Vec<&[u8]> = rig
+        .log
+        .iter()
+        .filter(|m| m.topic == Topic::Commands)
+        .map(|m| m.data.as_slice())
+        .collect();
+    let wire: Vec<Vec<u8>> = received.iter().map(|c| c.packet.to_frame()).collect();
+    let missing = wire
+        .iter()
+        .filter(|w| !logged.contains(&w.as_slice()))
+        .count();
+    assert_eq!(missing, 0, "commands the twin received that the log lacks");
+    let _ = rig.faults;
+}
+
+/// The same loop over a real pseudo-terminal, through the bridge's serial code.
+#[test]
+fn the_serial_link_drives_the_twin_over_a_pty() {
+    let channel = PtyChannel::open().unwrap();
+    let url = format!("serial://{}?baud=115200", channel.peer_path());
+    let rig = run_rig(Box::new(channel), url, 2.0, |_| {});
+    let twin = rig.twin.join().unwrap();
+    let driven = twin
+        .received()
+        .iter()
+        .filter_map(|c| wheel_speeds(&c.packet.command))
+        .filter(|(l, r)| *l != 0.0 || *r != 0.0)
+        .count();
+    assert!(
+        driven >= 20,
+        "{driven} motion commands over the pty; {:?}",
+        rig.report
+    );
+    assert!(rig.report.telemetry_received >= 3, "{:?}", rig.report);
+}
+
+/// Tracker silence: every robot is stopped (a broadcast stop reaches the twin) within the silence
+/// limit plus 50 ms, measured on the twin's receipt times.
+#[test]
+fn tracker_silence_stops_every_robot_in_time() {
+    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let silent_at = Arc::new(Mutex::new(None));
+    let s = silent_at.clone();
+    let rig = run_rig(Box::new(channel), url, 3.0, move |faults| {
+        std::thread::sleep(Duration::from_millis(1500));
+        faults.lock().unwrap().silent = true;
+        *s.lock().unwrap() = Some(Instant::now());
+    });
+    let twin = rig.twin.join().unwrap();
+    let silent_at = silent_at.lock().unwrap().unwrap();
+    let stop = twin
+        .received()
+        .iter()
+        .find(|c| c.at > silent_at && c.packet.id == BROADCAST_ID && rig.bridge_stopped_at > c.at)
+        .expect("a broadcast stop after the tracker went silent");
+    let delay = stop.at.duration_since(silent_at).as_secs_f64();
+    let limit = scenario().spec.rig.tracker_silence as f64;
+    assert!(
+        rig.report.stops.contains(&"tracker_silent".to_string()),
+        "{:?}",
+        rig.report
+    );
+    // The tracker's last block may have been up to one block period (40 ms) old when it went silent.
+    assert!(
+        delay <= limit + 0.05,
+        "stop {delay:.3} s after the silence began (limit {limit} s + 50 ms)"
+    );
+    // While silent, no motion command follows the stop.
+    let after: Vec<_> = twin
+        .received()
+        .iter()
+        .filter(|c| c.at > stop.at && rig.bridge_stopped_at > c.at)
+        .filter_map(|c| wheel_speeds(&c.packet.command))
+        .filter(|(l, r)| *l != 0.0 || *r != 0.0)
+        .collect();
+    assert!(after.is_empty(), "motion after the safety stop: {after:?}");
+}
