@@ -1,10 +1,12 @@
 //! colcos: a simulator, RL environment and hardware bridge for multi-pheromone swarm robotics, after
 //! the ColCOSPhi system. This facade re-exports the library crates; the `colcos` binary is the CLI.
 
+pub use colcos_bridge as bridge;
 pub use colcos_sim as sim;
 
 pub mod backend;
 pub mod display;
 pub mod experiment;
 pub mod report;
+pub mod rig;
 pub mod run;

@@ -49,6 +49,12 @@ enum Command {
     Display(colcos::display::DisplayArgs),
     /// Reproduce the paper's case studies (all trials in parallel): figures, CSVs, summary.json/.md.
     Experiment(colcos::experiment::ExperimentArgs),
+    /// Drive real robots with a scenario's behaviours: poses from the tracker, pheromone injected and
+    /// the field stepped by the simulator, commands over the radio link, safety stops by a watchdog.
+    Bridge(colcos::rig::BridgeArgs),
+    /// The digital twin: the simulator serving the rig's wire formats (SwarmCon over TCP, the robots'
+    /// serial protocol over a pseudo-terminal or UDP) for `colcos bridge` to drive.
+    Twin(colcos::rig::TwinArgs),
     /// Check a scenario file and print what it sets up, without running it.
     Check { scenario: PathBuf },
     /// List the behaviours a scenario can name.
@@ -89,6 +95,8 @@ fn run_command(command: Command, text: &mut String) -> Result<()> {
     match command {
         Command::Display(args) => colcos::display::main(args),
         Command::Experiment(args) => colcos::experiment::main(args),
+        Command::Bridge(args) => colcos::rig::bridge(args, text),
+        Command::Twin(args) => colcos::rig::twin(args, text),
         Command::Run {
             scenario,
             out,

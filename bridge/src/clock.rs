@@ -64,12 +64,13 @@ mod tests {
             let capture = 1000.0 + k as f64 * 0.03;
             c.observe(capture + ahead, capture + 0.005 + (k % 5) as f64 * 0.001);
         }
+        // Within what the slow forgetting adds over the few blocks since the fastest one.
         assert!(
-            (c.offset() - (0.005 - ahead)).abs() < 1e-6,
+            (c.offset() - (0.005 - ahead)).abs() < 1e-4,
             "{}",
             c.offset()
         );
         let age = c.age(1000.0 + ahead, 1000.02);
-        assert!((age - 0.015).abs() < 1e-6, "{age}");
+        assert!((age - 0.015).abs() < 1e-4, "{age}");
     }
 }

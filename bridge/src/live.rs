@@ -28,6 +28,9 @@ pub struct LiveOptions {
     pub duration: Option<f64>,
     /// Width of the frames sent to the frame stream (height from the panel's aspect); 0: none.
     pub stream_width: u32,
+    /// Frames sent to the frame stream per second (at most one a tick; 0: every tick). Rendering
+    /// costs the loop: a 960-pixel frame of two Gaussian fields takes ~10 ms on one core.
+    pub stream_hz: f64,
     /// Where the rig log (MCAP) goes; None: no log.
     pub log: Option<PathBuf>,
     /// Print a status line every second.
@@ -231,6 +234,7 @@ pub fn run(
     let mut last_sent: Vec<(WheelCommand, f64)> = vec![(WheelCommand::STOP, f64::NEG_INFINITY); n];
     let mut tick_ms: Vec<f64> = Vec::new();
     let (mut next_telemetry, mut telemetry_robot) = (0.0, 0usize);
+    let mut next_frame = 0.0;
     let (mut last_tick, mut next, mut last_status) = (start, start, start);
     loop {
         let now = Instant::now();
@@ -302,8 +306,14 @@ pub fn run(
         // The screen to the frame stream.
         if let Some(server) = frames.as_mut()
             && stream_size.0 > 0
+            && t >= next_frame
             && server.subscribers() > 0
         {
+            next_frame = t + if opts.stream_hz > 0.0 {
+                1.0 / opts.stream_hz
+            } else {
+                0.0
+            };
             let img = host.render(stream_size.0, stream_size.1);
             server.publish(&img, host.time() as f64);
             let json = serde_json::json!({"tick": report.ticks, "width": img.width(), "height": img.height(), "fnv1a": format!("{:016x}", fnv1a(img.as_raw()))});

@@ -57,6 +57,7 @@ fn run_rig(
     let live_opts = LiveOptions {
         duration: Some(seconds),
         stream_width: 480,
+        stream_hz: 25.0,
         log: Some(log_path.clone()),
         ..LiveOptions::default()
     };
@@ -131,7 +132,7 @@ fn case_two_drives_the_twin_over_udp() {
     // The rig log has every kind of traffic, the commands byte for byte as the twin received them.
     let count = |t: Topic| rig.log.iter().filter(|m| m.topic == t).count();
     assert!(
-        count(Topic::Poses) >= 60 && count(Topic::Frames) >= 100 && count(Topic::Telemetry) >= 10
+        count(Topic::Poses) >= 60 && count(Topic::Frames) >= 50 && count(Topic::Telemetry) >= 10
     );
     let logged: Vec<&[u8]> = rig
         .log

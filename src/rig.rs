@@ -1,0 +1,184 @@
+//! `colcos bridge` and `colcos twin`: a scenario's behaviours driving real robots through the tracker
+//! and the radio link, and the digital twin that plays the rig over the same wire formats.
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use colcos_bridge::frames::FrameServer;
+use colcos_bridge::live::{self, LiveOptions};
+use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::twin::{ByteChannel, PtyChannel, TrackerServer, Twin, UdpChannel};
+use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
+use colcos_sim::scenario::Scenario;
+use std::fmt::Write as _;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+#[derive(Args, Debug)]
+pub struct BridgeArgs {
+    /// Scenario file (TOML): pheromones, behaviours and the `[rig]` section.
+    pub scenario: PathBuf,
+    /// Where poses come from: swarmcon://HOST:6666, udp://HOST:PORT (JSON lines) or
+    /// replay://FILE[?speed=S|max].
+    #[arg(long)]
+    pub tracker: String,
+    /// The robots' radio link: serial:///dev/ttyUSB0?baud=115200 or udp://HOST:PORT.
+    #[arg(long)]
+    pub robots: String,
+    /// Serve the displayed frames on this address (e.g. 127.0.0.1:7700) for a twin or a viewer.
+    #[arg(long)]
+    pub frames: Option<SocketAddr>,
+    /// Width of the served frames, px.
+    #[arg(long, default_value_t = 960)]
+    pub frame_width: u32,
+    /// Served frames per second.
+    #[arg(long, default_value_t = 25.0)]
+    pub frame_rate: f64,
+    /// Stop after this many seconds (default: until Ctrl-C).
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// Output directory: rig.mcap (everything that crossed a wire), screen.png, summary.json.
+    #[arg(long, default_value = "runs/bridge")]
+    pub out: PathBuf,
+    /// No status line.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct TwinArgs {
+    /// Scenario file (TOML): the arena, robots, tracker model and `[rig]` IDs.
+    pub scenario: PathBuf,
+    /// Address of the SwarmCon position server to serve (the bridge's swarmcon://).
+    #[arg(long, default_value = "127.0.0.1:6666")]
+    pub tracker: SocketAddr,
+    /// The robots' end: udp://ADDR to listen on, or pty (prints the device the bridge opens).
+    #[arg(long, default_value = "pty")]
+    pub robots: String,
+    /// The bridge's frame stream, for colour readings from what it displays.
+    #[arg(long)]
+    pub frames: Option<SocketAddr>,
+    /// Stop after this many seconds (default: until Ctrl-C).
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// Header form of the served blocks: plain, dot or updated (CosPhi).
+    #[arg(long, default_value = "updated")]
+    pub header: String,
+    /// Allow serving on addresses other than loopback.
+    #[arg(long)]
+    pub public: bool,
+}
+
+/// A flag that Ctrl-C and SIGTERM set.
+fn stop_on_signal() -> Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let s = stop.clone();
+    ctrlc::set_handler(move || s.store(true, Ordering::Relaxed))
+        .context("installing the Ctrl-C / SIGTERM handler")?;
+    Ok(stop)
+}
+
+pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
+    let sc = Scenario::from_file(&args.scenario)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating output directory {}", args.out.display()))?;
+    let opts = SourceOptions::new(FrameTransform::new(sc.arena_size().y as f64));
+    let source = open_pose_source(&args.tracker, &opts)
+        .with_context(|| format!("--tracker {}", args.tracker))?;
+    let link =
+        open_robot_link(&args.robots).with_context(|| format!("--robots {}", args.robots))?;
+    let frames = match args.frames {
+        Some(addr) => Some(FrameServer::bind(addr).with_context(|| format!("--frames {addr}"))?),
+        None => None,
+    };
+    let log = args.out.join("rig.mcap");
+    let live_opts = LiveOptions {
+        duration: args.duration,
+        stream_width: args.frame_width.clamp(16, 7680),
+        stream_hz: if args.frame_rate.is_finite() {
+            args.frame_rate.clamp(1.0, 50.0)
+        } else {
+            25.0
+        },
+        log: Some(log.clone()),
+        status: !args.quiet,
+        ..LiveOptions::default()
+    };
+    let stop = stop_on_signal()?;
+    let report = live::run(&sc, source, link, frames, &live_opts, stop)?;
+    let summary = args.out.join("summary.json");
+    std::fs::write(&summary, serde_json::to_string_pretty(&report)?)
+        .with_context(|| format!("writing {}", summary.display()))?;
+    writeln!(
+        text,
+        "{} ticks in {:.1} s ({} overruns; tick work worst {:.2} ms, 99th percentile {:.2} ms)",
+        report.ticks, report.seconds, report.overruns, report.worst_tick_ms, report.p99_tick_ms
+    )?;
+    writeln!(
+        text,
+        "{} pose blocks, {} commands, {} telemetry frames; shield capped {} and walled {} commands; safety stops: {}",
+        report.pose_blocks,
+        report.commands_sent,
+        report.telemetry_received,
+        report.shield.capped,
+        report.shield.walled,
+        if report.stops.is_empty() {
+            "none".to_string()
+        } else {
+            report.stops.join(", ")
+        }
+    )?;
+    writeln!(text, "  wrote {}", log.display())?;
+    writeln!(text, "  wrote {}", summary.display())?;
+    Ok(())
+}
+
+pub fn twin(args: TwinArgs, text: &mut String) -> Result<()> {
+    let sc = Scenario::from_file(&args.scenario)?;
+    if !args.public && !args.tracker.ip().is_loopback() {
+        bail!(
+            "--tracker {}: not a loopback address (add --public to serve beyond this machine)",
+            args.tracker
+        );
+    }
+    let form = match args.header.as_str() {
+        "plain" => HeaderForm::Plain,
+        "dot" => HeaderForm::Dot,
+        "updated" => HeaderForm::Updated,
+        other => bail!("--header {other:?}: must be plain, dot or updated"),
+    };
+    let tracker = TrackerServer::bind(args.tracker, form)
+        .with_context(|| format!("serving the tracker on {}", args.tracker))?;
+    let channel: Box<dyn ByteChannel> = if args.robots == "pty" {
+        let pty = PtyChannel::open().context("opening a pseudo-terminal pair")?;
+        eprintln!("robots: serial://{}?baud=115200", pty.peer_path());
+        Box::new(pty)
+    } else if let Some(addr) = args.robots.strip_prefix("udp://") {
+        let parsed: SocketAddr = addr
+            .parse()
+            .with_context(|| format!("--robots {}: not an address", args.robots))?;
+        if !args.public && !parsed.ip().is_loopback() {
+            bail!(
+                "--robots {}: not a loopback address (add --public)",
+                args.robots
+            );
+        }
+        let udp = UdpChannel::bind(addr).with_context(|| format!("--robots {}", args.robots))?;
+        eprintln!("robots: udp://{}", udp.local_addr()?);
+        Box::new(udp)
+    } else {
+        bail!("--robots {:?}: must be pty or udp://ADDR", args.robots);
+    };
+    eprintln!("tracker: swarmcon://{}", tracker.local_addr());
+    let mut twin = Twin::new(&sc, tracker, channel, args.frames)?;
+    let stop = stop_on_signal()?;
+    twin.run(args.duration, &stop);
+    writeln!(
+        text,
+        "twin ran {:.1} s of {}: {} commands received",
+        twin.plant().time(),
+        args.scenario.display(),
+        twin.received().len()
+    )?;
+    Ok(())
+}
