@@ -19,6 +19,7 @@ pub mod patch;
 pub mod spaces;
 pub mod task;
 mod vec_env;
+mod world_output;
 mod world_slot;
 
 pub use backend::EnvBackend;

@@ -10,6 +10,8 @@ use crate::encoding::{self, OBS_DIM};
 use crate::error::{EnvError, Result};
 use crate::spaces::{EnvSpec, Space};
 use crate::task::{Task, registry};
+pub use crate::world_output::render_world;
+use crate::world_output::{write_obs, write_patch, write_state};
 use crate::world_slot::WorldSlot;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
@@ -584,65 +586,4 @@ fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut Out) {
     if let Some(p) = &ctx.patch {
         write_patch(&slot.world, agents, p, out.patch);
     }
-}
-
-fn write_obs(world: &World, agents: &[usize], max_speed: f32, out: &mut [f32]) {
-    let obs = world.observations();
-    for (&i, o) in agents.iter().zip(out.chunks_exact_mut(OBS_DIM)) {
-        encoding::encode(&obs[i], max_speed, o);
-    }
-}
-
-/// Global state: per robot `x / W * 2 - 1`, `y / H * 2 - 1`, `cos`, `sin` of the heading; then the
-/// episode's elapsed fraction.
-fn write_state(world: &World, steps: u64, max_cycles: u64, out: &mut [f32]) {
-    let arena = world.arena();
-    for (p, o) in world.poses().iter().zip(out.chunks_exact_mut(4)) {
-        o[0] = (2.0 * p.pos.x / arena.x - 1.0).clamp(-1.0, 1.0);
-        o[1] = (2.0 * p.pos.y / arena.y - 1.0).clamp(-1.0, 1.0);
-        o[2] = p.heading.cos();
-        o[3] = p.heading.sin();
-    }
-    if let Some(last) = out.last_mut() {
-        *last = (steps as f32 / max_cycles.max(1) as f32).min(1.0);
-    }
-}
-
-fn write_patch(world: &World, agents: &[usize], cfg: &PatchConfig, out: &mut [u8]) {
-    let len = cfg.pixels * cfg.pixels * 3;
-    let poses = world.poses();
-    for (&i, o) in agents.iter().zip(out.chunks_exact_mut(len)) {
-        crate::patch::sample(world.pheromones(), world.screen(), &poses[i], cfg, o);
-    }
-}
-
-/// Screen image with robots: agents white, scripted robots coloured by order of their role.
-pub fn render_world(world: &World, agents: &[usize], width: u32) -> image::RgbImage {
-    let screen = world.screen();
-    let width = width.max(16);
-    let height = ((width as f32 * screen.size[1] / screen.size[0]).round() as u32).max(1);
-    let mut img = colcos_sim::screen::render(world.pheromones(), screen, width, height);
-    const OTHERS: [[u8; 3]; 4] = [[255, 200, 0], [255, 0, 255], [0, 200, 255], [150, 150, 150]];
-    let mut roles: Vec<&str> = Vec::new();
-    let colours: Vec<image::Rgb<u8>> = (0..world.robot_count())
-        .map(|i| {
-            if agents.contains(&i) {
-                return image::Rgb([240, 240, 240]);
-            }
-            let role = world.role(i);
-            let k = roles.iter().position(|r| *r == role).unwrap_or_else(|| {
-                roles.push(role);
-                roles.len() - 1
-            });
-            image::Rgb(OTHERS[k % OTHERS.len()])
-        })
-        .collect();
-    colcos_sim::output::draw::robots(
-        &mut img,
-        screen,
-        world.poses(),
-        world.robot_params().radius,
-        &colours,
-    );
-    img
 }

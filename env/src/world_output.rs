@@ -1,0 +1,66 @@
+//! What a world of the batch shows its agents and users: observation rows, the global state, screen
+//! patches and the rendered screen with the robots on it.
+use crate::config::PatchConfig;
+use crate::encoding::{self, OBS_DIM};
+use colcos_sim::world::World;
+
+pub(crate) fn write_obs(world: &World, agents: &[usize], max_speed: f32, out: &mut [f32]) {
+    let obs = world.observations();
+    for (&i, o) in agents.iter().zip(out.chunks_exact_mut(OBS_DIM)) {
+        encoding::encode(&obs[i], max_speed, o);
+    }
+}
+
+/// Global state: per robot `x / W * 2 - 1`, `y / H * 2 - 1`, `cos`, `sin` of the heading; then the
+/// episode's elapsed fraction.
+pub(crate) fn write_state(world: &World, steps: u64, max_cycles: u64, out: &mut [f32]) {
+    let arena = world.arena();
+    for (p, o) in world.poses().iter().zip(out.chunks_exact_mut(4)) {
+        o[0] = (2.0 * p.pos.x / arena.x - 1.0).clamp(-1.0, 1.0);
+        o[1] = (2.0 * p.pos.y / arena.y - 1.0).clamp(-1.0, 1.0);
+        o[2] = p.heading.cos();
+        o[3] = p.heading.sin();
+    }
+    if let Some(last) = out.last_mut() {
+        *last = (steps as f32 / max_cycles.max(1) as f32).min(1.0);
+    }
+}
+
+pub(crate) fn write_patch(world: &World, agents: &[usize], cfg: &PatchConfig, out: &mut [u8]) {
+    let len = cfg.pixels * cfg.pixels * 3;
+    let poses = world.poses();
+    for (&i, o) in agents.iter().zip(out.chunks_exact_mut(len)) {
+        crate::patch::sample(world.pheromones(), world.screen(), &poses[i], cfg, o);
+    }
+}
+
+/// Screen image with robots: agents white, scripted robots coloured by order of their role.
+pub fn render_world(world: &World, agents: &[usize], width: u32) -> image::RgbImage {
+    let screen = world.screen();
+    let width = width.max(16);
+    let height = ((width as f32 * screen.size[1] / screen.size[0]).round() as u32).max(1);
+    let mut img = colcos_sim::screen::render(world.pheromones(), screen, width, height);
+    const OTHERS: [[u8; 3]; 4] = [[255, 200, 0], [255, 0, 255], [0, 200, 255], [150, 150, 150]];
+    let mut roles: Vec<&str> = Vec::new();
+    let colours: Vec<image::Rgb<u8>> = (0..world.robot_count())
+        .map(|i| {
+            if agents.contains(&i) {
+                return image::Rgb([240, 240, 240]);
+            }
+            let role = world.role(i);
+            let k = roles.iter().position(|r| *r == role).unwrap_or_else(|| {
+                roles.push(role);
+                roles.len() - 1
+            });
+            image::Rgb(OTHERS[k % OTHERS.len()])
+        })
+        .collect();
+    colcos_sim::output::draw::robots(
+        &mut img,
+        screen,
+        world.poses(),
+        world.robot_params().radius,
+        &colours,
+    );
+    img
+}
