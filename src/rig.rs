@@ -37,7 +37,7 @@ pub struct BridgeArgs {
     /// Stop after this many seconds (default: until Ctrl-C).
     #[arg(long)]
     pub duration: Option<f64>,
-    /// Output directory: rig.mcap (everything that crossed a wire), screen.png, summary.json.
+    /// Output directory: rig.mcap (everything that crossed a wire), trajectory.csv, summary.json.
     #[arg(long, default_value = "runs/bridge")]
     pub out: PathBuf,
     /// No status line.
@@ -101,6 +101,7 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
             25.0
         },
         log: Some(log.clone()),
+        trajectory: Some(args.out.join("trajectory.csv")),
         status: !args.quiet,
         ..LiveOptions::default()
     };
@@ -129,6 +130,11 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
         }
     )?;
     writeln!(text, "  wrote {}", log.display())?;
+    writeln!(
+        text,
+        "  wrote {}",
+        args.out.join("trajectory.csv").display()
+    )?;
     writeln!(text, "  wrote {}", summary.display())?;
     Ok(())
 }

@@ -84,6 +84,10 @@ impl Host {
     pub fn observations(&self) -> &[Observation] {
         self.parts.sensing.observations()
     }
+    /// Each robot's group in the scenario.
+    pub fn groups(&self) -> Vec<usize> {
+        self.parts.slots.iter().map(|s| s.group).collect()
+    }
     /// The commands the behaviours decided in the last tick.
     pub fn commands(&self) -> &[WheelCommand] {
         &self.commands

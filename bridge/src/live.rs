@@ -14,6 +14,7 @@ use crate::watchdog::{self, Heartbeats, SafetyLimits, StopReason};
 use crate::{ConnectionState, PoseSource, RobotLink};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::error::{Result, SimError};
+use colcos_sim::output::{TickRows, TrajectoryLog};
 use colcos_sim::scenario::{Firmware, Scenario};
 use colcos_sim::shield::{Shield, ShieldCounts};
 use std::path::PathBuf;
@@ -33,6 +34,8 @@ pub struct LiveOptions {
     pub stream_hz: f64,
     /// Where the rig log (MCAP) goes; None: no log.
     pub log: Option<PathBuf>,
+    /// Where the trajectory CSV goes (the simulator's columns, the tracked poses as used); None: none.
+    pub trajectory: Option<PathBuf>,
     /// Print a status line every second.
     pub status: bool,
     /// How wheel speeds become motion commands for old firmware (`[rig] firmware = "motion"`).
@@ -188,6 +191,11 @@ pub fn run(
         ),
         None => None,
     };
+    let mut trajectory = match &opts.trajectory {
+        Some(path) => Some(TrajectoryLog::create(path)?),
+        None => None,
+    };
+    let groups = host.groups();
     let start = Instant::now();
     let stopper = Stopper {
         link: Arc::new(Mutex::new(link)),
@@ -321,6 +329,7 @@ pub fn run(
         }
         // Commands out through the shield; unchanged ones again at the keep-alive rate.
         let mut link_error = None;
+        let mut sent_now = commands.clone();
         if let Ok(mut l) = link.lock() {
             for (i, cmd) in commands.iter().enumerate() {
                 let (cmd, intervention) = shield.apply(&host.poses()[i], *cmd);
@@ -330,6 +339,7 @@ pub fn run(
                 } else {
                     cmd
                 };
+                sent_now[i] = cmd;
                 let (prev, at) = last_sent[i];
                 if cmd != prev || t - at >= keepalive {
                     let packet =
@@ -357,6 +367,18 @@ pub fn run(
         }
         if let Some(e) = link_error {
             stopper.stop(&StopReason::LinkError(e));
+        }
+        if let Some(traj) = trajectory.as_mut() {
+            traj.record_rows(&TickRows {
+                tick: report.ticks,
+                time: host.time(),
+                poses: host.poses(),
+                tracked: host.tracked(),
+                obs: host.observations(),
+                commands: &sent_now,
+                groups: &groups,
+                group_specs: &scenario.spec.robots,
+            })?;
         }
         if let Ok(mut l) = log.lock()
             && let Some(r) = l.as_mut()

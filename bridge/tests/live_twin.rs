@@ -59,6 +59,7 @@ fn run_rig(
         stream_width: 480,
         stream_hz: 25.0,
         log: Some(log_path.clone()),
+        trajectory: Some(dir.path().join("trajectory.csv")),
         ..LiveOptions::default()
     };
     let stop = Arc::new(AtomicBool::new(false));
@@ -73,6 +74,14 @@ fn run_rig(
     let report = bridge.join().unwrap();
     let bridge_stopped_at = Instant::now();
     let log = read_log(&std::fs::read(&log_path).unwrap());
+    // The trajectory has the simulator's columns and one row per robot and tick.
+    let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some(colcos_sim::output::trajectory::header().as_str())
+    );
+    assert_eq!(lines.count() as u64, 5 * report.ticks);
     Rig {
         twin,
         faults,

@@ -6,4 +6,4 @@ pub mod npy;
 pub mod trajectory;
 
 pub use gif::GifRecorder;
-pub use trajectory::TrajectoryLog;
+pub use trajectory::{TickRows, TrajectoryLog};

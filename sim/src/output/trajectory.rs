@@ -80,7 +80,6 @@ impl TrajectoryLog {
 
     /// Appends one row per robot for the world's current tick and flushes them to the file.
     pub fn record(&mut self, world: &World) -> Result<()> {
-        let n = world.robot_count();
         // Taken out of `self` while the rows borrow them (writing needs `&mut self`), then put back.
         let (mut commands, mut groups) = (
             std::mem::take(&mut self.commands),
@@ -90,7 +89,7 @@ impl TrajectoryLog {
         commands.extend(world.robots().iter().map(|r| r.command));
         groups.clear();
         groups.extend(world.robots().iter().map(|r| r.group));
-        let rows = RowInputs {
+        let rows = TickRows {
             tick: world.tick(),
             time: world.time(),
             poses: world.poses(),
@@ -100,15 +99,21 @@ impl TrajectoryLog {
             groups: &groups,
             group_specs: &world.scenario().spec.robots,
         };
-        let written = self.write_rows(&rows, n);
+        let written = self.record_rows(&rows);
         (self.commands, self.groups) = (commands, groups);
-        written?;
+        written
+    }
+
+    /// Appends one row per robot of `rows` and flushes them: for a host without a simulated world
+    /// (the hardware bridge, whose `poses` are the tracked ones as it used them).
+    pub fn record_rows(&mut self, rows: &TickRows) -> Result<()> {
+        self.write_rows(rows, rows.poses.len())?;
         // Rows reach the file whole: the buffer is flushed only at a tick boundary.
         self.flush()
     }
 
     /// Formats and writes the `n` rows of one tick, in robot order.
-    fn write_rows(&mut self, rows: &RowInputs, n: usize) -> Result<()> {
+    fn write_rows(&mut self, rows: &TickRows, n: usize) -> Result<()> {
         if n < 2 * ROWS_PER_CHUNK {
             let mut text = std::mem::take(&mut self.line);
             text.clear();
@@ -138,19 +143,22 @@ impl TrajectoryLog {
 /// Robots whose rows one parallel task formats.
 const ROWS_PER_CHUNK: usize = 512;
 
-/// What the rows of one tick are made of (the world itself is not shared across threads).
-struct RowInputs<'a> {
-    tick: u64,
-    time: f32,
-    poses: &'a [crate::robot::Pose],
-    tracked: &'a [crate::tracker::TrackedPose],
-    obs: &'a [crate::behaviour::Observation],
-    commands: &'a [crate::behaviour::WheelCommand],
-    groups: &'a [usize],
-    group_specs: &'a [crate::scenario::RobotGroupSpec],
+/// What the rows of one tick are made of, one entry per robot in each slice (the world itself is not
+/// shared across the formatting threads).
+pub struct TickRows<'a> {
+    pub tick: u64,
+    /// s.
+    pub time: f32,
+    pub poses: &'a [crate::robot::Pose],
+    pub tracked: &'a [crate::tracker::TrackedPose],
+    pub obs: &'a [crate::behaviour::Observation],
+    pub commands: &'a [crate::behaviour::WheelCommand],
+    /// Each robot's group, an index into `group_specs` (its role is written).
+    pub groups: &'a [usize],
+    pub group_specs: &'a [crate::scenario::RobotGroupSpec],
 }
 
-impl RowInputs<'_> {
+impl TickRows<'_> {
     /// Appends robot `i`'s row, newline included.
     fn push_row(&self, l: &mut String, i: usize) {
         let (p, t, o, cmd) = (
