@@ -131,6 +131,35 @@ fn case_two_drives_the_twin_over_udp() {
         let moved = twin.plant().poses()[i].pos.distance(start_poses[i].pos);
         assert!(moved > 0.02, "robot {id} moved only {moved} m");
     }
+    // S(t) of eq. (9), the followers' summed distance to the leader: the robots on the twin aggregate
+    // as in the pure simulation. They differ by the latency the rig adds (tracker 40 ms + a block
+    // period + a tick, ~0.1 s of a robot's 8 cm/s) and by their random streams, so only the trend and
+    // the rough amount are compared.
+    let s_of = |poses: &[colcos_sim::robot::Pose]| {
+        let pos: Vec<_> = poses.iter().map(|p| p.pos).collect();
+        colcos_sim::metrics::sum_distance_of(&pos, 0, &[1, 2, 3])
+    };
+    let mut sim = colcos_sim::world::World::new(&scenario()).unwrap();
+    // The twin ran on a second after the bridge stopped its robots.
+    let steps = (r.seconds / sim.dt() as f64).round() as usize;
+    for _ in 0..steps {
+        sim.step();
+    }
+    let (s0, s_sim, s_twin) = (
+        s_of(&start_poses),
+        s_of(sim.poses()),
+        s_of(twin.plant().poses()),
+    );
+    let (r_sim, r_twin) = (s_sim / s0, s_twin / s0);
+    eprintln!(
+        "S(t)/S(0) after {:.1} s: simulation {r_sim:.3}, twin {r_twin:.3}",
+        r.seconds
+    );
+    assert!(
+        r_twin < 1.0 && r_sim < 1.0,
+        "no aggregation: sim {r_sim}, twin {r_twin}"
+    );
+    assert!((r_sim - r_twin).abs() < 0.15, "sim {r_sim}, twin {r_twin}");
     // The last thing sent is the exit guard's broadcast stop, and the twin's robots obey it.
     let last = received.last().unwrap().packet;
     assert_eq!(last.id, BROADCAST_ID);
