@@ -297,3 +297,59 @@ fn stream_faults_do_not_stop_the_loop() {
     let worst = ages.iter().copied().fold(0.0, f64::max);
     assert!(worst < 0.5, "a pose {worst} s old");
 }
+
+/// A robot the camera loses (its slot goes stale): that robot alone is stopped within the pose-age
+/// limit plus 50 ms; the others keep driving.
+#[test]
+fn a_lost_robot_alone_is_stopped_in_time() {
+    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let hidden_at = Arc::new(Mutex::new(None));
+    let h = hidden_at.clone();
+    let rig = run_rig(Box::new(channel), url, 3.0, move |faults| {
+        std::thread::sleep(Duration::from_millis(1500));
+        faults.lock().unwrap().hidden = vec![2];
+        *h.lock().unwrap() = Some(Instant::now());
+    });
+    let twin = rig.twin.join().unwrap();
+    let hidden_at = hidden_at.lock().unwrap().unwrap();
+    // Tracker ID 2 is the third robot, radio address 3.
+    let stop = twin
+        .received()
+        .iter()
+        .find(|c| {
+            c.at > hidden_at
+                && c.packet.id == 3
+                && wheel_speeds(&c.packet.command) == Some((0.0, 0.0))
+        })
+        .expect("a stop for the lost robot");
+    let delay = stop.at.duration_since(hidden_at).as_secs_f64();
+    let limit = scenario().spec.rig.pose_age as f64;
+    assert!(
+        rig.report.stops.contains(&"pose_stale".to_string()),
+        "{:?}",
+        rig.report
+    );
+    assert!(
+        !rig.report.stops.iter().any(|s| s != "pose_stale"),
+        "{:?}",
+        rig.report
+    );
+    // The last fresh pose may be up to a block period (40 ms) older than the moment it was hidden.
+    assert!(
+        delay <= limit + 0.05,
+        "stopped {delay:.3} s after it was lost (limit {limit} s + 50 ms)"
+    );
+    let moving_after = |id: u8| {
+        twin.received()
+            .iter()
+            .filter(|c| c.at > stop.at && rig.bridge_stopped_at > c.at && c.packet.id == id)
+            .filter_map(|c| wheel_speeds(&c.packet.command))
+            .any(|(l, r)| l != 0.0 || r != 0.0)
+    };
+    assert!(!moving_after(3), "the lost robot was driven again");
+    assert!(
+        [1, 2, 4, 5].iter().all(|&id| moving_after(id)),
+        "the others stopped too"
+    );
+}

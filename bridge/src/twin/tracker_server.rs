@@ -11,8 +11,11 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 /// Faults the twin's tracker can play, switchable while it runs.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TrackerFaults {
+    /// Marker IDs the camera no longer sees: their slots repeat the last pose with its old time, as
+    /// the server does for a lost robot.
+    pub hidden: Vec<i32>,
     /// Send nothing (the camera or the server hangs).
     pub silent: bool,
     /// Write each block in pieces of this many bytes (0: whole), so a read holds part of a block.
@@ -33,6 +36,8 @@ pub struct TrackerServer {
     held: Vec<u8>,
     held_blocks: usize,
     form: HeaderForm,
+    /// The last pose and time sent for each marker, repeated while it is hidden.
+    last: std::collections::HashMap<i32, (f64, f64, f64, Option<i64>)>,
     /// Calibrate commands received (their raw lines).
     received: Arc<Mutex<Vec<String>>>,
 }
@@ -58,6 +63,7 @@ impl TrackerServer {
             held: Vec::new(),
             held_blocks: 0,
             form,
+            last: Default::default(),
             received,
         })
     }
@@ -80,7 +86,7 @@ impl TrackerServer {
     /// Sends one block: `poses` are (marker id, x, y, yaw_deg, last seen µs or `None` if never) in the
     /// tracker's frame, `t_us` the frame time.
     pub fn publish(&mut self, t_us: i64, poses: &[(i32, f64, f64, f64, Option<i64>)]) {
-        let faults = self.faults.lock().map(|f| *f).unwrap_or_default();
+        let faults = self.faults.lock().map(|f| f.clone()).unwrap_or_default();
         if faults.silent {
             return;
         }
@@ -89,6 +95,12 @@ impl TrackerServer {
         let robots: Vec<SlotPose> = poses
             .iter()
             .map(|&(id, x, y, yaw_deg, seen)| {
+                let (x, y, yaw_deg, seen) = if faults.hidden.contains(&id) {
+                    *self.last.entry(id).or_insert((x, y, yaw_deg, seen))
+                } else {
+                    self.last.insert(id, (x, y, yaw_deg, seen));
+                    (x, y, yaw_deg, seen)
+                };
                 let last_seen_us = seen.map(shift).unwrap_or(-1);
                 SlotPose {
                     id,
