@@ -57,6 +57,8 @@ pub struct LiveReport {
     pub stops: Vec<String>,
     pub commands_sent: u64,
     pub telemetry_received: u64,
+    /// Robots (radio addresses) that stopped answering data requests, in the order they fell silent.
+    pub silent_robots: Vec<u8>,
     /// Tracker blocks taken.
     pub pose_blocks: u64,
 }
@@ -243,6 +245,11 @@ pub fn run(
     let mut tick_ms: Vec<f64> = Vec::new();
     let (mut next_telemetry, mut telemetry_robot) = (0.0, 0usize);
     let mut next_frame = 0.0;
+    // Each robot is asked every `n / telemetry_hz` s; five missed answers (at least a second) mean it
+    // is gone.
+    let answer_timeout = (5.0 * telemetry_every * n as f64).max(1.0);
+    let mut answered: Vec<Option<f64>> = vec![None; n];
+    let mut silent = vec![false; n];
     let (mut last_tick, mut next, mut last_status) = (start, start, start);
     loop {
         let now = Instant::now();
@@ -296,9 +303,26 @@ pub fn run(
             report.telemetry_received += 1;
             record(log, Topic::Telemetry, &tm.to_frame());
             if let Some(i) = radio.iter().position(|&r| r == tm.id) {
+                answered[i] = Some(t);
+                silent[i] = false;
                 let bumpers =
                     std::array::from_fn(|k| bumper_reading(tm.tcrt_on[k], tm.tcrt_off[k]));
                 host.set_readings(i, colour_to_sim(tm.colour), bumpers);
+            }
+        }
+        // A robot that has answered before and not for `answer_timeout`: its radio is gone, so it can
+        // no longer be stopped from here (its firmware's timeout must); said once, in the log and the
+        // report, and its readings are no longer trusted.
+        for i in 0..n {
+            if let Some(at) = answered[i]
+                && !silent[i]
+                && t - at > answer_timeout
+            {
+                silent[i] = true;
+                report.silent_robots.push(radio[i]);
+                let event = serde_json::json!({"kind": "robot_silent", "robot": i, "detail": format!("radio {} has not answered for {:.2} s", radio[i], t - at)});
+                record(log, Topic::Events, event.to_string().as_bytes());
+                log::warn!("robot {i} (radio {}) stopped answering", radio[i]);
             }
         }
         // Fields, injection, sensing, decisions, on the measured time since the last tick.
@@ -334,7 +358,7 @@ pub fn run(
             for (i, cmd) in commands.iter().enumerate() {
                 let (cmd, intervention) = shield.apply(&host.poses()[i], *cmd);
                 report.shield.add(intervention);
-                let cmd = if beats.is_stopped(i) || !host.tracked()[i].seen {
+                let cmd = if beats.is_stopped(i) || !host.tracked()[i].seen || silent[i] {
                     WheelCommand::STOP
                 } else {
                     cmd

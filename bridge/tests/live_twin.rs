@@ -7,7 +7,7 @@ use colcos_bridge::live::{self, LiveOptions, LiveReport};
 use colcos_bridge::recorder::{Topic, read_log};
 use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
 use colcos_bridge::twin::{
-    ByteChannel, PtyChannel, TrackerFaults, TrackerServer, Twin, UdpChannel,
+    ByteChannel, PtyChannel, RobotFaults, TrackerFaults, TrackerServer, Twin, UdpChannel,
 };
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::scenario::Scenario;
@@ -34,7 +34,7 @@ fn run_rig(
     channel: Box<dyn ByteChannel>,
     link_url: String,
     seconds: f64,
-    during: impl FnOnce(&Arc<Mutex<TrackerFaults>>),
+    during: impl FnOnce(&Arc<Mutex<TrackerFaults>>, &Arc<Mutex<RobotFaults>>),
 ) -> Rig {
     // One rig at a time: the timing bounds hold for a loop that has a core, not for four at once.
     static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
@@ -46,6 +46,7 @@ fn run_rig(
     let frames_addr = frames.local_addr();
     let mut twin = Twin::new(&sc, tracker, channel, Some(frames_addr)).unwrap();
     let faults = twin.tracker().faults();
+    let robot_faults = twin.robots().faults.clone();
     let twin_stop = Arc::new(AtomicBool::new(false));
     let ts = twin_stop.clone();
     let twin = std::thread::spawn(move || {
@@ -73,7 +74,7 @@ fn run_rig(
             live::run(&sc, source, link, Some(frames), &live_opts, stop).unwrap()
         })
     };
-    during(&faults);
+    during(&faults, &robot_faults);
     let report = bridge.join().unwrap();
     let bridge_stopped_at = Instant::now();
     let log = read_log(&std::fs::read(&log_path).unwrap());
@@ -112,7 +113,7 @@ fn case_two_drives_the_twin_over_udp() {
         let sc = scenario();
         colcos_sim::world::World::new(&sc).unwrap().poses().to_vec()
     };
-    let rig = run_rig(Box::new(channel), url, 4.0, |_| {});
+    let rig = run_rig(Box::new(channel), url, 4.0, |_, _| {});
     let twin = rig.twin.join().unwrap();
     let r = &rig.report;
     assert!(r.ticks >= 150, "{r:?}");
@@ -195,7 +196,7 @@ fn case_two_drives_the_twin_over_udp() {
 fn the_serial_link_drives_the_twin_over_a_pty() {
     let channel = PtyChannel::open().unwrap();
     let url = format!("serial://{}?baud=115200", channel.peer_path());
-    let rig = run_rig(Box::new(channel), url, 2.0, |_| {});
+    let rig = run_rig(Box::new(channel), url, 2.0, |_, _| {});
     let twin = rig.twin.join().unwrap();
     let driven = twin
         .received()
@@ -219,7 +220,7 @@ fn tracker_silence_stops_every_robot_in_time() {
     let url = format!("udp://{}", channel.local_addr().unwrap());
     let silent_at = Arc::new(Mutex::new(None));
     let s = silent_at.clone();
-    let rig = run_rig(Box::new(channel), url, 3.0, move |faults| {
+    let rig = run_rig(Box::new(channel), url, 3.0, move |faults, _| {
         std::thread::sleep(Duration::from_millis(1500));
         faults.lock().unwrap().silent = true;
         *s.lock().unwrap() = Some(Instant::now());
@@ -260,7 +261,7 @@ fn tracker_silence_stops_every_robot_in_time() {
 fn stream_faults_do_not_stop_the_loop() {
     let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
     let url = format!("udp://{}", channel.local_addr().unwrap());
-    let rig = run_rig(Box::new(channel), url, 3.0, |faults| {
+    let rig = run_rig(Box::new(channel), url, 3.0, |faults, _| {
         let mut f = faults.lock().unwrap();
         f.split = 7;
         f.merge = 2;
@@ -306,7 +307,7 @@ fn a_lost_robot_alone_is_stopped_in_time() {
     let url = format!("udp://{}", channel.local_addr().unwrap());
     let hidden_at = Arc::new(Mutex::new(None));
     let h = hidden_at.clone();
-    let rig = run_rig(Box::new(channel), url, 3.0, move |faults| {
+    let rig = run_rig(Box::new(channel), url, 3.0, move |faults, _| {
         std::thread::sleep(Duration::from_millis(1500));
         faults.lock().unwrap().hidden = vec![2];
         *h.lock().unwrap() = Some(Instant::now());
@@ -351,5 +352,29 @@ fn a_lost_robot_alone_is_stopped_in_time() {
     assert!(
         [1, 2, 4, 5].iter().all(|&id| moving_after(id)),
         "the others stopped too"
+    );
+}
+
+/// A robot whose radio goes quiet (it neither obeys nor answers): the bridge notices within about a
+/// second of unanswered data requests, says so, and sends it nothing but stops from then on.
+#[test]
+fn a_robot_that_stops_answering_is_reported() {
+    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let rig = run_rig(Box::new(channel), url, 3.0, |_, robots| {
+        std::thread::sleep(Duration::from_millis(1000));
+        robots.lock().unwrap().deaf = vec![4];
+    });
+    let _twin = rig.twin.join().unwrap();
+    assert_eq!(rig.report.silent_robots, vec![4], "{:?}", rig.report);
+    let events: Vec<String> = rig
+        .log
+        .iter()
+        .filter(|m| m.topic == Topic::Events)
+        .map(|m| String::from_utf8_lossy(&m.data).to_string())
+        .collect();
+    assert!(
+        events.iter().any(|e| e.contains("robot_silent")),
+        "{events:?}"
     );
 }

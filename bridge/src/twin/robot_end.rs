@@ -131,7 +131,8 @@ pub struct RobotEnd {
     payloads: Vec<[u8; COMMAND_LEN]>,
     /// Radio ID of each robot, in scenario order.
     radio: Vec<u8>,
-    pub faults: RobotFaults,
+    /// The faults, shared so they can be switched while the twin runs.
+    pub faults: std::sync::Arc<std::sync::Mutex<RobotFaults>>,
     /// Every command received, in order.
     pub log: Vec<Received>,
     /// Payloads that were framed right but did not decode.
@@ -146,7 +147,7 @@ impl RobotEnd {
             bytes: Vec::new(),
             payloads: Vec::new(),
             radio,
-            faults: RobotFaults::default(),
+            faults: Default::default(),
             log: Vec::new(),
             rejected: 0,
         }
@@ -164,6 +165,7 @@ impl RobotEnd {
         self.payloads.clear();
         self.decoder.feed_into(&self.bytes, &mut self.payloads);
         let payloads = std::mem::take(&mut self.payloads);
+        let faults = self.faults.lock().map(|f| f.clone()).unwrap_or_default();
         for p in &payloads {
             let Ok(packet) = CommandPacket::decode(p) else {
                 self.rejected += 1;
@@ -184,7 +186,7 @@ impl RobotEnd {
                     .collect()
             };
             for i in targets {
-                if self.faults.deaf.contains(&self.radio[i]) {
+                if faults.deaf.contains(&self.radio[i]) {
                     continue;
                 }
                 match packet.command {
@@ -195,7 +197,7 @@ impl RobotEnd {
                     HostCommand::RequestTelemetry(n) => {
                         for _ in 0..n.min(MAX_REQUEST) {
                             let t = self.telemetry(plant, i, frame);
-                            if self.faults.garbage {
+                            if faults.garbage {
                                 self.channel.send(&[0xFE, 0x01, 0x00, 0x01]);
                             }
                             self.channel.send(&t.to_frame());
