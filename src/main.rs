@@ -173,8 +173,20 @@ fn run_command(command: Command, text: &mut String) -> Result<()> {
             Ok(())
         }
         Command::Behaviours => {
-            for (name, about) in colcos::sim::behaviour::registry::list() {
-                writeln!(text, "{name:10} {about}")?;
+            use colcos::sim::behaviour::registry;
+            writeln!(
+                text,
+                "A robot group names one with `behaviour = \"NAME\"` and sets its keys in `params = {{ ... }}`."
+            )?;
+            for (name, about) in registry::list() {
+                writeln!(text, "\n{name}: {about}")?;
+                for p in registry::params(name).unwrap_or_default() {
+                    writeln!(
+                        text,
+                        "  {:18} {:24} default {:6} {}",
+                        p.name, p.ty, p.default, p.meaning
+                    )?;
+                }
             }
             Ok(())
         }

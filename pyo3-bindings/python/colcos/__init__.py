@@ -43,6 +43,7 @@ __all__ = [
     "ScenarioError",
     "StateError",
     "TaskError",
+    "behaviour_params",
     "behaviours",
     "default_scenario",
     "discrete_actions",
@@ -60,5 +61,20 @@ def tasks() -> dict[str, str]:
 
 
 def behaviours() -> dict[str, str]:
-    """Every hand-written behaviour (usable with `colcos.baselines.Baseline`): name -> description."""
+    """Every hand-written behaviour (usable with `colcos.baselines.Baseline`): name -> description.
+
+    `behaviour_params(name)` lists the parameters of each.
+    """
     return dict(_core.behaviours())
+
+
+def behaviour_params(name: str) -> list[dict[str, str]]:
+    """The keys of behaviour `name`'s `params`, as `colcos behaviours` prints them: one dict per key
+    with `name`, `type` (TOML type, unit and allowed range), `default` (as TOML) and `meaning`.
+
+    Raises `TaskError` for an unknown behaviour.
+    """
+    return [
+        {"name": key, "type": ty, "default": default, "meaning": meaning}
+        for key, ty, default, meaning in _core.behaviour_params(name)
+    ]

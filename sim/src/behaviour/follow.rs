@@ -1,11 +1,12 @@
 //! Trail following: steer toward the side whose colour sensor sees more of one channel; wander when
 //! off the trail.
+use super::registry::ParamDoc;
 use super::{Behaviour, Observation, Wander, WheelCommand};
 use crate::rng::SimRng;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Parameters of [`Follow`] as written in a scenario's `params` table.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FollowParams {
     /// Channel to follow: "r", "g" or "b".
@@ -27,6 +28,36 @@ impl Default for FollowParams {
             threshold: 0.05,
         }
     }
+}
+
+impl FollowParams {
+    /// Every key of the `params` table of `follow`, as `colcos behaviours` prints it.
+    pub const DOCS: &'static [ParamDoc] = &[
+        ParamDoc {
+            name: "channel",
+            ty: "string",
+            default: "\"b\"",
+            meaning: "colour channel of the trail to follow: \"r\", \"g\" or \"b\"",
+        },
+        ParamDoc {
+            name: "speed",
+            ty: "float, m/s, >= 0",
+            default: "0.1",
+            meaning: "base wheel speed on the trail, and the wandering speed off it",
+        },
+        ParamDoc {
+            name: "sensitivity",
+            ty: "float, m/s",
+            default: "0.6",
+            meaning: "wheel speed difference per unit of left-right intensity difference",
+        },
+        ParamDoc {
+            name: "threshold",
+            ty: "float, 0..1, >= 0",
+            default: "0.05",
+            meaning: "mean intensity of the channel below which the robot is off the trail and wanders",
+        },
+    ];
 }
 
 /// Parses "r" / "g" / "b" into a channel index.

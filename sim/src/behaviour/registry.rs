@@ -1,54 +1,106 @@
 //! Behaviours by name, as scenario files refer to them. Every behaviour reads its parameters from the
 //! group's `params` table and rejects unknown keys.
 use super::follow::{FollowParams, channel_index};
+use super::paper::{FollowerParams, ForagingParams, LeaderParams};
 use super::{Avoid, Behaviour, Follow, Wander};
 use crate::error::{Result, SimError};
 use crate::robot::ColiasParams;
 use crate::scenario::RobotGroupSpec;
-use serde::Deserialize;
 use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
 
 /// Builds a behaviour from its `params` table (`key` names it in errors) for a robot with `robot`'s
 /// body (a behaviour that turns at a set yaw rate needs its wheel base).
 type Builder = fn(&toml::Table, &str, &ColiasParams) -> Result<Box<dyn Behaviour>>;
 
-/// Every registered behaviour: name, one-line description, builder.
-const REGISTRY: &[(&str, &str, Builder)] = &[
-    (
-        "wander",
-        "correlated random walk (bumps into things)",
-        build_wander,
-    ),
-    (
-        "avoid",
-        "random walk with a sharp turn on a bumper hit",
-        build_avoid,
-    ),
-    (
-        "follow",
-        "follow a colour trail (left/right sensor difference), wander off it, avoid on a bump",
-        build_follow,
-    ),
-    (
-        "forage",
-        "paper Algorithm 1: follow LAP/SAP trails by eq. (7), cyan 70 % at bifurcations, avoid SRP",
-        build_forage,
-    ),
-    (
-        "aggregation_leader",
-        "paper Algorithm 2: flee down the ALP gradient by eq. (8), else wander",
-        build_aggregation_leader,
-    ),
-    (
-        "aggregation_follower",
-        "paper Algorithm 3: flee the ALP, else climb the AGP gradient by eq. (8), else wander",
-        build_aggregation_follower,
-    ),
+/// One key of a behaviour's `params` table, for `colcos behaviours` and `colcos.behaviour_params()`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ParamDoc {
+    pub name: &'static str,
+    /// TOML type, unit and allowed range.
+    pub ty: &'static str,
+    /// The value used when the key is left out, as TOML.
+    pub default: &'static str,
+    pub meaning: &'static str,
+}
+
+/// A registered behaviour.
+struct Entry {
+    name: &'static str,
+    about: &'static str,
+    build: Builder,
+    params: &'static [ParamDoc],
+    /// The defaults of `params` as a table (what the behaviour reads when the table is empty).
+    defaults: fn() -> toml::Table,
+}
+
+fn table_of<T: Default + Serialize>() -> toml::Table {
+    toml::Table::try_from(T::default()).unwrap_or_default()
+}
+
+/// Every registered behaviour.
+const REGISTRY: &[Entry] = &[
+    Entry {
+        name: "wander",
+        about: "correlated random walk (bumps into things)",
+        build: build_wander,
+        params: WanderParams::DOCS,
+        defaults: table_of::<WanderParams>,
+    },
+    Entry {
+        name: "avoid",
+        about: "random walk with a sharp turn on a bumper hit",
+        build: build_avoid,
+        params: WanderParams::DOCS,
+        defaults: table_of::<WanderParams>,
+    },
+    Entry {
+        name: "follow",
+        about: "follow a colour trail (left/right sensor difference), wander off it, avoid on a bump",
+        build: build_follow,
+        params: FollowParams::DOCS,
+        defaults: table_of::<FollowParams>,
+    },
+    Entry {
+        name: "forage",
+        about: "paper Algorithm 1: follow LAP/SAP trails by eq. (7), cyan 70 % at bifurcations, avoid SRP",
+        build: build_forage,
+        params: ForagingParams::DOCS,
+        defaults: table_of::<ForagingParams>,
+    },
+    Entry {
+        name: "aggregation_leader",
+        about: "paper Algorithm 2: flee down the ALP gradient by eq. (8), else wander",
+        build: build_aggregation_leader,
+        params: LeaderParams::DOCS,
+        defaults: table_of::<LeaderParams>,
+    },
+    Entry {
+        name: "aggregation_follower",
+        about: "paper Algorithm 3: flee the ALP, else climb the AGP gradient by eq. (8), else wander",
+        build: build_aggregation_follower,
+        params: FollowerParams::DOCS,
+        defaults: table_of::<FollowerParams>,
+    },
 ];
 
 /// Names and descriptions of all behaviours.
 pub fn list() -> impl Iterator<Item = (&'static str, &'static str)> {
-    REGISTRY.iter().map(|(n, d, _)| (*n, *d))
+    REGISTRY.iter().map(|e| (e.name, e.about))
+}
+
+/// The keys of behaviour `name`'s `params` table with type, default and meaning (`None`: no such
+/// behaviour).
+pub fn params(name: &str) -> Option<&'static [ParamDoc]> {
+    REGISTRY.iter().find(|e| e.name == name).map(|e| e.params)
+}
+
+/// The default `params` table of behaviour `name`: every key it reads, at its default.
+pub fn default_params(name: &str) -> Option<toml::Table> {
+    REGISTRY
+        .iter()
+        .find(|e| e.name == name)
+        .map(|e| (e.defaults)())
 }
 
 /// Builds behaviour `name` from its parameter table for a robot with the default Colias body; `key` is
@@ -74,10 +126,10 @@ pub fn build_with(
     key: &str,
     robot: &ColiasParams,
 ) -> Result<Box<dyn Behaviour>> {
-    match REGISTRY.iter().find(|(n, _, _)| *n == name) {
-        Some((_, _, builder)) => builder(params, key, robot),
+    match REGISTRY.iter().find(|e| e.name == name) {
+        Some(entry) => (entry.build)(params, key, robot),
         None => {
-            let known: Vec<_> = REGISTRY.iter().map(|(n, _, _)| *n).collect();
+            let known: Vec<_> = REGISTRY.iter().map(|e| e.name).collect();
             Err(SimError::invalid(
                 format!("{key}.behaviour"),
                 format!("{name:?}"),
@@ -101,11 +153,21 @@ pub fn parse_params<T: DeserializeOwned>(params: &toml::Table, key: &str) -> Res
     })
 }
 
-#[derive(Deserialize)]
+/// Parameters of `wander` and `avoid`.
+#[derive(Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 struct WanderParams {
     /// Forward speed, m/s.
     speed: f32,
+}
+
+impl WanderParams {
+    const DOCS: &'static [ParamDoc] = &[ParamDoc {
+        name: "speed",
+        ty: "float, m/s, >= 0",
+        default: "0.1",
+        meaning: "mean wheel speed of the random walk",
+    }];
 }
 
 impl Default for WanderParams {
@@ -175,7 +237,7 @@ fn build_forage(
     key: &str,
     robot: &ColiasParams,
 ) -> Result<Box<dyn Behaviour>> {
-    let p: super::paper::ForagingParams = parse_params(params, key)?;
+    let p: ForagingParams = parse_params(params, key)?;
     p.validate(key)?;
     let mut forage = super::paper::Foraging::new(p);
     forage.wheel_base = robot.wheel_base;
@@ -187,7 +249,7 @@ fn build_aggregation_leader(
     key: &str,
     _: &ColiasParams,
 ) -> Result<Box<dyn Behaviour>> {
-    let p: super::paper::LeaderParams = parse_params(params, key)?;
+    let p: LeaderParams = parse_params(params, key)?;
     Ok(Box::new(super::paper::Leader::new(p.validate(key)?)))
 }
 
@@ -196,6 +258,64 @@ fn build_aggregation_follower(
     key: &str,
     _: &ColiasParams,
 ) -> Result<Box<dyn Behaviour>> {
-    let p: super::paper::FollowerParams = parse_params(params, key)?;
+    let p: FollowerParams = parse_params(params, key)?;
     Ok(Box::new(super::paper::Follower::new(p.validate(key)?)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn documented_defaults(docs: &[ParamDoc]) -> toml::Table {
+        docs.iter()
+            .map(|d| {
+                let v: toml::Table = toml::from_str(&format!("v = {}", d.default))
+                    .unwrap_or_else(|e| panic!("default of `{}` is not TOML: {e}", d.name));
+                (d.name.to_string(), v["v"].clone())
+            })
+            .collect()
+    }
+
+    /// Every key a behaviour reads is documented, with its true default, and nothing else is.
+    #[test]
+    fn params_are_documented_with_their_defaults() {
+        for entry in REGISTRY {
+            let name = entry.name;
+            let documented = documented_defaults(entry.params);
+            let actual = (entry.defaults)();
+            assert!(!actual.is_empty(), "{name}: no parameters serialised");
+            let doc_keys: Vec<_> = documented.keys().collect();
+            let keys: Vec<_> = actual.keys().collect();
+            assert_eq!(
+                doc_keys, keys,
+                "{name}: documented keys vs the params struct"
+            );
+            for (k, v) in &actual {
+                let doc = &documented[k];
+                let same = match (
+                    v.as_float(),
+                    doc.as_float().or(doc.as_integer().map(|i| i as f64)),
+                ) {
+                    (Some(a), Some(b)) => (a - b).abs() <= 1e-6 * a.abs().max(1.0),
+                    _ => v == doc,
+                };
+                assert!(same, "{name}.{k}: default {v} but documented as {doc}");
+            }
+            build(name, &documented, "robots[0]")
+                .unwrap_or_else(|e| panic!("{name} with every documented key: {e}"));
+            let mut extra = documented.clone();
+            extra.insert("not_a_parameter".into(), toml::Value::Float(1.0));
+            assert!(
+                build(name, &extra, "robots[0]").is_err(),
+                "{name} accepts an undocumented key"
+            );
+            for d in entry.params {
+                assert!(
+                    !d.ty.is_empty() && !d.meaning.is_empty(),
+                    "{name}.{}",
+                    d.name
+                );
+            }
+        }
+    }
 }

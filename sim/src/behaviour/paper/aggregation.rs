@@ -13,6 +13,7 @@
 //! Directions come from eq. (6) ([`Observation::gradient_direction`]); see the parent module for the
 //! sign of eq. (8).
 use super::{GREEN, RED, check, eq8, wrap_angle};
+use crate::behaviour::registry::ParamDoc;
 use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
 use crate::error::Result;
 use crate::rng::SimRng;
@@ -83,6 +84,34 @@ pub struct AggregationParams {
 }
 
 impl LeaderParams {
+    /// Every key of the `params` table of `aggregation_leader`, as `colcos behaviours` prints it.
+    pub const DOCS: &'static [ParamDoc] = &[
+        ParamDoc {
+            name: "speed",
+            ty: "float, m/s, >= 0",
+            default: "0.1",
+            meaning: "base speed v_b of eq. (8) when fleeing",
+        },
+        ParamDoc {
+            name: "wander_speed",
+            ty: "float, m/s, >= 0",
+            default: "0.03",
+            meaning: "wandering speed",
+        },
+        ParamDoc {
+            name: "sensitivity",
+            ty: "float, m/s per rad, >= 0",
+            default: "0.03",
+            meaning: "p of eq. (8)",
+        },
+        ParamDoc {
+            name: "alarm_threshold",
+            ty: "float, 0..1, >= 0",
+            default: "0.05",
+            meaning: "mean red intensity above which the robot senses the ALP and flees it",
+        },
+    ];
+
     pub fn validate(&self, key: &str) -> Result<AggregationParams> {
         check(key, "speed", self.speed, 0.0)?;
         check(key, "wander_speed", self.wander_speed, 0.0)?;
@@ -99,6 +128,40 @@ impl LeaderParams {
 }
 
 impl FollowerParams {
+    /// Every key of the `params` table of `aggregation_follower`, as `colcos behaviours` prints it.
+    pub const DOCS: &'static [ParamDoc] = &[
+        ParamDoc {
+            name: "speed",
+            ty: "float, m/s, >= 0",
+            default: "0.08",
+            meaning: "base speed v_b of eq. (8)",
+        },
+        ParamDoc {
+            name: "wander_speed",
+            ty: "float, m/s, >= 0",
+            default: "0.05",
+            meaning: "wandering speed",
+        },
+        ParamDoc {
+            name: "sensitivity",
+            ty: "float, m/s per rad, >= 0",
+            default: "0.03",
+            meaning: "p of eq. (8)",
+        },
+        ParamDoc {
+            name: "alarm_threshold",
+            ty: "float, 0..1, >= 0",
+            default: "0.05",
+            meaning: "mean red intensity above which the robot senses the ALP and flees it",
+        },
+        ParamDoc {
+            name: "attract_threshold",
+            ty: "float, 0..1, >= 0",
+            default: "0.01",
+            meaning: "mean green intensity above which the robot senses the AGP and climbs it",
+        },
+    ];
+
     pub fn validate(&self, key: &str) -> Result<AggregationParams> {
         check(key, "speed", self.speed, 0.0)?;
         check(key, "wander_speed", self.wander_speed, 0.0)?;

@@ -48,6 +48,7 @@
 //! the trail, turns away from the chosen side when that sensor leaves the trail and toward it when the
 //! front sensor does. No new bifurcation is detected while committed.
 use super::{BLUE, GREEN, RED, SENSOR_FRONT, SENSOR_LEFT, SENSOR_RIGHT, check, eq7};
+use crate::behaviour::registry::ParamDoc;
 use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
 use crate::error::Result;
 use crate::rng::SimRng;
@@ -98,6 +99,64 @@ impl Default for ForagingParams {
 }
 
 impl ForagingParams {
+    /// Every key of the `params` table of `forage`, as `colcos behaviours` prints it.
+    pub const DOCS: &'static [ParamDoc] = &[
+        ParamDoc {
+            name: "speed",
+            ty: "float, m/s, >= 0",
+            default: "0.1",
+            meaning: "base speed v_b of eq. (7), also the wandering speed",
+        },
+        ParamDoc {
+            name: "sensitivity",
+            ty: "float, m/s, >= 0",
+            default: "0.03",
+            meaning: "p of eq. (7): wheel speed difference per unit of left-right intensity difference",
+        },
+        ParamDoc {
+            name: "threshold",
+            ty: "float, 0..1, >= 0",
+            default: "0.3",
+            meaning: "calibrated intensity above which a sensor counts as on a pheromone",
+        },
+        ParamDoc {
+            name: "cyan_probability",
+            ty: "float, 0..=1",
+            default: "0.7",
+            meaning: "probability of taking the cyan branch at a cyan/blue bifurcation",
+        },
+        ParamDoc {
+            name: "commit_time",
+            ty: "float, s, >= 0",
+            default: "1.0",
+            meaning: "how long the robot keeps to the branch it chose",
+        },
+        ParamDoc {
+            name: "damping",
+            ty: "float, s, >= 0",
+            default: "0.3",
+            meaning: "eq. (7) acts on e + damping * de/dt (0: eq. (7) as printed)",
+        },
+        ParamDoc {
+            name: "turn_angle",
+            ty: "float, degrees, >= 0",
+            default: "35.0",
+            meaning: "angle of the turn into the chosen branch (the fork's half-angle)",
+        },
+        ParamDoc {
+            name: "turn_rate",
+            ty: "float, rad/s, >= 0.001",
+            default: "3.0",
+            meaning: "yaw rate of that turn",
+        },
+        ParamDoc {
+            name: "commit_speed",
+            ty: "float, >= 0",
+            default: "0.5",
+            meaning: "forward speed during that turn, as a fraction of speed",
+        },
+    ];
+
     /// Checks every value; `key` is the scenario key path of the group (for errors).
     pub fn validate(&self, key: &str) -> Result<()> {
         check(key, "speed", self.speed, 0.0)?;
