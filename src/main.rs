@@ -34,8 +34,9 @@ enum Command {
         /// Override the scenario's duration, s.
         #[arg(long)]
         duration: Option<f32>,
-        /// Worker threads (default: all cores). Results do not depend on it.
-        #[arg(long)]
+        /// Worker threads, 1 to 1024 (default: all cores). Results do not depend on it.
+        // 0 would silently mean "all cores"; beyond 1024 each thread's stack only costs memory.
+        #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
         threads: Option<usize>,
         /// No progress bar.
         #[arg(long)]

@@ -7,8 +7,9 @@ use serde::{Deserialize, Serialize};
 
 /// The display panel: resolution in pixels and physical size in metres. Pixel row 0 is at the top
 /// (`y = height`), as in images.
+/// A `[screen]` table that gives only one key takes the default (the paper's panel) for the other.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct ScreenSpec {
     pub resolution: [u32; 2],
     /// m.

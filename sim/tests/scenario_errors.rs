@@ -181,15 +181,13 @@ fn maps_and_sources_are_checked() {
 }
 
 #[test]
-fn missing_image_is_a_clear_error_at_build_time() {
+fn missing_image_is_a_clear_error_at_validation() {
     let text = GOOD.replace(
         "evaporation = 10.0",
         "evaporation = 10.0\nmaps = [{ image = \"no_such_file.png\", rate = 1 }]",
     );
-    let sc = Scenario::from_toml_str(&text, ".").unwrap();
-    let e = colcos_sim::world::World::new(&sc)
-        .err()
-        .expect("missing image must fail")
-        .to_string();
+    // Refused before any world is built, with the key path and the file name.
+    let e = err(&text);
+    assert!(e.contains("pheromones[0].maps[0].image"), "{e}");
     assert!(e.contains("no_such_file.png"), "{e}");
 }

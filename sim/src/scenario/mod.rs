@@ -2,11 +2,16 @@
 //! then validated before anything runs; or built in code with [`ScenarioBuilder`].
 
 mod builder;
+mod limits;
 mod rig;
 mod spec;
 mod validate;
 
 pub use builder::ScenarioBuilder;
+pub use limits::{
+    MAX_CELLS, MAX_GIF_SIDE, MAX_IMAGE_PIXELS, MAX_MAP_CELL_VISITS, MAX_POLYLINE_POINTS,
+    MAX_POSES_IN_FLIGHT, MAX_ROBOTS, MAX_SUBSTEPS, MAX_TRACKER_LATENCY, MAX_TRACKER_RATE_HZ,
+};
 pub use rig::{BROADCAST_ID, Firmware, RigSpec, SensorSource};
 pub use spec::*;
 
@@ -66,7 +71,11 @@ impl Scenario {
 
     /// Total number of robots.
     pub fn robot_count(&self) -> usize {
-        self.spec.robots.iter().map(|g| g.count).sum()
+        // Saturating: validation reads it before it has bounded the counts.
+        self.spec
+            .robots
+            .iter()
+            .fold(0usize, |n, g| n.saturating_add(g.count))
     }
 
     /// Index of the pheromone called `name`.
@@ -98,7 +107,7 @@ pub fn parse_spec(text: &str) -> Result<ScenarioSpec> {
         path: "<text>".into(),
         message: e.to_string(),
     })?;
-    serde_path_to_error::deserialize(de).map_err(|e| {
+    let spec: ScenarioSpec = serde_path_to_error::deserialize(de).map_err(|e| {
         let path = e.path().to_string();
         let inner = e.into_inner().to_string();
         let message = if path == "." || path.is_empty() {
@@ -110,5 +119,53 @@ pub fn parse_spec(text: &str) -> Result<ScenarioSpec> {
             path: "<text>".into(),
             message,
         }
-    })
+    })?;
+    check_array_lengths(text, &spec)?;
+    Ok(spec)
+}
+
+/// Serde fills a fixed-size array (`[x, y]`) from the first elements of a longer TOML array and
+/// drops the rest, so `resolution = [1920, 1080, 3]` or a 3-D polyline point would pass unnoticed.
+/// Every array of the file must therefore come back from the parsed spec with the same length.
+fn check_array_lengths(text: &str, spec: &ScenarioSpec) -> Result<()> {
+    let (Ok(input), Ok(parsed)) = (text.parse::<toml::Table>(), toml::Table::try_from(spec)) else {
+        return Ok(());
+    };
+    fn walk(path: &str, input: &toml::Value, parsed: &toml::Value) -> Result<()> {
+        match (input, parsed) {
+            (toml::Value::Array(a), toml::Value::Array(b)) => {
+                if a.len() != b.len() {
+                    let mut shown = input.to_string();
+                    if shown.chars().count() > 80 {
+                        shown = format!("{}...", shown.chars().take(77).collect::<String>());
+                    }
+                    return Err(SimError::invalid(
+                        path,
+                        shown,
+                        format!("expected {} values, got {}", b.len(), a.len()),
+                    ));
+                }
+                for (n, (x, y)) in a.iter().zip(b).enumerate() {
+                    walk(&format!("{path}[{n}]"), x, y)?;
+                }
+                Ok(())
+            }
+            (toml::Value::Table(a), toml::Value::Table(b)) => walk_tables(path, a, b),
+            _ => Ok(()),
+        }
+    }
+    fn walk_tables(path: &str, input: &toml::Table, parsed: &toml::Table) -> Result<()> {
+        for (k, v) in input {
+            if let Some(w) = parsed.get(k) {
+                let key = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                walk(&key, v, w)?;
+            }
+        }
+        Ok(())
+    }
+    walk_tables("", &input, &parsed)
 }

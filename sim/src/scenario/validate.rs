@@ -2,6 +2,7 @@
 //! names the key path and the bad value.
 
 use super::Scenario;
+use super::limits::{self, *};
 use super::spec::*;
 use crate::behaviour::registry;
 use crate::error::{Result, SimError};
@@ -62,15 +63,15 @@ pub(super) fn validate(sc: &Scenario) -> Result<()> {
     }
     positive("screen.size[0]", s.screen.size[0])?;
     positive("screen.size[1]", s.screen.size[1])?;
-    validate_field(sc)?;
-    validate_robot_params(s)?;
-    validate_pheromones(s)?;
+    let grid = validate_field(sc)?;
+    validate_robot_params(sc)?;
+    validate_pheromones(sc, &grid)?;
     validate_robots(sc)?;
     s.rig.validate(sc.robot_count())?;
     Ok(())
 }
 
-fn validate_field(sc: &Scenario) -> Result<()> {
+fn validate_field(sc: &Scenario) -> Result<crate::field::GridSpec> {
     let s = &sc.spec;
     let arena = sc.arena_size();
     positive("field.cell", s.field.cell)?;
@@ -81,30 +82,60 @@ fn validate_field(sc: &Scenario) -> Result<()> {
             format!("larger than half the arena ({} m)", arena.min_element()),
         ));
     }
-    let cells = (arena.x / s.field.cell) as f64 * (arena.y / s.field.cell) as f64;
-    if cells > 2e8 {
+    let grid = limits::check_grid(sc)?;
+    positive("output.gif_width", s.output.gif_width as f32)?;
+    // The frame is rendered in memory at this size, and GIF sides are 16-bit.
+    let (w, sz) = (s.output.gif_width, s.screen.size);
+    let gif_height = ((w as f32 * sz[1] / sz[0]).round() as u32).max(1);
+    if w > MAX_GIF_SIDE || gif_height > MAX_GIF_SIDE {
         return Err(SimError::invalid(
-            "field.cell",
-            s.field.cell,
-            format!("{cells:.0} cells per pheromone is more than 2e8"),
+            "output.gif_width",
+            w,
+            format!(
+                "the frames would be {w} x {gif_height} px (screen aspect {} x {}): at most {MAX_GIF_SIDE} px a side",
+                sz[0], sz[1]
+            ),
         ));
     }
-    positive("output.gif_width", s.output.gif_width as f32)?;
     non_negative("output.gif_interval", s.output.gif_interval)?;
     if s.output.log_every == 0 {
         return Err(SimError::invalid("output.log_every", 0, "must be >= 1"));
     }
-    Ok(())
+    Ok(grid)
 }
 
-fn validate_robot_params(s: &ScenarioSpec) -> Result<()> {
+fn validate_robot_params(sc: &Scenario) -> Result<()> {
+    let s = &sc.spec;
     positive("robot.radius", s.robot.radius)?;
     positive("robot.mass", s.robot.mass)?;
     positive("robot.wheel_base", s.robot.wheel_base)?;
+    if s.robot.wheel_base > 2.0 * s.robot.radius {
+        return Err(SimError::invalid(
+            "robot.wheel_base",
+            s.robot.wheel_base,
+            format!(
+                "the wheels must fit under the robot (diameter {} m)",
+                2.0 * s.robot.radius
+            ),
+        ));
+    }
     positive("robot.max_wheel_speed", s.robot.max_wheel_speed)?;
     non_negative("robot.motor_lag", s.robot.motor_lag)?;
     let c = &s.sensor;
     non_negative("sensor.footprint_radius", c.footprint_radius)?;
+    let reach = crate::sensors::SENSOR_RADIUS + c.footprint_radius;
+    if reach > s.robot.radius {
+        return Err(SimError::invalid(
+            "sensor.footprint_radius",
+            c.footprint_radius,
+            format!(
+                "the colour sensors sit {} m from the centre: their footprint reaches {reach} m, \
+                 beyond the robot's radius {} m",
+                crate::sensors::SENSOR_RADIUS,
+                s.robot.radius
+            ),
+        ));
+    }
     positive("sensor.gamma", c.gamma)?;
     positive("sensor.gain", c.gain)?;
     positive("sensor.integration_ms", c.integration_ms)?;
@@ -128,7 +159,32 @@ fn validate_robot_params(s: &ScenarioSpec) -> Result<()> {
     }
     let t = &s.tracker;
     positive("tracker.rate_hz", t.rate_hz)?;
+    if t.rate_hz > MAX_TRACKER_RATE_HZ {
+        return Err(SimError::invalid(
+            "tracker.rate_hz",
+            t.rate_hz,
+            format!("at most {MAX_TRACKER_RATE_HZ} Hz (every frame is simulated)"),
+        ));
+    }
     non_negative("tracker.latency", t.latency)?;
+    if t.latency > MAX_TRACKER_LATENCY {
+        return Err(SimError::invalid(
+            "tracker.latency",
+            t.latency,
+            format!("at most {MAX_TRACKER_LATENCY} s"),
+        ));
+    }
+    // Every frame captured but not yet delivered is held in memory.
+    let in_flight = (t.rate_hz * t.latency).ceil().max(1.0) as f64 * sc.robot_count() as f64;
+    if in_flight > MAX_POSES_IN_FLIGHT {
+        return Err(SimError::invalid(
+            "tracker.latency",
+            t.latency,
+            format!(
+                "{in_flight:.0} tracked poses in flight (rate_hz x latency x robots), more than {MAX_POSES_IN_FLIGHT:.0e}"
+            ),
+        ));
+    }
     non_negative("tracker.position_noise", t.position_noise)?;
     non_negative("tracker.heading_noise", t.heading_noise)?;
     if !(0.0..1.0).contains(&t.dropout) {
@@ -147,7 +203,8 @@ fn det3(m: &[[f32; 3]; 3]) -> f32 {
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
-fn validate_pheromones(s: &ScenarioSpec) -> Result<()> {
+fn validate_pheromones(sc: &Scenario, grid: &crate::field::GridSpec) -> Result<()> {
+    let s = &sc.spec;
     for (i, p) in s.pheromones.iter().enumerate() {
         let k = |f: &str| format!("pheromones[{i}].{f}");
         if p.name.trim().is_empty() {
@@ -178,8 +235,14 @@ fn validate_pheromones(s: &ScenarioSpec) -> Result<()> {
                         "fixed Gaussian sources need model = \"gaussian\"",
                     ));
                 }
+                limits::check_substeps(sc, i, grid)?;
                 for (m, map) in p.maps.iter().enumerate() {
-                    validate_map(&format!("pheromones[{i}].maps[{m}]"), map)?;
+                    let key = format!("pheromones[{i}].maps[{m}]");
+                    validate_map(&key, map)?;
+                    limits::check_polyline(&key, map, grid)?;
+                    if let Some(image) = &map.image {
+                        limits::check_image(&key, image, &sc.base_dir)?;
+                    }
                 }
             }
             ModelKind::Gaussian => {
@@ -304,8 +367,17 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
         ));
     }
     let mut footprint = 0.0f64;
+    let mut total = 0usize;
     for (g, group) in s.robots.iter().enumerate() {
         let k = |f: &str| format!("robots[{g}].{f}");
+        total = total.saturating_add(group.count);
+        if total > MAX_ROBOTS {
+            return Err(SimError::invalid(
+                k("count"),
+                group.count,
+                format!("more than {MAX_ROBOTS} robots in the scenario"),
+            ));
+        }
         registry::build_for_group(group, &s.robot, &format!("robots[{g}]"))?;
         let region = group.region.unwrap_or([0.0, 0.0, arena.x, arena.y]);
         for (n, v) in region.iter().enumerate() {
@@ -426,7 +498,7 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
             "the robots together cover more than the arena",
         ));
     }
-    Ok(())
+    limits::check_placement(sc)
 }
 
 fn find_pheromone(sc: &Scenario, key: &str, name: &str) -> Result<usize> {
