@@ -33,3 +33,13 @@ xvfb-run -a -s "-screen 0 640x480x24" cargo run --release -q -- display scenario
     --backend gpu --size 480x270 --close-after 2 2>&1 | tee target/ci-display-gpu.log
 grep -q "screen composed on the GPU" target/ci-display-gpu.log
 grep -q "the device of the field backend" target/ci-display-gpu.log
+# The bridge shows the arena's screen in a full-screen window while it drives the twin.
+target/release/colcos twin scenarios/case2_alarm.toml --tracker 127.0.0.1:16866 --robots udp://127.0.0.1:16867 --duration 5 \
+    > target/ci-twin.log 2>&1 &
+sleep 0.5
+xvfb-run -a -s "-screen 0 640x480x24" target/release/colcos bridge scenarios/case2_alarm.toml \
+    --tracker swarmcon://127.0.0.1:16866 --robots udp://127.0.0.1:16867 --display 0 --duration 2 --quiet \
+    --out target/ci-bridge > target/ci-bridge.log 2>&1
+wait
+grep -q "safety stops: none" target/ci-bridge.log
+grep -q "commands received" target/ci-twin.log

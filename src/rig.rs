@@ -34,6 +34,19 @@ pub struct BridgeArgs {
     /// Served frames per second.
     #[arg(long, default_value_t = 25.0)]
     pub frame_rate: f64,
+    /// Show the screen full screen on this monitor (the arena's LCD; monitors are listed when the
+    /// window opens).
+    #[arg(long)]
+    pub display: Option<usize>,
+    /// With --display: a window instead of full screen.
+    #[arg(long)]
+    pub windowed: bool,
+    /// Width the screen is rendered at for the display, px (the window scales it to the monitor).
+    #[arg(long, default_value_t = 960)]
+    pub display_width: u32,
+    /// Frames shown per second.
+    #[arg(long, default_value_t = 10.0)]
+    pub display_rate: f64,
     /// Stop after this many seconds (default: until Ctrl-C).
     #[arg(long)]
     pub duration: Option<f64>,
@@ -92,7 +105,18 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
         None => None,
     };
     let log = args.out.join("rig.mcap");
+    let display = match args.display {
+        Some(monitor) => Some(std::sync::Mutex::new(open_display(&sc, monitor, &args)?)),
+        None => None,
+    };
     let live_opts = LiveOptions {
+        display,
+        display_width: args.display_width,
+        display_hz: if args.display_rate.is_finite() {
+            args.display_rate
+        } else {
+            10.0
+        },
         duration: args.duration,
         stream_width: args.frame_width.clamp(16, 7680),
         stream_hz: if args.frame_rate.is_finite() {
@@ -187,4 +211,46 @@ pub fn twin(args: TwinArgs, text: &mut String) -> Result<()> {
         twin.received().len()
     )?;
     Ok(())
+}
+
+/// The LCD's window: full screen on `monitor` (or windowed), showing each frame as it comes.
+#[cfg(feature = "display")]
+fn open_display(
+    sc: &Scenario,
+    monitor: usize,
+    args: &BridgeArgs,
+) -> Result<Box<dyn colcos_bridge::live::FrameSink>> {
+    struct Window(colcos_display::Viewer);
+    impl colcos_bridge::live::FrameSink for Window {
+        fn show(&mut self, frame: &image::RgbImage) -> bool {
+            let size = (frame.width(), frame.height());
+            let rgba = image::DynamicImage::ImageRgb8(frame.clone())
+                .into_rgba8()
+                .into_raw();
+            self.0.show(rgba, size)
+        }
+    }
+    let w = args.display_width.clamp(16, 7680);
+    let s = sc.spec.screen.size;
+    let size = (w, ((w as f32) * s[1] / s[0]).round().max(1.0) as u32);
+    let opts = colcos_display::DisplayOptions {
+        title: "colcos bridge".into(),
+        fullscreen: !args.windowed,
+        monitor: Some(monitor),
+        // The loop paces the frames; the window must never hold it up.
+        frame_period: std::time::Duration::from_millis(1),
+        ..Default::default()
+    };
+    let viewer = colcos_display::Viewer::open(opts, size)
+        .with_context(|| format!("--display {monitor}: opening the window"))?;
+    Ok(Box::new(Window(viewer)))
+}
+
+#[cfg(not(feature = "display"))]
+fn open_display(
+    _: &Scenario,
+    monitor: usize,
+    _: &BridgeArgs,
+) -> Result<Box<dyn colcos_bridge::live::FrameSink>> {
+    bail!("--display {monitor}: this build has no display window (the `display` feature)")
 }

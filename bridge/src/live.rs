@@ -22,9 +22,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+/// A screen the loop shows its frames on: the window on the arena's LCD.
+pub trait FrameSink: Send {
+    /// Shows `frame` (row 0 at the top of the panel); false once the sink is gone (window closed).
+    fn show(&mut self, frame: &image::RgbImage) -> bool;
+}
+
 /// What a live run does besides driving the robots.
-#[derive(Clone, Debug, Default)]
+#[derive(Default)]
 pub struct LiveOptions {
+    /// The LCD's window, shown `display_width` px wide at `display_hz` (the window scales it to the
+    /// panel). The CPU renders a 4K frame in ~90 ms, so the default is a smaller frame.
+    pub display: Option<std::sync::Mutex<Box<dyn FrameSink>>>,
+    pub display_width: u32,
+    pub display_hz: f64,
     /// Stop after this many seconds (None: until stopped).
     pub duration: Option<f64>,
     /// Width of the frames sent to the frame stream (height from the panel's aspect); 0: none.
@@ -245,6 +256,7 @@ pub fn run(
     let mut tick_ms: Vec<f64> = Vec::new();
     let (mut next_telemetry, mut telemetry_robot) = (0.0, 0usize);
     let mut next_frame = 0.0;
+    let (mut next_display, mut display_gone) = (0.0, false);
     // Each robot is asked every `n / telemetry_hz` s; five missed answers (at least a second) mean it
     // is gone.
     let answer_timeout = (5.0 * telemetry_every * n as f64).max(1.0);
@@ -350,6 +362,23 @@ pub fn run(
             server.publish(&img, host.time() as f64);
             let json = serde_json::json!({"tick": report.ticks, "width": img.width(), "height": img.height(), "fnv1a": format!("{:016x}", fnv1a(img.as_raw()))});
             record(log, Topic::Frames, json.to_string().as_bytes());
+        }
+        if let Some(display) = &opts.display
+            && !display_gone
+            && t >= next_display
+        {
+            next_display = t + 1.0 / opts.display_hz.clamp(1.0, 50.0);
+            let (s, w) = (
+                scenario.spec.screen.size,
+                opts.display_width.clamp(16, 7680),
+            );
+            let img = host.render(w, ((w as f32) * s[1] / s[0]).round().max(1.0) as u32);
+            if let Ok(mut d) = display.lock()
+                && !d.show(&img)
+            {
+                display_gone = true;
+                log::warn!("the display window was closed; the loop goes on without it");
+            }
         }
         // Commands out through the shield; unchanged ones again at the keep-alive rate.
         let mut link_error = None;
