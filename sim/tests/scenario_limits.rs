@@ -197,6 +197,33 @@ fn work_and_memory_are_bounded() {
         ),
         &["pheromones[0].maps[0].polyline", "visits"],
     );
+    // Every robot's deposit kernel covers the whole fine grid.
+    assert_err(
+        &format!(
+            "{}\n[field]\ncell = 0.0005\n",
+            with_robots(
+                "count = 500\nbehaviour = \"avoid\"\n\
+                 deposits = [{ pheromone = \"trail\", kernel = { shape = \"disc\", radius = 1.0 }, rate = 1 }]"
+            )
+        ),
+        &["robots[0].deposits[0].kernel", "1e9"],
+    );
+    // Every robot senses every source: 40,000 robots each emitting one is 1.6e9 pairs a step.
+    let emitters = r#"
+duration = 1.0
+[arena]
+size = [10.0, 10.0]
+[[pheromones]]
+name = "alarm"
+colour = [255, 0, 0]
+model = "gaussian"
+evaporation = 5.0
+[[robots]]
+count = 40000
+behaviour = "avoid"
+emits = [{ pheromone = "alarm", k = 1, sigma = [0.1, 0.1], evaporation = 5 }]
+"#;
+    assert_err(emitters, &["robots[0].emits", "1e9"]);
 }
 
 // Class 3: input that parses but means nothing is refused; half a table takes the defaults.

@@ -329,3 +329,46 @@ pub(super) fn check_placement(sc: &Scenario) -> Result<()> {
     }
     Ok(())
 }
+
+/// Most grid cells all deposits together may touch in one step (each robot's kernel box, per deposit).
+pub const MAX_DEPOSIT_CELLS: f64 = 1e9;
+/// Most (robot, Gaussian source) pairs a step may evaluate (every robot senses every source).
+pub const MAX_SOURCE_PAIRS: f64 = 1e9;
+
+/// The cells a step of deposits touches and the robot-source pairs it evaluates, both summed over
+/// the groups: the first group to cross a limit is named.
+pub(super) fn check_step_work(sc: &Scenario, grid: &GridSpec) -> Result<()> {
+    let s = &sc.spec;
+    let robots = sc.robot_count() as f64;
+    let mut sources: f64 = s.pheromones.iter().map(|p| p.sources.len() as f64).sum();
+    let mut cells = 0.0f64;
+    let side =
+        |support: f32, n: usize| ((2.0 * support / grid.cell).ceil() as f64 + 2.0).min(n as f64);
+    for (g, group) in s.robots.iter().enumerate() {
+        for (d, dep) in group.deposits.iter().enumerate() {
+            let support = dep.kernel.support();
+            cells += group.count as f64 * side(support, grid.nx) * side(support, grid.ny);
+            if cells > MAX_DEPOSIT_CELLS {
+                return Err(SimError::invalid(
+                    format!("robots[{g}].deposits[{d}].kernel"),
+                    format!("{:?}", dep.kernel),
+                    format!(
+                        "the deposits would touch {cells:.0} cells a step, more than {MAX_DEPOSIT_CELLS:.0e}"
+                    ),
+                ));
+            }
+        }
+        sources += group.count as f64 * group.emits.len() as f64;
+        if sources * robots > MAX_SOURCE_PAIRS {
+            return Err(SimError::invalid(
+                format!("robots[{g}].emits"),
+                group.emits.len(),
+                format!(
+                    "{robots} robots sensing {sources} Gaussian sources is {:.0} pairs a step, more than {MAX_SOURCE_PAIRS:.0e}",
+                    sources * robots
+                ),
+            ));
+        }
+    }
+    Ok(())
+}

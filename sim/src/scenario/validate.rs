@@ -498,6 +498,7 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
             "the robots together cover more than the arena",
         ));
     }
+    limits::check_step_work(sc, &crate::field::GridSpec::covering(arena, s.field.cell))?;
     limits::check_placement(sc)
 }
 
