@@ -163,6 +163,11 @@ fn work_and_memory_are_bounded() {
         &format!("{GOOD}\n[output]\ngif_width = 100000\n"),
         &["output.gif_width", "7680"],
     );
+    check(
+        &format!("{GOOD}\n[output]\ngif_width = 100000\ngif_interval = 0.0\n"),
+        Path::new("."),
+    )
+    .expect("no GIF, no frame size");
     // A tall screen makes a tall GIF from a modest width.
     assert_err(
         &format!("{GOOD}\n[screen]\nsize = [0.1, 10.0]\n[arena]\nsize = [1.0, 1.0]\n"),

@@ -84,10 +84,10 @@ fn validate_field(sc: &Scenario) -> Result<crate::field::GridSpec> {
     }
     let grid = limits::check_grid(sc)?;
     positive("output.gif_width", s.output.gif_width as f32)?;
-    // The frame is rendered in memory at this size, and GIF sides are 16-bit.
+    // The frame is rendered in memory at this size, and GIF sides are 16-bit (no GIF: not used).
     let (w, sz) = (s.output.gif_width, s.screen.size);
     let gif_height = ((w as f32 * sz[1] / sz[0]).round() as u32).max(1);
-    if w > MAX_GIF_SIDE || gif_height > MAX_GIF_SIDE {
+    if s.output.gif_interval > 0.0 && (w > MAX_GIF_SIDE || gif_height > MAX_GIF_SIDE) {
         return Err(SimError::invalid(
             "output.gif_width",
             w,
