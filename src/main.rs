@@ -120,14 +120,28 @@ fn run_command(command: Command, text: &mut String) -> Result<()> {
             let out = out.unwrap_or_else(|| {
                 PathBuf::from("runs").join(scenario.file_stem().unwrap_or_default())
             });
+            // Ctrl-C and SIGTERM end the run after the current step, with every output written.
+            let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+            let flag = stop.clone();
+            ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed))
+                .context("installing the Ctrl-C / SIGTERM handler")?;
             let report = run(
                 &sc,
                 &out,
                 &RunOptions {
                     progress: !quiet,
                     no_gif: false,
+                    stop: Some(stop),
                 },
             )?;
+            if report.interrupted {
+                writeln!(
+                    text,
+                    "interrupted after {} of {} steps: the outputs hold what ran",
+                    report.steps,
+                    sc.steps()
+                )?;
+            }
             writeln!(text, "field backend: {}", report.backend)?;
             writeln!(
                 text,

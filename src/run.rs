@@ -13,6 +13,9 @@ pub struct RunOptions {
     pub progress: bool,
     /// Skip the GIF (tests that compare logs do not need it).
     pub no_gif: bool,
+    /// Set to end the run after the current step, writing the outputs of what ran (the CLI sets it on
+    /// Ctrl-C and SIGTERM).
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// Runs `scenario` to its end, writing into `out_dir`, with the backend the scenario's `field.backend`
@@ -39,6 +42,7 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
                 crate::backend::try_install(world, choice).map_err(Into::into)
             })),
             on_step: Some(&mut on_step),
+            stop: opts.stop.as_deref(),
         },
     );
     bar.finish_and_clear();

@@ -108,3 +108,59 @@ fn run_arguments_are_bounded() {
     assert_fails(&strs(&run(&["--duration", "inf"])), &["duration"]);
     assert!(!Path::new(out).join("trajectory.csv").exists());
 }
+
+/// Ctrl-C (SIGINT) and SIGTERM end `colcos run` after the current step with every output complete:
+/// the summary says it was interrupted, the screen, fields and GIF are whole files, and every
+/// trajectory row is complete.
+#[test]
+fn an_interrupted_run_leaves_complete_outputs() {
+    for signal in ["-INT", "-TERM"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_colcos"))
+            .args([
+                "run",
+                "scenarios/three_trails.toml",
+                "--duration",
+                "600",
+                "--quiet",
+                "--out",
+            ])
+            .arg(&out)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Let it get going (the trajectory grows past its header).
+        let log = out.join("trajectory.csv");
+        let t0 = std::time::Instant::now();
+        while std::fs::metadata(&log).map(|m| m.len()).unwrap_or(0) < 100_000 {
+            assert!(t0.elapsed().as_secs() < 60, "the run did not start");
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let status = std::process::Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let exit = child.wait().unwrap();
+        assert!(exit.success(), "{signal}: {exit:?}");
+        let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        assert!(summary.contains("\"interrupted\": true"), "{summary}");
+        image::open(out.join("screen.png")).expect("a whole screen.png");
+        let gif = std::fs::read(out.join("run.gif")).unwrap();
+        assert_eq!(gif.last(), Some(&0x3B), "the GIF has its trailer");
+        for f in ["red", "green", "blue"] {
+            assert!(
+                std::fs::metadata(out.join(format!("fields/{f}.npy")))
+                    .unwrap()
+                    .len()
+                    > 128
+            );
+        }
+        let text = std::fs::read_to_string(&log).unwrap();
+        assert!(text.ends_with('\n'));
+        let columns = text.lines().next().unwrap().split(',').count();
+        assert!(text.lines().all(|l| l.split(',').count() == columns));
+    }
+}

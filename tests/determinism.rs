@@ -51,6 +51,7 @@ fn run_with_threads(threads: usize) -> (Vec<u8>, Vec<u8>) {
             &RunOptions {
                 progress: false,
                 no_gif: true,
+                ..Default::default()
             },
         )
     })

@@ -30,6 +30,9 @@ pub struct RunOptions<'a> {
     pub backend: Option<BackendSetup<'a>>,
     /// Called after every step with (steps done, steps in all).
     pub on_step: Option<&'a mut dyn FnMut(u64, u64)>,
+    /// Set (by a signal handler, say) to end the run after the current step; the outputs are written
+    /// for what ran, and the report and `summary.json` say it was interrupted.
+    pub stop: Option<&'a std::sync::atomic::AtomicBool>,
 }
 
 /// What a finished run wrote and how fast it went.
@@ -44,6 +47,8 @@ pub struct RunReport {
     pub files: Vec<PathBuf>,
     /// The field backend that stepped the grids (`cpu (...)` or `gpu: <adapter>`).
     pub backend: String,
+    /// The run was stopped before the scenario's end (`steps` says how far it got).
+    pub interrupted: bool,
 }
 
 impl RunReport {
@@ -76,6 +81,7 @@ pub fn run(
         no_gif,
         backend,
         mut on_step,
+        stop,
     } = opts;
     std::fs::create_dir_all(out_dir).map_err(|e| {
         SimError::io(
@@ -122,7 +128,12 @@ pub fn run(
     let steps = scenario.steps();
     let started = Instant::now();
     let mut stepping = 0.0f64;
+    let mut done_steps = 0;
     for done in 1..=steps {
+        if stop.is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed)) {
+            break;
+        }
+        done_steps = done;
         let t0 = Instant::now();
         world.step();
         stepping += t0.elapsed().as_secs_f64();
@@ -150,7 +161,8 @@ pub fn run(
 
     let mut report = RunReport {
         out_dir: out_dir.to_path_buf(),
-        steps,
+        steps: done_steps,
+        interrupted: done_steps < steps,
         robots: world.robot_count(),
         sim_seconds: world.time(),
         wall_seconds: stepping,

@@ -18,7 +18,7 @@ pub(super) fn write(
 /// Formatted by hand: this crate has no JSON dependency, and the timings read best at fixed decimals.
 fn text(scenario: &Scenario, report: &RunReport, total_wall_seconds: f64) -> String {
     format!(
-        "{{\n  \"scenario\": {:?},\n  \"seed\": {},\n  \"steps\": {},\n  \"robots\": {},\n  \"sim_seconds\": {},\n  \"step_wall_seconds\": {:.4},\n  \"real_time_factor\": {:.2},\n  \"total_wall_seconds\": {:.3},\n  \"backend\": {:?}\n}}\n",
+        "{{\n  \"scenario\": {:?},\n  \"seed\": {},\n  \"steps\": {},\n  \"robots\": {},\n  \"sim_seconds\": {},\n  \"step_wall_seconds\": {:.4},\n  \"real_time_factor\": {:.2},\n  \"total_wall_seconds\": {:.3},\n  \"backend\": {:?},\n  \"interrupted\": {}\n}}\n",
         scenario.spec.name,
         scenario.spec.seed,
         report.steps,
@@ -27,6 +27,7 @@ fn text(scenario: &Scenario, report: &RunReport, total_wall_seconds: f64) -> Str
         report.wall_seconds,
         report.real_time_factor(),
         total_wall_seconds,
-        report.backend
+        report.backend,
+        report.interrupted
     )
 }
