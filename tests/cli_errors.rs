@@ -164,3 +164,42 @@ fn an_interrupted_run_leaves_complete_outputs() {
         assert!(text.lines().all(|l| l.split(',').count() == columns));
     }
 }
+
+/// A second run into the same `--out` replaces the first one's files all together: a run without a
+/// GIF and with other pheromones leaves no GIF or field of the first behind.
+#[test]
+fn a_second_run_into_the_same_directory_replaces_the_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let run = |scenario: &str| {
+        let st = std::process::Command::new(env!("CARGO_BIN_EXE_colcos"))
+            .args(["run", scenario, "--duration", "0.4", "--quiet", "--out"])
+            .arg(&out)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+    };
+    run("scenarios/three_trails.toml");
+    assert!(out.join("run.gif").exists() && out.join("fields/red.npy").exists());
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    // case I: no GIF (gif_interval 0) and other pheromone names.
+    run("scenarios/case1_g3.toml");
+    assert!(
+        !out.join("run.gif").exists(),
+        "the first run's GIF was left behind"
+    );
+    assert!(
+        !out.join("fields/red.npy").exists(),
+        "the first run's field was left behind"
+    );
+    assert!(out.join("fields/LAP.npy").exists());
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
+}

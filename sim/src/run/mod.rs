@@ -1,5 +1,6 @@
 //! One scenario from start to end, writing what a run leaves behind: `scenario.toml`,
-//! `trajectory.csv`, `run.gif`, `screen.png`, `fields/<name>.npy` and `summary.json`.
+//! `trajectory.csv`, `run.gif`, `screen.png`, `fields/<name>.npy` and `summary.json`. A run into a
+//! directory that holds an earlier run's files replaces them all.
 //!
 //! The command line, a sweep runner and the hardware bridge all call [`run`]; what differs between
 //! them comes in through [`RunOptions`]: the field backend (the GPU one lives in `colcos-gpu`, which
@@ -89,6 +90,7 @@ pub fn run(
             e,
         )
     })?;
+    clear_previous_outputs(out_dir)?;
     let mut files = Vec::new();
     let scenario_copy = out_dir.join("scenario.toml");
     std::fs::write(&scenario_copy, scenario.to_toml())
@@ -189,6 +191,36 @@ fn cpu_backend(choice: BackendChoice) -> Result<String, RunError> {
 
 /// One `.npy` per pheromone, shape (ny, nx), row 0 at y = 0: grid fields as they are, Gaussian fields
 /// evaluated at the centres of the scenario's field grid.
+/// Removes what an earlier run wrote into `out_dir` (its files only, nothing else there), so that a
+/// run into the same directory replaces them all and never leaves a mix of two runs.
+fn clear_previous_outputs(out_dir: &Path) -> Result<(), SimError> {
+    let remove = |path: PathBuf| match std::fs::remove_file(&path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(SimError::io(
+            format!("removing the earlier run's {}", path.display()),
+            e,
+        )),
+        _ => Ok(()),
+    };
+    for name in [
+        "scenario.toml",
+        "trajectory.csv",
+        "run.gif",
+        "screen.png",
+        "summary.json",
+    ] {
+        remove(out_dir.join(name))?;
+    }
+    if let Ok(entries) = std::fs::read_dir(out_dir.join("fields")) {
+        for entry in entries.flatten() {
+            let path = entry.path();
+            if path.extension().is_some_and(|e| e == "npy") {
+                remove(path)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 fn write_fields(
     world: &World,
     scenario: &Scenario,
