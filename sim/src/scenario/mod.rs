@@ -3,6 +3,7 @@
 
 mod builder;
 mod limits;
+pub(crate) mod placement;
 mod rig;
 mod spec;
 mod validate;

@@ -10,7 +10,7 @@ use crate::field::{
 };
 use crate::rng::{self, Stream};
 use crate::robot::{ArenaPhysics, DriveState, Pose};
-use crate::scenario::{EmitWhen, MapSpec, ModelKind, PheromoneSpec, Scenario};
+use crate::scenario::{EmitWhen, MapSpec, ModelKind, PheromoneSpec, Scenario, placement};
 use crate::sensors::ColourSensor;
 use crate::tracker::Tracker;
 use glam::Vec2;
@@ -84,23 +84,14 @@ impl WorldParts {
             .collect::<Result<Vec<_>>>()?;
 
         let mut placement_rng = rng::stream_of(spec.seed, world_index, Stream::Placement);
-        let mut poses: Vec<Pose> = Vec::with_capacity(scenario.robot_count());
-        let mut slots = Vec::with_capacity(scenario.robot_count());
+        let poses: Vec<Pose> = placement::place(scenario, &mut placement_rng)?;
+        let mut slots = Vec::with_capacity(poses.len());
         let mut deposits = Vec::new();
         let mut emitters = Vec::new();
         for (g, group) in spec.robots.iter().enumerate() {
             let key = format!("robots[{g}]");
-            let placed = super::placement::place_group(
-                group,
-                &key,
-                arena,
-                spec.robot.radius,
-                &poses,
-                &mut placement_rng,
-            )?;
-            for pose in placed {
-                let index = poses.len();
-                poses.push(pose);
+            let first = slots.len();
+            for (index, &pose) in poses.iter().enumerate().skip(first).take(group.count) {
                 slots.push(RobotSlot {
                     group: g,
                     behaviour: registry::build_for_group(group, &spec.robot, &key)?,

@@ -14,7 +14,6 @@ mod access;
 mod build;
 mod fields;
 mod inject;
-mod placement;
 mod robots;
 mod sensing;
 mod step;
