@@ -19,8 +19,11 @@ pub struct Host {
     ticks: u64,
     /// Latest tracked pose of every robot (`seen` false until the tracker has reported it).
     tracked: Vec<TrackedPose>,
-    /// Scratch: the poses injection and sensing use this tick.
+    /// Scratch: the poses injection and sensing use this tick, and as tracked poses.
     poses: Vec<Pose>,
+    predicted: Vec<TrackedPose>,
+    /// Scratch: the robots' own readings, kept across virtual sensing in [`SensorMode::Robot`].
+    kept: Vec<Observation>,
     commands: Vec<WheelCommand>,
     mode: SensorMode,
     /// Each pose is predicted forward by this much (s) from the robot's last command before pheromone
@@ -43,6 +46,8 @@ impl Host {
             ticks: 0,
             tracked: vec![TrackedPose::default(); n],
             poses: vec![Pose::default(); n],
+            predicted: vec![TrackedPose::default(); n],
+            kept: Vec::with_capacity(n),
             commands: vec![WheelCommand::STOP; n],
             mode,
             latency: 0.0,
@@ -117,10 +122,10 @@ impl Host {
     /// Robot `i`'s own readings (real sensors), in the simulator's sensor order: used by the next
     /// tick's decisions in [`SensorMode::Robot`].
     pub fn set_readings(&mut self, i: usize, counts: [[u16; 3]; 4], bumpers: [f32; 3]) {
-        let sensor = self.parts.sensing.sensor().clone();
+        let intensity = self.parts.sensing.sensor().intensities(&counts);
         if let Some(o) = self.parts.sensing.observations_mut().get_mut(i) {
             o.counts = counts;
-            o.intensity = sensor.intensities(&counts);
+            o.intensity = intensity;
             o.bumpers = bumpers.map(|b| {
                 if b.is_finite() {
                     b.clamp(0.0, 1.0)
@@ -148,23 +153,25 @@ impl Host {
         for ((p, t), cmd) in self.poses.iter_mut().zip(&self.tracked).zip(&self.commands) {
             *p = predict(t.pose, *cmd, self.latency, self.time - t.stamp, wheel_base);
         }
-        let predicted: Vec<TrackedPose> = self
-            .tracked
-            .iter()
+        for ((out, t), p) in self
+            .predicted
+            .iter_mut()
+            .zip(&self.tracked)
             .zip(&self.poses)
-            .map(|(t, p)| TrackedPose { pose: *p, ..*t })
-            .collect();
+        {
+            *out = TrackedPose { pose: *p, ..*t };
+        }
         stages::inject(
             &mut parts.injection,
             &mut parts.fields,
             &self.poses,
-            &predicted,
+            &self.predicted,
             dt,
         );
-        let kept: Vec<Observation> = match self.mode {
-            SensorMode::Robot => parts.sensing.observations().to_vec(),
-            SensorMode::Virtual => Vec::new(),
-        };
+        self.kept.clear();
+        if self.mode == SensorMode::Robot {
+            self.kept.extend_from_slice(parts.sensing.observations());
+        }
         stages::index(&mut parts.sensing, &self.poses);
         stages::sense(
             &mut parts.sensing,
@@ -175,7 +182,7 @@ impl Host {
             self.time,
         );
         if self.mode == SensorMode::Robot {
-            for (o, k) in parts.sensing.observations_mut().iter_mut().zip(kept) {
+            for (o, k) in parts.sensing.observations_mut().iter_mut().zip(&self.kept) {
                 o.counts = k.counts;
                 o.intensity = k.intensity;
                 o.bumpers = k.bumpers;

@@ -254,6 +254,8 @@ pub fn run(
     let mut report = LiveReport::default();
     let mut last_sent: Vec<(WheelCommand, f64)> = vec![(WheelCommand::STOP, f64::NEG_INFINITY); n];
     let mut tick_ms: Vec<f64> = Vec::new();
+    // Reused every tick: the behaviours' commands and the commands as sent (after shield and stops).
+    let (mut commands, mut sent_now) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let (mut next_telemetry, mut telemetry_robot) = (0.0, 0usize);
     let mut next_frame = 0.0;
     let (mut next_display, mut display_gone) = (0.0, false);
@@ -344,7 +346,8 @@ pub fn run(
             now.duration_since(last_tick).as_secs_f64()
         };
         last_tick = now;
-        let commands: Vec<WheelCommand> = host.tick(step as f32).to_vec();
+        commands.clear();
+        commands.extend_from_slice(host.tick(step as f32));
         beats.policy();
         report.ticks += 1;
         // The screen to the frame stream.
@@ -382,7 +385,8 @@ pub fn run(
         }
         // Commands out through the shield; unchanged ones again at the keep-alive rate.
         let mut link_error = None;
-        let mut sent_now = commands.clone();
+        sent_now.clear();
+        sent_now.extend_from_slice(&commands);
         if let Ok(mut l) = link.lock() {
             for (i, cmd) in commands.iter().enumerate() {
                 let (cmd, intervention) = shield.apply(&host.poses()[i], *cmd);

@@ -31,6 +31,8 @@ pub enum Stream {
     Scripted(usize),
     /// The baseline policy of agent `i` of a batched environment.
     Baseline(usize),
+    /// The noise of robot `i`'s telemetry readings in a digital twin.
+    Telemetry(usize),
 }
 
 impl Stream {
@@ -39,6 +41,8 @@ impl Stream {
     const SCRIPTED0: u64 = 1 << 20;
     /// First id of the baseline policies' streams.
     const BASELINE0: u64 = 1 << 40;
+    /// First id of the twin's telemetry streams.
+    const TELEMETRY0: u64 = 1 << 41;
 
     /// The stream's id under [`stream`].
     pub fn id(self) -> u64 {
@@ -48,6 +52,7 @@ impl Stream {
             Stream::Robot(i) => 2 + i as u64,
             Stream::Scripted(i) => Self::SCRIPTED0 + i as u64,
             Stream::Baseline(i) => Self::BASELINE0 + i as u64,
+            Stream::Telemetry(i) => Self::TELEMETRY0 + i as u64,
         }
     }
 }
@@ -169,6 +174,7 @@ mod tests {
         let last_robot = Stream::Robot(Stream::SCRIPTED0 as usize - 3).id();
         assert!(last_robot < Stream::Scripted(0).id());
         assert!(Stream::Scripted(1 << 30).id() < Stream::Baseline(0).id());
+        assert!(Stream::Baseline(1 << 30).id() < Stream::Telemetry(0).id());
         assert_eq!(Stream::Placement.id(), 0);
         assert_eq!(Stream::Tracker.id(), 1);
         assert_eq!(Stream::Robot(0).id(), 2);

@@ -18,7 +18,6 @@ use crate::frames::FrameClient;
 use crate::swarmcon::FrameTransform;
 use colcos_sim::scenario::Scenario;
 use std::net::SocketAddr;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -135,9 +134,4 @@ impl Twin {
         }
         self.tracker.close();
     }
-}
-
-/// A stop flag that Ctrl-C and SIGTERM set.
-pub fn stop_flag() -> Arc<AtomicBool> {
-    Arc::new(AtomicBool::new(false))
 }

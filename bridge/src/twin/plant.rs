@@ -34,9 +34,8 @@ impl TwinPlant {
             world,
             commands: vec![WheelCommand::STOP; n],
             heard: vec![f64::NEG_INFINITY; n],
-            // Telemetry noise: streams of world 1, apart from the simulation's own (world 0).
             telemetry_rng: (0..n)
-                .map(|i| rng::stream_of(seed, 1, Stream::Robot(i)))
+                .map(|i| rng::stream_of(seed, 0, Stream::Telemetry(i)))
                 .collect(),
         })
     }
