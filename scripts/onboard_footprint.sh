@@ -55,10 +55,9 @@ arm-none-eabi-gcc "${cflags[@]}" "${lflags[@]}" -I"$out" -DWITH_POLICY=1 "$repo/
 arm-none-eabi-size "$out/firmware_none.elf" "$out/firmware.elf"
 read -r t0 d0 b0 _ < <(arm-none-eabi-size "$out/firmware_none.elf" | tail -1)
 read -r t1 d1 b1 _ < <(arm-none-eabi-size "$out/firmware.elf" | tail -1)
-libm="$(arm-none-eabi-nm --size-sort -S -t d "$out/firmware.elf" | awk '$4 !~ /^(colcos_policy|main|_|control_tick|read_|set_wheel|left|right|sensor_regs|motor_regs)/ && $3 ~ /[Tt]/ {print $4 " " $2 + 0}' | sort)"
-nm_size() { arm-none-eabi-nm -S -t d "$1" | awk -v f="$2" '$4 == f {print $2 + 0}'; }
-echo "   the policy adds $((t1 + d1 - t0 - d0)) bytes of flash (text + data); functions of the firmware with it, not colcos_policy_* nor the example's (bytes):"
-echo "$libm" | sed 's/^/     /'
+syms() { arm-none-eabi-nm -S -t d "$1" | awk '$3 ~ /[Tt]/ && $4 !~ /^(colcos_policy|main$)/ {print $4 " " $2 + 0}' | sort; }
+echo "   the policy adds $((t1 + d1 - t0 - d0)) bytes of flash (text + data); library functions it pulls in (bytes):"
+comm -13 <(syms "$out/firmware_none.elf") <(syms "$out/firmware.elf") | sed 's/^/     /'
 read -r pt pd pb _ < <(arm-none-eabi-size "$out/policy.o" | tail -1)
 
 step="$(frame colcos_policy_step)"; encode="$(frame colcos_policy_encode)"; pow="$(frame colcos_policy_pow_unit)"
