@@ -1,0 +1,95 @@
+//! What can go wrong in a sweep, each error naming where: the key path and value of a bad sweep file,
+//! the combination whose scenario fails validation, the file that could not be written.
+use colcos_sim::error::SimError;
+
+/// A sweep's error.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// The sweep file is not valid TOML or does not fit the format (unknown key, wrong type).
+    #[error("invalid sweep file {file}: {message}")]
+    Parse { file: String, message: String },
+    /// A key of the sweep file has a bad value.
+    #[error("invalid sweep: `{key}` = {value}: {reason}")]
+    Invalid {
+        key: String,
+        value: String,
+        reason: String,
+    },
+    /// The scenario of one combination fails the scenario checks.
+    #[error("combination {combo} ({params}), seed {seed}: {source}")]
+    Combination {
+        combo: usize,
+        params: String,
+        seed: u64,
+        #[source]
+        source: SimError,
+    },
+    /// The base scenario cannot be read or parsed.
+    #[error("base scenario {path}: {source}")]
+    Base {
+        path: String,
+        #[source]
+        source: SimError,
+    },
+    /// A run id that the plan does not have.
+    #[error("run {id} does not exist: the sweep has runs 0..{total}")]
+    NoSuchRun { id: u64, total: u64 },
+    /// An output directory already holds the table of another sweep.
+    #[error(
+        "{dir} holds the results of a different sweep (its table's header or fingerprint differs): \
+         choose another output directory or delete {dir}/results.csv to start again"
+    )]
+    OtherSweep { dir: String },
+    /// `resume` was asked for but there is nothing to resume.
+    #[error("nothing to resume: {path} does not exist")]
+    NothingToResume { path: String },
+    #[error("{context}: {source}")]
+    Io {
+        context: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{context}: {source}")]
+    Csv {
+        context: String,
+        #[source]
+        source: csv::Error,
+    },
+    /// A run failed after its scenario passed validation.
+    #[error("run {id}: {message}")]
+    Run { id: u64, message: String },
+}
+
+impl SweepError {
+    pub(crate) fn invalid(
+        key: impl Into<String>,
+        value: impl std::fmt::Display,
+        reason: impl Into<String>,
+    ) -> Self {
+        let mut value = value.to_string();
+        if value.chars().count() > 80 {
+            value = format!("{}...", value.chars().take(77).collect::<String>());
+        }
+        SweepError::Invalid {
+            key: key.into(),
+            value,
+            reason: reason.into(),
+        }
+    }
+
+    pub(crate) fn io(context: impl Into<String>, source: std::io::Error) -> Self {
+        SweepError::Io {
+            context: context.into(),
+            source,
+        }
+    }
+
+    pub(crate) fn csv(context: impl Into<String>, source: csv::Error) -> Self {
+        SweepError::Csv {
+            context: context.into(),
+            source,
+        }
+    }
+}
+
+pub type Result<T, E = SweepError> = std::result::Result<T, E>;
