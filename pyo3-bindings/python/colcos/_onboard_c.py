@@ -95,15 +95,20 @@ def header(p: dict) -> str:
  *     {{
  *         uint16_t colour[12];                   // TCS34725 R, G, B counts of front, back, left, right
  *         uint16_t ir_on[3], ir_off[3];          // IR bumpers left, middle, right: emitter on / off
- *         read_colour_sensors(colour);           // integration {p["integration_ms"]} ms (the calibration below)
+ *         read_colour_sensors(colour);           // {p["integration_ms"]} ms integration, as calibrated
  *         read_bumpers(ir_on, ir_off);
  *         {P}_step(colour, ir_on, ir_off, &left, &right);
  *         set_wheel_speeds(left, right);         // m/s; the firmware's own limits and timeouts still apply
  *     }}
  *
+ * The encoding inverts the colour sensors' calibration (gain {p["gain"]} counts per unit light per ms,
+ * {p["integration_ms"]} ms integration, dark {p["dark_counts"]} counts, gamma {p["gamma"]}; the crosstalk in the .c): the robot must
+ * read its sensors with those settings. The firmware's own limits may change the wheel speeds: pass
+ * back what was actually commanded.
+ *
  * Compile as C99 without -ffast-math (it would reorder the f32 arithmetic the encoding relies on);
- * with -std=c99 (no contraction into fused multiply-adds) the encoding gives the simulator's values
- * bit for bit. Cortex-M4F: -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard.
+ * with GCC's -std=c99 (or -ffp-contract=off: no fused multiply-adds) the encoding gives the
+ * simulator's values bit for bit. Cortex-M4F: -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard.
  */
 #ifndef {U}_H
 #define {U}_H
