@@ -8,14 +8,23 @@ counts to the 17 inputs), the actor with its input normaliser, and the action de
 speeds; the header's comment shows the firmware side. Without `--policy` it exports an untrained actor
 of the same shape (random weights, numpy only: what `scripts/onboard_footprint.sh` measures, whose
 sizes do not depend on the values). `--scenario` takes the sensor calibration and the largest wheel
-speed from a scenario file instead of the simulator's defaults.
+speed from a scenario file instead of the simulator's defaults. `--check N` compiles the C with the
+host's `cc` and drives N episodes of the `aggregation` task with it and with the same network in numpy
+(same seeds): the returns and the largest action difference, a check before flashing.
 """
 
 from __future__ import annotations
 
 import argparse
+import ctypes
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
 
 import numpy as np
+
+import colcos
 
 from colcos.onboard import export_c
 
@@ -26,11 +35,24 @@ def actor_from_state_dict(path: str):
     """The actor's (weight, bias) pairs and its normaliser's mean and var from the example's policy.pt."""
     import torch
 
+    if not Path(path).is_file():
+        raise SystemExit(f"--policy {path}: no such file (train_aggregation.py writes OUT/policy.pt)")
     state = torch.load(path, map_location="cpu", weights_only=True)
-    keys = sorted({k.split(".")[1] for k in state if k.startswith("pi.") and k.endswith(".weight")}, key=int)
+    keys = sorted(
+        {
+            k.split(".")[1]
+            for k in state
+            if k.startswith("pi.") and k.endswith(".weight")
+        },
+        key=int,
+    )
     if not keys:
-        raise SystemExit(f"{path}: no actor (`pi.*.weight`) in it: is it the state_dict train_aggregation.py saves?")
-    pairs = [(state[f"pi.{k}.weight"].numpy(), state[f"pi.{k}.bias"].numpy()) for k in keys]
+        raise SystemExit(
+            f"{path}: no actor (`pi.*.weight`) in it: is it the state_dict train_aggregation.py saves?"
+        )
+    pairs = [
+        (state[f"pi.{k}.weight"].numpy(), state[f"pi.{k}.bias"].numpy()) for k in keys
+    ]
     return pairs, state["obs_norm.mean"].numpy(), state["obs_norm.var"].numpy()
 
 
@@ -45,22 +67,131 @@ def untrained_actor(seed: int):
     return pairs, np.zeros(17), np.ones(17)
 
 
+def numpy_act(pairs, mean, var, obs: np.ndarray) -> np.ndarray:
+    """The network in numpy (f64), as the example's ActorCritic.act computes it."""
+    h = np.clip(
+        (obs - mean) / np.sqrt(np.asarray(var, np.float32) + np.float32(1e-8)), -10, 10
+    )
+    for k, (w, b) in enumerate(pairs):
+        h = h @ np.asarray(w, np.float64).T + b
+        h = np.tanh(h) if k < len(pairs) - 1 else h
+    return np.clip(h, -1, 1).astype(np.float32)
+
+
+def c_act_fn(info):
+    """`<prefix>_act` of the exported C, compiled with the host's cc, over a batch of observations."""
+    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    if cc is None:
+        raise SystemExit("--check needs a C compiler (cc, gcc or clang) on PATH")
+    so = Path(tempfile.mkdtemp(prefix="colcos-onboard-")) / "policy.so"
+    subprocess.run(
+        [
+            cc,
+            "-std=c99",
+            "-O2",
+            "-shared",
+            "-fPIC",
+            str(info.source),
+            "-o",
+            str(so),
+            "-lm",
+        ],
+        check=True,
+    )
+    fn = getattr(ctypes.CDLL(str(so)), f"{info.prefix}_act")
+    f32p = ctypes.POINTER(ctypes.c_float)
+    fn.argtypes = [f32p, f32p]
+
+    def act(obs: np.ndarray) -> np.ndarray:
+        obs = np.ascontiguousarray(obs, dtype=np.float32)
+        out = np.zeros((len(obs), 2), dtype=np.float32)
+        for i in range(len(obs)):
+            fn(obs[i].ctypes.data_as(f32p), out[i].ctypes.data_as(f32p))
+        return out
+
+    return act
+
+
+def episode_returns(
+    act, episodes: int, scenario: str | None
+) -> tuple[float, list[np.ndarray]]:
+    """Mean return per agent over `episodes` seeded aggregation episodes driven by `act`, and the
+    observations seen."""
+    env = colcos.parallel_env(
+        task="aggregation",
+        max_cycles=500,
+        **({"scenario": scenario} if scenario else {}),
+    )
+    total, seen = 0.0, []
+    for ep in range(episodes):
+        obs, _ = env.reset(seed=1000 + ep)
+        while env.agents:
+            batch = np.stack([obs[a] for a in env.agents])
+            seen.append(batch)
+            a = act(batch)
+            obs, rew, *_ = env.step({name: a[k] for k, name in enumerate(env.agents)})
+            total += sum(rew.values()) / len(rew)
+    env.close()
+    return total / episodes, seen
+
+
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--policy", help="policy.pt of examples/train_aggregation.py (default: an untrained actor)")
-    p.add_argument("--out", default="firmware/policy", help="file stem: writes OUT.h and OUT.c")
-    p.add_argument("--scenario", help="scenario file whose [sensor] and robot.max_wheel_speed the encoding uses")
+    p = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    p.add_argument(
+        "--policy",
+        help="policy.pt of examples/train_aggregation.py (default: an untrained actor)",
+    )
+    p.add_argument(
+        "--out", default="firmware/policy", help="file stem: writes OUT.h and OUT.c"
+    )
+    p.add_argument(
+        "--scenario",
+        help="scenario file whose [sensor] and robot.max_wheel_speed the encoding uses",
+    )
     p.add_argument("--prefix", default="colcos_policy", help="prefix of the C names")
     p.add_argument("--seed", type=int, default=0, help="seed of the untrained actor")
+    p.add_argument(
+        "--check",
+        type=int,
+        default=0,
+        metavar="N",
+        help="run N aggregation episodes with the C and with numpy",
+    )
     args = p.parse_args()
-    pairs, mean, var = actor_from_state_dict(args.policy) if args.policy else untrained_actor(args.seed)
-    info = export_c(pairs, args.out, activation="tanh", obs_mean=mean, obs_var=var, scenario=args.scenario, prefix=args.prefix)
+    pairs, mean, var = (
+        actor_from_state_dict(args.policy)
+        if args.policy
+        else untrained_actor(args.seed)
+    )
+    info = export_c(
+        pairs,
+        args.out,
+        activation="tanh",
+        obs_mean=mean,
+        obs_var=var,
+        scenario=args.scenario,
+        prefix=args.prefix,
+    )
     print(f"wrote {info.header} and {info.source}")
     print(
         f"network {'-'.join(map(str, info.layer_sizes))} ({', '.join(info.activations)}): {info.n_params:,} parameters, "
         f"{info.weight_bytes:,} bytes of weights in flash, {info.stack_bytes:,} bytes of layer buffers on the stack, "
         f"{info.macs:,} multiply-adds per step"
     )
+    if args.check > 0:
+        c_act = c_act_fn(info)
+        ret_c, seen = episode_returns(c_act, args.check, args.scenario)
+        ret_np, _ = episode_returns(
+            lambda o: numpy_act(pairs, mean, var, o), args.check, args.scenario
+        )
+        obs = np.concatenate(seen)
+        diff = float(np.abs(c_act(obs) - numpy_act(pairs, mean, var, obs)).max())
+        print(
+            f"check over {args.check} episodes of 500 steps: mean return per agent, C {ret_c:.2f}, numpy {ret_np:.2f}; "
+            f"largest action difference on the C run's {len(obs):,} observations {diff:.3g}"
+        )
 
 
 if __name__ == "__main__":
