@@ -7,6 +7,7 @@
 //! The live loop calls [`open_pose_source`] and [`open_robot_link`] and then, every tick,
 //! [`PoseSource::poll`], [`RobotLink::send`] and [`RobotLink::pump`].
 
+pub mod calibrate;
 pub mod clock;
 pub mod colias;
 pub mod frames;

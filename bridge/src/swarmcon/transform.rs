@@ -1,8 +1,10 @@
 //! Converts tracker poses (origin at the top-left calibration pattern, y down, yaw in degrees in
 //! image axes) to the simulator's frame (origin bottom-left, y up, heading in radians CCW from +x),
-//! once, at the edge.
+//! once, at the edge; with a screen calibration, through its homography, parallax correction and
+//! heading sign and offset instead of the nominal frame change.
 
 use super::SlotPose;
+use crate::calibrate::ScreenMap;
 use colcos_sim::Vec2;
 use colcos_sim::robot::Pose;
 use std::f64::consts::PI;
@@ -15,6 +17,8 @@ pub struct FrameTransform {
     /// Where the tracker's (0,0) lies from the arena's top-left corner, in tracker axes (x right,
     /// y down), m: the calibration patterns sit inset by the robot radius.
     pub offset: (f64, f64),
+    /// A measured screen calibration: when set, it replaces the nominal frame change.
+    pub screen: Option<ScreenMap>,
 }
 
 /// Wraps an angle to (-pi, pi].
@@ -35,6 +39,7 @@ impl FrameTransform {
         FrameTransform {
             arena_height,
             offset: (0.0, 0.0),
+            screen: None,
         }
     }
 
@@ -42,11 +47,26 @@ impl FrameTransform {
         FrameTransform {
             arena_height,
             offset: (dx, dy),
+            screen: None,
         }
     }
 
-    /// Tracker (x, y, yaw_deg) to simulator (x, y, heading_rad), in f64.
+    /// Converts through a measured screen calibration.
+    pub fn with_screen(self, map: ScreenMap) -> Self {
+        FrameTransform {
+            screen: Some(map),
+            ..self
+        }
+    }
+
+    /// Tracker (x, y, yaw_deg) to simulator (x, y, heading_rad), in f64 (NaN where a calibration's
+    /// homography is undefined: such a pose is not used).
     pub fn to_sim_f64(&self, x: f64, y: f64, yaw_deg: f64) -> (f64, f64, f64) {
+        if let Some(map) = &self.screen {
+            return map
+                .to_sim(x, y, yaw_deg)
+                .unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        }
         let sx = self.offset.0 + x;
         let sy = self.arena_height - (self.offset.1 + y);
         // Flipping y mirrors the rotation sense: clockwise-positive image yaw becomes CCW heading.
@@ -55,6 +75,11 @@ impl FrameTransform {
 
     /// Simulator (x, y, heading_rad) to tracker (x, y, yaw_deg), in f64.
     pub fn to_tracker_f64(&self, x: f64, y: f64, heading: f64) -> (f64, f64, f64) {
+        if let Some(map) = &self.screen {
+            return map
+                .to_tracker(x, y, heading)
+                .unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        }
         let tx = x - self.offset.0;
         let ty = self.arena_height - y - self.offset.1;
         (tx, ty, wrap_180(-heading.to_degrees()))

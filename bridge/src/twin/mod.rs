@@ -3,10 +3,12 @@
 //! the exact text format; the robots' end of the serial protocol (a pseudo-terminal or UDP) applies
 //! the commands it receives to the simulated robots and answers data requests with telemetry whose
 //! colour counts come from the frames the bridge displays. Faults on demand.
+mod camera;
 mod plant;
 mod robot_end;
 mod tracker_server;
 
+pub use camera::{CameraModel, Noise, detect_fiducials};
 pub use plant::{FIRMWARE_TIMEOUT, TwinPlant};
 pub use robot_end::{
     BUMPER_DARK, BUMPER_SPAN, ByteChannel, PtyChannel, Received, RobotEnd, RobotFaults, UdpChannel,
@@ -28,8 +30,11 @@ pub struct Twin {
     frames: Option<FrameClient>,
     transform: FrameTransform,
     tracker_ids: Vec<i32>,
-    /// Epoch µs at twin time 0.
-    epoch0_us: i64,
+    /// The overhead camera, when one is modelled (calibration): poses go through it, and the
+    /// fiducials in the frames the bridge shows are reported as unidentified (`-01`) slots.
+    camera: Option<(CameraModel, Noise)>,
+    /// Time of the frame the fiducials were found in, and their centres (our frame, m).
+    fiducials: (f64, Vec<[f64; 2]>),
     /// Twin time of the last block sent, s.
     last_block: f64,
     block_period: f64,
@@ -56,10 +61,8 @@ impl Twin {
             frames: frames.map(FrameClient::connect),
             transform: FrameTransform::new(scenario.arena_size().y as f64),
             tracker_ids: (0..n).map(|i| rig.tracker_id(i)).collect(),
-            epoch0_us: SystemTime::now()
-                .duration_since(UNIX_EPOCH)
-                .map(|d| d.as_micros() as i64)
-                .unwrap_or(0),
+            camera: None,
+            fiducials: (f64::NAN, Vec::new()),
             last_block: f64::NEG_INFINITY,
             block_period: 1.0 / rate,
         })
@@ -67,6 +70,14 @@ impl Twin {
 
     pub fn plant(&self) -> &TwinPlant {
         &self.plant
+    }
+    pub fn plant_mut(&mut self) -> &mut TwinPlant {
+        &mut self.plant
+    }
+    /// Sees the arena through `camera` (noise drawn from `seed`); `None`: the tracker reports the
+    /// nominal frame change of the true tracked poses, as without calibration.
+    pub fn set_camera(&mut self, camera: Option<CameraModel>, seed: u64) {
+        self.camera = camera.map(|c| (c, Noise::new(seed)));
     }
     pub fn tracker(&mut self) -> &mut TrackerServer {
         &mut self.tracker
@@ -81,11 +92,15 @@ impl Twin {
 
     /// One step: commands in, the arena moves, a tracker block out when one is due.
     pub fn tick(&mut self) {
-        let frame = self
-            .frames
-            .as_ref()
-            .and_then(|f| f.latest())
-            .map(|(img, _)| img);
+        let latest = self.frames.as_ref().and_then(|f| f.latest());
+        if let Some((img, t)) = &latest
+            && self.camera.is_some()
+            && *t != self.fiducials.0
+        {
+            let size = self.plant.world().screen().size;
+            self.fiducials = (*t, detect_fiducials(img, [size[0] as f64, size[1] as f64]));
+        }
+        let frame = latest.map(|(img, _)| img);
         self.robots.poll(&mut self.plant, frame.as_deref());
         self.plant.step();
         let now = self.plant.time();
@@ -96,21 +111,43 @@ impl Twin {
     }
 
     fn publish(&mut self) {
-        let epoch = |t: f32| self.epoch0_us + (t as f64 * 1e6).round() as i64;
+        // Twin times on this machine's clock, anchored now: a twin that falls behind real time does
+        // not drift away from the host's clock.
+        let wall_us = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .map(|d| d.as_micros() as i64)
+            .unwrap_or(0);
+        let now = self.plant.time();
+        let epoch = |t: f32| wall_us - ((now - t as f64) * 1e6).round() as i64;
         let tracked = self.plant.tracked();
         let frame_t = tracked
             .iter()
             .filter(|p| p.seen)
             .map(|p| p.stamp)
             .fold(0.0f32, f32::max);
-        let poses: Vec<_> = tracked
+        let mut poses: Vec<_> = tracked
             .iter()
             .zip(&self.tracker_ids)
             .map(|(p, &id)| {
-                let (x, y, yaw) = self.transform.to_tracker(&p.pose);
+                let (x, y, yaw) = match &mut self.camera {
+                    Some((cam, noise)) => {
+                        let q = &p.pose;
+                        cam.see_marker(q.pos.x as f64, q.pos.y as f64, q.heading as f64, noise)
+                            .unwrap_or((-1.0, -1.0, 0.0))
+                    }
+                    None => self.transform.to_tracker(&p.pose),
+                };
                 (id, x, y, yaw, p.seen.then(|| epoch(p.stamp)))
             })
             .collect();
+        // Fiducials are seen in the same camera frame as the robots.
+        if let Some((cam, noise)) = &mut self.camera {
+            for f in &self.fiducials.1 {
+                if let Some((x, y)) = cam.see_fiducial(f[0], f[1], noise) {
+                    poses.push((-1, x, y, 0.0, Some(epoch(frame_t))));
+                }
+            }
+        }
         self.tracker.publish(epoch(frame_t), &poses);
     }
 

@@ -40,6 +40,18 @@ pub struct TrackerServer {
     last: std::collections::HashMap<i32, (f64, f64, f64, Option<i64>)>,
     /// Calibrate commands received (their raw lines).
     received: Arc<Mutex<Vec<String>>>,
+    /// When set, every block is held back by a set latency and jitter before it is written.
+    delay: Option<DelayLine>,
+}
+
+/// Holds blocks back: each is written `latency + jitter * U(-1, 1)` s after it was published (never
+/// before the one published before it), by a thread of its own so the twin's tick does not wait.
+struct DelayLine {
+    tx: std::sync::mpsc::Sender<(std::time::Instant, Vec<u8>, usize)>,
+    latency: f64,
+    jitter: f64,
+    noise: super::camera::Noise,
+    last_due: std::time::Instant,
 }
 
 impl TrackerServer {
@@ -65,6 +77,7 @@ impl TrackerServer {
             form,
             last: Default::default(),
             received,
+            delay: None,
         })
     }
 
@@ -81,6 +94,35 @@ impl TrackerServer {
     /// Lines the clients sent (`Calibrate ...`).
     pub fn received(&self) -> Vec<String> {
         self.received.lock().map(|r| r.clone()).unwrap_or_default()
+    }
+
+    /// Holds every block back by `latency` s plus a uniform jitter of up to `jitter` s either way
+    /// (a camera and tracker that take this long from capture to delivery); 0 and 0: none.
+    pub fn set_delay(&mut self, latency: f64, jitter: f64, seed: u64) {
+        if !(latency > 0.0 || jitter > 0.0) {
+            self.delay = None;
+            return;
+        }
+        let (tx, rx) = std::sync::mpsc::channel::<(std::time::Instant, Vec<u8>, usize)>();
+        let clients = self.clients.clone();
+        let spawned = std::thread::Builder::new()
+            .name("twin-tracker-delay".into())
+            .spawn(move || {
+                for (due, bytes, split) in rx {
+                    let now = std::time::Instant::now();
+                    if due > now {
+                        std::thread::sleep(due - now);
+                    }
+                    write_to(&clients, &bytes, split);
+                }
+            });
+        self.delay = spawned.ok().map(|_| DelayLine {
+            tx,
+            latency: latency.max(0.0),
+            jitter: jitter.max(0.0),
+            noise: super::camera::Noise::new(seed),
+            last_due: std::time::Instant::now(),
+        });
     }
 
     /// Sends one block: `poses` are (marker id, x, y, yaw_deg, last seen µs or `None` if never) in the
@@ -142,6 +184,10 @@ impl TrackerServer {
         let mut s = String::new();
         write_event(&mut s, TrackerEvent::Closed);
         self.write_all(s.as_bytes(), 0);
+        if let Some(line) = &self.delay {
+            // What is held back goes out first.
+            std::thread::sleep(Duration::from_secs_f64(line.latency + line.jitter + 0.02));
+        }
         if let Ok(mut c) = self.clients.lock() {
             for client in c.drain(..) {
                 let _ = client.shutdown(std::net::Shutdown::Both);
@@ -149,20 +195,32 @@ impl TrackerServer {
         }
     }
 
-    fn write_all(&self, bytes: &[u8], split: usize) {
-        let Ok(mut clients) = self.clients.lock() else {
-            return;
-        };
-        clients.retain_mut(|c| {
-            if split == 0 {
-                c.write_all(bytes).is_ok()
-            } else {
-                bytes
-                    .chunks(split)
-                    .all(|piece| c.write_all(piece).and_then(|_| c.flush()).is_ok())
+    fn write_all(&mut self, bytes: &[u8], split: usize) {
+        match &mut self.delay {
+            Some(line) => {
+                let d = line.latency + line.jitter * (2.0 * line.noise.uniform() - 1.0);
+                let due = std::time::Instant::now() + Duration::from_secs_f64(d.max(0.0));
+                line.last_due = due.max(line.last_due);
+                let _ = line.tx.send((line.last_due, bytes.to_vec(), split));
             }
-        });
+            None => write_to(&self.clients, bytes, split),
+        }
     }
+}
+
+fn write_to(clients: &Mutex<Vec<TcpStream>>, bytes: &[u8], split: usize) {
+    let Ok(mut clients) = clients.lock() else {
+        return;
+    };
+    clients.retain_mut(|c| {
+        if split == 0 {
+            c.write_all(bytes).is_ok()
+        } else {
+            bytes
+                .chunks(split)
+                .all(|piece| c.write_all(piece).and_then(|_| c.flush()).is_ok())
+        }
+    });
 }
 
 impl Drop for TrackerServer {

@@ -57,6 +57,14 @@ pub struct RigSpec {
     pub policy_stall: f32,
     /// The safety shield applied to every command (also in the simulator's environments).
     pub shield: ShieldParams,
+    /// A screen <-> camera calibration file (`colcos calibrate screen`), relative to the scenario's
+    /// directory: every tracker pose goes through it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub screen_calibration: Option<String>,
+    /// A per-robot colour sensor calibration file (`colcos calibrate colour`), relative to the
+    /// scenario's directory: the robots' raw counts go through its calibrated inverse.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub colour_calibration: Option<String>,
 }
 
 impl Default for RigSpec {
@@ -73,6 +81,8 @@ impl Default for RigSpec {
             pose_age: 0.3,
             policy_stall: 0.2,
             shield: ShieldParams::default(),
+            screen_calibration: None,
+            colour_calibration: None,
         }
     }
 }
@@ -169,6 +179,18 @@ impl RigSpec {
         )?;
         within("shield.margin", self.shield.margin, 0.0, 1.0)?;
         within("shield.horizon", self.shield.horizon, 0.0, 2.0)?;
+        for (key, path) in [
+            ("screen_calibration", &self.screen_calibration),
+            ("colour_calibration", &self.colour_calibration),
+        ] {
+            if path.as_ref().is_some_and(|p| p.trim().is_empty()) {
+                return Err(SimError::invalid(
+                    format!("rig.{key}"),
+                    "\"\"",
+                    "must name a calibration file",
+                ));
+            }
+        }
         Ok(())
     }
 }

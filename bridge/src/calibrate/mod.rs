@@ -1,0 +1,122 @@
+//! Sim-to-real calibration of the rig, proved on the digital twin whose true values are known:
+//! the screen against the camera ([`screen`]: a homography with the markers' parallax, the
+//! heading's sign and offset), the latency of each stage ([`latency`]), and each robot's colour
+//! sensors ([`colour`]). [`session`] runs them over the rig's wire formats; each writes a file that
+//! the scenario's `[rig]` section names and the bridge loads ([`RigCalibration`]).
+pub mod colour;
+pub mod homography;
+pub mod latency;
+pub mod run_screen;
+pub mod screen;
+pub mod screen_map;
+pub mod session;
+
+pub use colour::ColourCalibration;
+pub use screen::ScreenCalibration;
+pub use screen_map::ScreenMap;
+
+use colcos_sim::scenario::Scenario;
+use std::path::Path;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum CalibrationError {
+    #[error("calibration file {path}: {reason}")]
+    File { path: String, reason: String },
+    #[error("calibration file {path}: `{key}` = {value}: {reason}")]
+    Invalid {
+        path: String,
+        key: String,
+        value: String,
+        reason: String,
+    },
+    #[error("screen calibration: {0}")]
+    WrongScreen(String),
+    #[error("calibration fit: {0}")]
+    Fit(String),
+    #[error("calibration run: {0}")]
+    Run(String),
+}
+
+impl CalibrationError {
+    pub fn file(path: &Path, e: impl std::fmt::Display) -> CalibrationError {
+        CalibrationError::File {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        }
+    }
+}
+
+/// The calibrations a scenario's `[rig]` section names, loaded and checked against its screen.
+#[derive(Clone, Debug, Default)]
+pub struct RigCalibration {
+    pub screen: Option<ScreenCalibration>,
+    pub colour: Option<ColourCalibration>,
+}
+
+impl RigCalibration {
+    /// Loads `rig.screen_calibration` and `rig.colour_calibration` (relative to the scenario's
+    /// directory); a screen calibration of another panel is refused.
+    pub fn load(scenario: &Scenario) -> Result<RigCalibration, CalibrationError> {
+        let rig = &scenario.spec.rig;
+        let resolve = |p: &str| scenario.base_dir.join(p);
+        let screen = match &rig.screen_calibration {
+            Some(p) => {
+                let cal = ScreenCalibration::load(&resolve(p))?;
+                let s = &scenario.spec.screen;
+                cal.check_screen(s.resolution, [s.size[0] as f64, s.size[1] as f64])?;
+                Some(cal)
+            }
+            None => None,
+        };
+        let colour = match &rig.colour_calibration {
+            Some(p) => Some(ColourCalibration::load(&resolve(p))?),
+            None => None,
+        };
+        Ok(RigCalibration { screen, colour })
+    }
+
+    /// The tracker-to-simulator conversion for `scenario`, with the screen calibration if any.
+    pub fn frame_transform(&self, scenario: &Scenario) -> crate::swarmcon::FrameTransform {
+        let t = crate::swarmcon::FrameTransform::new(scenario.arena_size().y as f64);
+        match &self.screen {
+            Some(cal) => t.with_screen(cal.map()),
+            None => t,
+        }
+    }
+}
+
+/// Now, UTC, as `YYYY-MM-DDTHH:MM:SSZ`.
+pub fn utc_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs() as i64)
+        .unwrap_or(0);
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_date_is_well_formed() {
+        let d = super::utc_now();
+        assert_eq!(d.len(), 20, "{d}");
+        assert!(d.starts_with("20") && d.ends_with('Z'), "{d}");
+    }
+}
