@@ -231,7 +231,8 @@ def test_other_activations_without_normaliser(activation, tmp_path):
 
 
 def test_encoding_from_scenario():
-    assert Encoding.from_scenario(colcos.default_scenario("aggregation")) == Encoding()
+    assert Encoding.from_scenario('name = "x"\ndt = 0.02\n') == Encoding()  # the simulator's defaults
+    assert Encoding.from_scenario(colcos.default_scenario("aggregation")).checked()
     enc = Encoding.from_scenario("dt = 0.05\n[sensor]\ngain = 1000.0\ndark_counts = 12\n[robot]\nmax_wheel_speed = 0.2\n")
     assert (enc.gain, enc.dark_counts, enc.max_wheel_speed, enc.dt, enc.integration_ms) == (1000.0, 12, 0.2, 0.05, 24.0)
     with pytest.raises(ExportError, match="singular"):
