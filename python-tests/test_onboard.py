@@ -237,6 +237,10 @@ def test_encoding_from_scenario():
     assert (enc.gain, enc.dark_counts, enc.max_wheel_speed, enc.dt, enc.integration_ms) == (1000.0, 12, 0.2, 0.05, 24.0)
     with pytest.raises(ExportError, match="singular"):
         Encoding.from_scenario("[sensor]\ncrosstalk = [[1, 1, 0], [1, 1, 0], [0, 0, 1]]\n")
+    with pytest.raises(ExportError, match="`crosstalk` = 3: must be a 3x3 matrix"):
+        Encoding.from_scenario("[sensor]\ncrosstalk = 3\n")
+    with pytest.raises(ExportError, match="unknown encoding key `gian`"):
+        Encoding.from_scenario("dt = 0.02", gian=3)
     with pytest.raises(ExportError, match="not valid TOML"):
         Encoding.from_scenario("[sensor\n")
     with pytest.raises(ExportError, match=r"`gain` = -1"):

@@ -86,7 +86,10 @@ class Encoding:
         if "dt" in doc:
             kw["dt"] = doc["dt"]
         kw.update(overrides)
-        if "crosstalk" in kw:
+        unknown = sorted(set(kw) - set(cls.__dataclass_fields__))
+        if unknown:
+            raise ExportError(f"unknown encoding key `{unknown[0]}`: expected one of {', '.join(cls.__dataclass_fields__)}")
+        if isinstance(kw.get("crosstalk"), list) and all(isinstance(r, list) for r in kw["crosstalk"]):
             kw["crosstalk"] = tuple(tuple(r) for r in kw["crosstalk"])
         return cls(**kw).checked()
 
