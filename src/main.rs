@@ -8,13 +8,14 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+// `pub(crate)`: the command-line fuzz target (fuzz/) compiles this file as a module and parses with it.
 #[derive(Parser)]
 #[command(
     name = "colcos",
     version,
     about = "Multi-pheromone swarm robotics simulator (ColCOSPhi)"
 )]
-struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
     command: Command,
 }
