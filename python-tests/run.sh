@@ -59,11 +59,12 @@ cd "$here"
 status=0
 if [ "${COLCOS_PY_PEERS:-1}" = 0 ]; then
     echo "== core venv (PettingZoo, errors, vector env, determinism; without COLCOS_PY_PEERS=0 also the peer libraries)"
-    make_venv venv-core "$here/requirements-core.txt"
+    make_venv venv-core "$here/requirements-core.txt" --no-deps --only-binary=:all:
+    check_venv venv-core
     lap "installed"
     "$work/venv-core/bin/python" -m pytest -q -p no:cacheprovider \
-        test_pettingzoo.py test_errors.py test_vector.py test_determinism.py \
-        test_backend.py test_render_human.py test_behaviours.py "$@" || status=1
+        test_pettingzoo.py test_errors.py test_misuse.py test_misuse_adapters.py test_hypothesis.py \
+        test_vector.py test_determinism.py test_backend.py test_render_human.py test_behaviours.py "$@" || status=1
     lap "core suites"
     echo "== python part done in $(($(stamp) - t0)) s (status $status)"
     exit $status

@@ -53,3 +53,54 @@ pub struct EnvSpec {
     /// Simulation time step, s.
     pub dt: f32,
 }
+
+/// The bounds every observation entry takes, per entry (low, high): colour intensities and bumpers
+/// in `[0, 1]`, the last wheel command in `[-1, 1]` (see [`crate::encoding::encode`]).
+pub fn observation_bounds() -> (Vec<f32>, Vec<f32>) {
+    let dim = crate::encoding::OBS_DIM;
+    let low = (0..dim)
+        .map(|i| if i >= dim - 2 { -1.0 } else { 0.0 })
+        .collect();
+    (low, vec![1.0; dim])
+}
+
+/// The bounds every global-state entry takes, per entry, for a state of `len` entries: each
+/// robot's position scaled to `[-1, 1]` and its heading's cos and sin, then the episode's elapsed
+/// fraction in `[0, 1]`.
+pub fn state_bounds(len: usize) -> (Vec<f32>, Vec<f32>) {
+    let mut low = vec![-1.0; len];
+    if let Some(last) = low.last_mut() {
+        *last = 0.0;
+    }
+    (low, vec![1.0; len])
+}
+
+impl EnvSpec {
+    /// Per-entry bounds `(low, high)` of the observation vector (tighter than the `observation`
+    /// box's scalar envelope).
+    pub fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
+        observation_bounds()
+    }
+
+    /// Per-entry bounds `(low, high)` of the global state, if it is enabled.
+    pub fn state_bounds(&self) -> Option<(Vec<f32>, Vec<f32>)> {
+        self.state.as_ref().map(|s| state_bounds(s.flat_len()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_follow_the_encoding() {
+        let (low, high) = observation_bounds();
+        assert_eq!(low.len(), crate::encoding::OBS_DIM);
+        assert_eq!(&low[..15], &[0.0; 15]);
+        assert_eq!(&low[15..], &[-1.0, -1.0]);
+        assert!(high.iter().all(|&h| h == 1.0));
+        let (low, high) = state_bounds(9);
+        assert_eq!(low[..8], [-1.0; 8]);
+        assert_eq!((low[8], high[8]), (0.0, 1.0));
+    }
+}

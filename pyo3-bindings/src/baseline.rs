@@ -1,15 +1,21 @@
 //! `colcos._core.Baseline`: the paper's hand-written behaviours as policies over a `VecEnv`.
-use crate::errors::{TaskError, to_py};
+//! Locks are taken with the GIL released, the env's before the policy's (one order, no deadlock).
+use crate::args::{self, guard};
+use crate::errors::{Kind, to_py};
 use crate::vec_env::PyVecEnv;
 use colcos_env::baseline::BaselinePolicy;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use std::sync::Mutex;
 
-#[pyclass(module = "colcos._core", name = "Baseline")]
-pub struct PyBaseline {
-    policy: Mutex<BaselinePolicy>,
+struct State {
+    policy: BaselinePolicy,
     out: Vec<f32>,
+}
+
+#[pyclass(module = "colcos._core", name = "Baseline", frozen)]
+pub struct PyBaseline {
+    state: Mutex<State>,
     shape: [usize; 3],
 }
 
@@ -18,43 +24,77 @@ impl PyBaseline {
     /// Behaviour `name` (see `colcos.behaviours()`) with `params_json` (a JSON object) for every agent
     /// of `env`.
     #[new]
-    #[pyo3(signature = (env, name, params_json=None, seed=0))]
+    #[pyo3(signature = (env, name, params_json=None, seed=None))]
     fn new(
-        env: PyRef<'_, PyVecEnv>,
-        name: &str,
-        params_json: Option<&str>,
-        seed: u64,
+        py: Python<'_>,
+        env: &Bound<'_, PyAny>,
+        name: &Bound<'_, PyAny>,
+        params_json: Option<&Bound<'_, PyAny>>,
+        seed: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let params = match params_json {
-            Some(s) => serde_json::from_str(s).map_err(|e| {
-                TaskError::new_err(format!("behaviour parameters are not valid JSON: {e}"))
-            })?,
-            None => serde_json::Value::Null,
-        };
-        let inner = env.lock();
-        let policy = BaselinePolicy::new(&inner.env, name, &params, seed).map_err(to_py)?;
-        let s = inner.env.spec();
-        let shape = [s.num_envs, s.num_agents, 2];
-        Ok(PyBaseline {
-            policy: Mutex::new(policy),
-            out: vec![0.0; shape.iter().product()],
-            shape,
+        guard(|| {
+            let env = env_of(env)?;
+            let name = args::text(name, "name")?;
+            let params = match args::opt_text(params_json, "params_json")? {
+                Some(s) => serde_json::from_str(&s).map_err(|e| {
+                    Kind::Task.err(format!("behaviour parameters are not valid JSON: {e}"))
+                })?,
+                None => serde_json::Value::Null,
+            };
+            let seed = match seed.filter(|s| !s.is_none()) {
+                Some(s) => args::seed(s, "seed")?,
+                None => 0,
+            };
+            let me: &PyVecEnv = env.get();
+            let (policy, shape) = py
+                .detach(|| {
+                    let g = me.lock();
+                    let s = g.env.spec();
+                    let shape = [s.num_envs, s.num_agents, 2];
+                    BaselinePolicy::new(&g.env, &name, &params, seed).map(|p| (p, shape))
+                })
+                .map_err(to_py)?;
+            Ok(PyBaseline {
+                state: Mutex::new(State {
+                    policy,
+                    out: vec![0.0; shape.iter().product()],
+                }),
+                shape,
+            })
         })
     }
 
     /// Continuous actions `(E, N, 2)` float32 for the env's current sensor readings.
-    fn act<'py>(
-        &mut self,
-        py: Python<'py>,
-        env: PyRef<'py, PyVecEnv>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let inner = env.lock();
-        let mut policy = self.policy.lock().unwrap_or_else(|e| e.into_inner());
-        policy.act(&inner.env, &mut self.out).map_err(to_py)?;
-        Ok(PyArray1::from_slice(py, &self.out)
-            .reshape(self.shape)?
-            .into_any())
+    fn act<'py>(&self, py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let env = env_of(env)?;
+            let me: &PyVecEnv = env.get();
+            let out = py
+                .detach(|| {
+                    let g = me.lock();
+                    let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
+                    let State { policy, out } = &mut *st;
+                    if out.len() != g.env.spec().num_envs * g.env.spec().num_agents * 2 {
+                        return Err(colcos_env::EnvError::State(
+                            "this policy was made for another environment (its sizes differ)"
+                                .into(),
+                        ));
+                    }
+                    policy.act(&g.env, out).map(|()| out.clone())
+                })
+                .map_err(to_py)?;
+            Ok(PyArray1::from_vec(py, out).reshape(self.shape)?.into_any())
+        })
     }
+}
+
+fn env_of<'a, 'py>(env: &'a Bound<'py, PyAny>) -> PyResult<&'a Bound<'py, PyVecEnv>> {
+    env.cast::<PyVecEnv>().map_err(|_| {
+        Kind::ArgumentType.err(format!(
+            "env must be a colcos._core.VecEnv, got {}",
+            args::show(env)
+        ))
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

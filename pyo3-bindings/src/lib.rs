@@ -1,11 +1,14 @@
 //! `colcos._core`: the native module behind the `colcos` Python package. A thin layer: the batched
 //! environment, baseline policies and the registries of `colcos-env` and `colcos-sim`, with one
-//! exception tree. The GIL is released around every reset and step.
+//! exception tree. The GIL is released around every reset and step, and before any lock is taken.
 use pyo3::prelude::*;
 
+mod args;
 mod baseline;
 mod errors;
+mod limits;
 mod registry;
+mod spec;
 mod vec_env;
 mod window;
 

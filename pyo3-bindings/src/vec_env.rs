@@ -1,5 +1,11 @@
 //! `colcos._core.VecEnv`: the batched environment, its buffers handed to Python as numpy views.
-use crate::errors::{ActionError, TaskError, to_py};
+//!
+//! Threads: every call waits for the environment's lock with the GIL released (`py.detach`), so
+//! that a thread stepping (which holds the lock and has released the GIL) and a thread asking for
+//! anything else never wait on each other. Every entry point runs under `args::guard`.
+use crate::args::{self, guard};
+use crate::errors::{Kind, to_py};
+use crate::limits;
 use colcos_env::{
     ActionKind, Actions, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource, Space, VecEnv,
 };
@@ -9,53 +15,43 @@ use numpy::{
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::sync::Mutex;
+use std::sync::{Mutex, MutexGuard};
 
-/// The environment and its action scratch buffers. Behind a mutex because pyo3 classes must be
-/// `Sync` (behaviours and field backends are `Send` only); every call takes it once.
+/// The environment. Behind a mutex because pyo3 classes must be `Sync` (behaviours and field
+/// backends are `Send` only).
 pub(crate) struct Inner {
     pub env: VecEnv,
-    actions_f: Vec<f32>,
-    actions_i: Vec<i64>,
 }
 
-#[pyclass(module = "colcos._core", name = "VecEnv")]
+#[pyclass(module = "colcos._core", name = "VecEnv", frozen)]
 pub struct PyVecEnv {
-    pub(crate) inner: Mutex<Inner>,
+    inner: Mutex<Inner>,
+    /// Fixed at construction, read without the lock.
+    num_envs: usize,
+    num_agents: usize,
+    discrete: bool,
 }
 
 impl PyVecEnv {
-    pub(crate) fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {
-        // A panic while holding the lock cannot leave the env half-stepped in a way Python could see
-        // differently from an error; keep going with the data.
+    /// The lock. Call only with the GIL released (inside `py.detach`).
+    pub(crate) fn lock(&self) -> MutexGuard<'_, Inner> {
+        // A panic while holding the lock is reported as an error; keep going with the data.
         self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
-}
 
-fn space_dict<'py>(py: Python<'py>, space: &Space) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    match space {
-        Space::Box {
-            low,
-            high,
-            shape,
-            dtype,
-        } => {
-            d.set_item("kind", "box")?;
-            d.set_item("low", low)?;
-            d.set_item("high", high)?;
-            d.set_item("shape", shape.clone())?;
-            d.set_item("dtype", dtype)?;
-        }
-        Space::Discrete { n } => {
-            d.set_item("kind", "discrete")?;
-            d.set_item("n", n)?;
-        }
+    fn world_index(&self, world: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let last = self.num_envs as u64 - 1;
+        args::int_in(world, "world", 0, last).map(|w| w as usize)
     }
-    Ok(d)
 }
 
-/// A numpy view of `len` elements at `ptr` shaped `shape`, keeping `owner` alive.
+/// Raw buffer pointers carried out of a `detach` closure.
+struct Ptrs<T>(T);
+// SAFETY: plain addresses of buffers owned by the env, only dereferenced with the GIL held while the
+// env is alive (see `views`).
+unsafe impl<T> Send for Ptrs<T> {}
+
+/// A numpy view of the elements at `ptr` shaped `shape`, keeping `owner` alive.
 ///
 /// # Safety
 /// `ptr..ptr + product(shape)` must stay valid for as long as `owner` lives.
@@ -68,100 +64,163 @@ unsafe fn view<'py, T: Element>(
     Ok(unsafe { PyArray::borrow_from_array(&a, owner.clone()) }.into_any())
 }
 
+/// The configuration from the constructor's arguments, each checked and named.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn config(
+    task: &Bound<'_, PyAny>,
+    num_envs: Option<&Bound<'_, PyAny>>,
+    seed: Option<&Bound<'_, PyAny>>,
+    num_threads: Option<&Bound<'_, PyAny>>,
+    scenario: Option<&Bound<'_, PyAny>>,
+    scenario_text: Option<&Bound<'_, PyAny>>,
+    max_cycles: Option<&Bound<'_, PyAny>>,
+    action: Option<&Bound<'_, PyAny>>,
+    autoreset_mode: Option<&Bound<'_, PyAny>>,
+    global_state: Option<&Bound<'_, PyAny>>,
+    patch_pixels: Option<&Bound<'_, PyAny>>,
+    patch_side: Option<&Bound<'_, PyAny>>,
+    params_json: Option<&Bound<'_, PyAny>>,
+    backend: Option<&Bound<'_, PyAny>>,
+) -> PyResult<EnvConfig> {
+    fn some<'a, 'py>(v: Option<&'a Bound<'py, PyAny>>) -> Option<&'a Bound<'py, PyAny>> {
+        v.filter(|v| !v.is_none())
+    }
+    let mut cfg = EnvConfig::new(args::text(task, "task")?);
+    let scenario_path = match some(scenario) {
+        Some(p) => Some(p.extract::<std::path::PathBuf>().map_err(|_| {
+            Kind::ArgumentType.err(format!(
+                "scenario must be a path (str or os.PathLike), got {}",
+                args::show(p)
+            ))
+        })?),
+        None => None,
+    };
+    cfg.scenario = match (
+        scenario_path,
+        args::opt_text(scenario_text, "scenario_text")?,
+    ) {
+        (Some(_), Some(_)) => {
+            return Err(Kind::Task.err("give either scenario (a path) or scenario_text, not both"));
+        }
+        (Some(p), None) => ScenarioSource::File(p),
+        (None, Some(t)) => ScenarioSource::Text(t),
+        (None, None) => ScenarioSource::Default,
+    };
+    if let Some(s) = args::opt_text(params_json, "params_json")? {
+        let v: serde_json::Value = serde_json::from_str(&s).map_err(|e| {
+            Kind::Task.err(format!(
+                "task parameters (params_json) are not valid JSON: {e}"
+            ))
+        })?;
+        limits::check_params("", &v).map_err(|e| Kind::Task.err(e))?;
+        cfg.params = v;
+    }
+    if let Some(n) = some(num_envs) {
+        cfg.num_envs = args::int_in(n, "num_envs", 1, limits::MAX_NUM_ENVS)? as usize;
+    }
+    if let Some(s) = some(seed) {
+        cfg.seed = args::seed(s, "seed")?;
+    }
+    if let Some(t) = some(num_threads) {
+        cfg.num_threads = Some(args::int_in(t, "num_threads", 1, limits::MAX_THREADS)? as usize);
+    }
+    if let Some(m) = some(max_cycles) {
+        // 0: the scenario's duration.
+        cfg.max_cycles = args::int_in(m, "max_cycles", 0, limits::MAX_CYCLES)?;
+    }
+    if let Some(a) = args::opt_text(action, "action")? {
+        cfg.action = a.parse::<ActionKind>().map_err(to_py)?;
+    }
+    if let Some(a) = args::opt_text(autoreset_mode, "autoreset_mode")? {
+        cfg.autoreset = a.parse::<AutoresetMode>().map_err(to_py)?;
+    }
+    if let Some(g) = some(global_state) {
+        cfg.global_state = args::flag(g, "global_state")?;
+    }
+    if let Some(p) = some(patch_pixels) {
+        let pixels = args::int_in(p, "patch_pixels", 1, limits::MAX_PATCH_PIXELS)? as usize;
+        let side = match some(patch_side) {
+            Some(s) => args::real(s, "patch_side")? as f32,
+            None => PatchConfig::default().side,
+        };
+        cfg.patch = Some(PatchConfig { pixels, side });
+    }
+    cfg.backend = args::opt_text(backend, "backend")?
+        .map(|b| b.parse::<colcos_sim::field::BackendChoice>())
+        .transpose()
+        .map_err(|e| Kind::Task.err(format!("backend: {e}")))?;
+    Ok(cfg)
+}
+
 #[pymethods]
 impl PyVecEnv {
     #[new]
-    #[pyo3(signature = (task, num_envs=1, seed=0, num_threads=None, scenario=None, scenario_text=None, max_cycles=0, action="continuous", autoreset_mode="next_step", global_state=true, patch_pixels=None, patch_side=0.08, params_json=None, backend=None))]
+    #[pyo3(signature = (task, num_envs=None, seed=None, num_threads=None, scenario=None, scenario_text=None, max_cycles=None, action=None, autoreset_mode=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        task: &str,
-        num_envs: usize,
-        seed: u64,
-        num_threads: Option<usize>,
-        scenario: Option<std::path::PathBuf>,
-        scenario_text: Option<String>,
-        max_cycles: u64,
-        action: &str,
-        autoreset_mode: &str,
-        global_state: bool,
-        patch_pixels: Option<usize>,
-        patch_side: f32,
-        params_json: Option<&str>,
-        backend: Option<&str>,
         py: Python<'_>,
+        task: &Bound<'_, PyAny>,
+        num_envs: Option<&Bound<'_, PyAny>>,
+        seed: Option<&Bound<'_, PyAny>>,
+        num_threads: Option<&Bound<'_, PyAny>>,
+        scenario: Option<&Bound<'_, PyAny>>,
+        scenario_text: Option<&Bound<'_, PyAny>>,
+        max_cycles: Option<&Bound<'_, PyAny>>,
+        action: Option<&Bound<'_, PyAny>>,
+        autoreset_mode: Option<&Bound<'_, PyAny>>,
+        global_state: Option<&Bound<'_, PyAny>>,
+        patch_pixels: Option<&Bound<'_, PyAny>>,
+        patch_side: Option<&Bound<'_, PyAny>>,
+        params_json: Option<&Bound<'_, PyAny>>,
+        backend: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let mut cfg = EnvConfig::new(task);
-        cfg.scenario = match (scenario, scenario_text) {
-            (Some(_), Some(_)) => {
-                return Err(TaskError::new_err(
-                    "give either scenario (a path) or scenario_text, not both",
-                ));
-            }
-            (Some(p), None) => ScenarioSource::File(p),
-            (None, Some(t)) => ScenarioSource::Text(t),
-            (None, None) => ScenarioSource::Default,
-        };
-        cfg.params = match params_json {
-            Some(s) => serde_json::from_str(s).map_err(|e| {
-                TaskError::new_err(format!("task parameters are not valid JSON: {e}"))
-            })?,
-            None => serde_json::Value::Object(Default::default()),
-        };
-        cfg.num_envs = num_envs;
-        cfg.seed = seed;
-        cfg.num_threads = num_threads;
-        cfg.max_cycles = max_cycles;
-        cfg.action = action.parse::<ActionKind>().map_err(to_py)?;
-        cfg.autoreset = autoreset_mode.parse::<AutoresetMode>().map_err(to_py)?;
-        cfg.global_state = global_state;
-        cfg.backend = backend
-            .map(|b| b.parse::<colcos_sim::field::BackendChoice>())
-            .transpose()
-            .map_err(|e| TaskError::new_err(format!("backend: {e}")))?;
-        cfg.patch = patch_pixels.map(|pixels| PatchConfig {
-            pixels,
-            side: patch_side,
-        });
-        let env = py.detach(|| VecEnv::new(&cfg)).map_err(to_py)?;
-        let (e, n) = (env.spec().num_envs, env.spec().num_agents);
-        Ok(PyVecEnv {
-            inner: Mutex::new(Inner {
-                env,
-                actions_f: vec![0.0; e * n * 2],
-                actions_i: vec![0; e * n],
-            }),
+        guard(|| {
+            let cfg = config(
+                task,
+                num_envs,
+                seed,
+                num_threads,
+                scenario,
+                scenario_text,
+                max_cycles,
+                action,
+                autoreset_mode,
+                global_state,
+                patch_pixels,
+                patch_side,
+                params_json,
+                backend,
+            )?;
+            let env = py
+                .detach(|| {
+                    limits::check_batch_memory(&cfg)?;
+                    VecEnv::new(&cfg)
+                })
+                .map_err(to_py)?;
+            let s = env.spec();
+            let (num_envs, num_agents) = (s.num_envs, s.num_agents);
+            let discrete = matches!(s.action, Space::Discrete { .. });
+            Ok(PyVecEnv {
+                inner: Mutex::new(Inner { env }),
+                num_envs,
+                num_agents,
+                discrete,
+            })
         })
     }
 
     /// Sizes, names and spaces, as a dict.
     fn spec<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let inner = self.lock();
-        let s = inner.env.spec();
-        let d = PyDict::new(py);
-        d.set_item("task", &s.task)?;
-        d.set_item("env_name", &s.env_name)?;
-        d.set_item("num_envs", s.num_envs)?;
-        d.set_item("num_agents", s.num_agents)?;
-        d.set_item("num_robots", s.num_robots)?;
-        d.set_item("agent_names", s.agent_names.clone())?;
-        d.set_item("agent_robots", s.agent_robots.clone())?;
-        d.set_item("observation", space_dict(py, &s.observation)?)?;
-        d.set_item("action", space_dict(py, &s.action)?)?;
-        d.set_item(
-            "state",
-            s.state.as_ref().map(|x| space_dict(py, x)).transpose()?,
-        )?;
-        d.set_item(
-            "patch",
-            s.patch.as_ref().map(|x| space_dict(py, x)).transpose()?,
-        )?;
-        d.set_item("max_cycles", s.max_cycles)?;
-        d.set_item("dt", s.dt)?;
-        d.set_item(
-            "autoreset_mode",
-            format!("{:?}", inner.env.autoreset_mode()),
-        )?;
-        Ok(d)
+        guard(|| {
+            let (spec, mode) = py.detach(|| {
+                let g = self.lock();
+                (
+                    g.env.spec().clone(),
+                    format!("{:?}", g.env.autoreset_mode()),
+                )
+            });
+            crate::spec::spec_dict(py, &spec, &mode)
+        })
     }
 
     /// Numpy views of the output buffers (no copies; overwritten in place by every step and reset):
@@ -169,205 +228,266 @@ impl PyVecEnv {
     /// `state [E,S] float32` (if enabled), `patch [E,N,P,P,3] uint8` (if enabled),
     /// `final_obs [E,N,D]`, `final_mask [E] bool`.
     fn views<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
-        let py = slf.py();
-        let owner = slf.clone().into_any();
-        let (ptrs, spec) = {
-            let me = slf.borrow();
-            let mut inner = me.lock();
-            (inner.env.buffer_ptrs(), inner.env.spec().clone())
-        };
-        let (e, n) = (spec.num_envs, spec.num_agents);
-        let d_obs = spec.observation.flat_len();
-        let d = PyDict::new(py);
-        // SAFETY: the buffers are allocated once in VecEnv::new and never reallocated; each view keeps
-        // `owner` (and so the VecEnv) alive.
-        unsafe {
-            d.set_item("obs", view(&owner, ptrs.obs, vec![e, n, d_obs])?)?;
-            d.set_item("rewards", view(&owner, ptrs.rewards, vec![e, n])?)?;
-            d.set_item("terminated", view(&owner, ptrs.terminated, vec![e, n])?)?;
-            d.set_item("truncated", view(&owner, ptrs.truncated, vec![e, n])?)?;
-            d.set_item(
-                "final_obs",
-                view(&owner, ptrs.final_obs, vec![e, n, d_obs])?,
-            )?;
-            d.set_item("final_mask", view(&owner, ptrs.final_mask, vec![e])?)?;
-            if let Some(s) = &spec.state {
-                d.set_item("state", view(&owner, ptrs.state, vec![e, s.flat_len()])?)?;
-            }
-            if let Some(Space::Box { shape, .. }) = &spec.patch {
+        guard(|| {
+            let py = slf.py();
+            let owner = slf.clone().into_any();
+            let me: &PyVecEnv = slf.get();
+            let (ptrs, spec) = py.detach(|| {
+                let mut g = me.lock();
+                (Ptrs(g.env.buffer_ptrs()), g.env.spec().clone())
+            });
+            let ptrs = ptrs.0;
+            let (e, n) = (spec.num_envs, spec.num_agents);
+            let d_obs = spec.observation.flat_len();
+            let d = PyDict::new(py);
+            // SAFETY: the buffers are allocated once in VecEnv::new and never reallocated; each view
+            // keeps `owner` (and so the VecEnv) alive.
+            unsafe {
+                d.set_item("obs", view(&owner, ptrs.obs, vec![e, n, d_obs])?)?;
+                d.set_item("rewards", view(&owner, ptrs.rewards, vec![e, n])?)?;
+                d.set_item("terminated", view(&owner, ptrs.terminated, vec![e, n])?)?;
+                d.set_item("truncated", view(&owner, ptrs.truncated, vec![e, n])?)?;
                 d.set_item(
-                    "patch",
-                    view(&owner, ptrs.patch, vec![e, n, shape[0], shape[1], shape[2]])?,
+                    "final_obs",
+                    view(&owner, ptrs.final_obs, vec![e, n, d_obs])?,
                 )?;
+                d.set_item("final_mask", view(&owner, ptrs.final_mask, vec![e])?)?;
+                d.set_item("shield", view(&owner, ptrs.shield, vec![e, n])?)?;
+                if let Some(s) = &spec.state {
+                    d.set_item("state", view(&owner, ptrs.state, vec![e, s.flat_len()])?)?;
+                }
+                if let Some(Space::Box { shape, .. }) = &spec.patch {
+                    d.set_item(
+                        "patch",
+                        view(&owner, ptrs.patch, vec![e, n, shape[0], shape[1], shape[2]])?,
+                    )?;
+                }
             }
-        }
-        Ok(d)
+            Ok(d)
+        })
     }
 
-    /// Resets the worlds where `mask` is true (all if None); a seed restarts the episode count.
+    /// Resets the worlds where `mask` (bool array of length num_envs) is true, all if None; a seed
+    /// (an integer in 0..=2**64-1) becomes the base seed and restarts the episode count.
     #[pyo3(signature = (seed=None, mask=None))]
     fn reset(
         &self,
         py: Python<'_>,
-        seed: Option<u64>,
-        mask: Option<PyReadonlyArrayDyn<'_, bool>>,
+        seed: Option<&Bound<'_, PyAny>>,
+        mask: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let mask: Option<Vec<bool>> = match mask {
-            Some(m) => {
-                if m.ndim() != 1 {
-                    return Err(ActionError::new_err(format!(
-                        "reset mask must be 1-D of length num_envs, got shape {:?}",
-                        m.shape()
-                    )));
-                }
-                Some(m.as_array().iter().copied().collect())
-            }
-            None => None,
-        };
-        py.detach(|| self.lock().env.reset(seed, mask.as_deref()))
-            .map_err(to_py)
+        guard(|| {
+            let seed = match seed.filter(|s| !s.is_none()) {
+                Some(s) => Some(args::seed(s, "seed")?),
+                None => None,
+            };
+            let mask = match mask.filter(|m| !m.is_none()) {
+                Some(m) => Some(self.mask(m)?),
+                None => None,
+            };
+            py.detach(|| self.lock().env.reset(seed, mask.as_deref()))
+                .map_err(to_py)
+        })
     }
 
     /// Steps every world. `actions`: float32 `[E, N, 2]` (continuous) or int64 `[E, N]` (discrete),
     /// C-contiguous or not.
     fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
-        let mut guard = self.lock();
-        let inner = &mut *guard;
-        let s = inner.env.spec();
-        let (e, n) = (s.num_envs, s.num_agents);
-        let discrete = matches!(s.action, Space::Discrete { .. });
-        if discrete {
-            let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
-                ActionError::new_err(
-                    "discrete actions must be an int64 numpy array of shape (num_envs, num_agents)",
-                )
-            })?;
-            if a.shape() != [e, n] {
-                return Err(ActionError::new_err(format!(
-                    "actions have shape {:?}, expected ({e}, {n}) = (num_envs, num_agents)",
-                    a.shape()
-                )));
-            }
-            inner
-                .actions_i
-                .iter_mut()
-                .zip(a.as_array().iter())
-                .for_each(|(d, s)| *d = *s);
-            let (env, acts) = (&mut inner.env, &inner.actions_i);
-            py.detach(|| env.step(Actions::Discrete(acts)))
-                .map_err(to_py)
-        } else {
-            let a: PyReadonlyArrayDyn<'_, f32> = actions
-                .extract()
-                .map_err(|_| ActionError::new_err("continuous actions must be a float32 numpy array of shape (num_envs, num_agents, 2)"))?;
-            if a.shape() != [e, n, 2] {
-                return Err(ActionError::new_err(format!(
-                    "actions have shape {:?}, expected ({e}, {n}, 2) = (num_envs, num_agents, wheels)",
-                    a.shape()
-                )));
-            }
-            match a.as_slice() {
-                Ok(src) => inner.actions_f.copy_from_slice(src),
-                Err(_) => inner
-                    .actions_f
-                    .iter_mut()
-                    .zip(a.as_array().iter())
-                    .for_each(|(d, s)| *d = *s),
-            }
-            let (env, acts) = (&mut inner.env, &inner.actions_f);
-            py.detach(|| env.step(Actions::Continuous(acts)))
-                .map_err(to_py)
-        }
+        guard(|| {
+            let (e, n) = (self.num_envs, self.num_agents);
+            let acts = if self.discrete {
+                let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
+                    Kind::ActionType.err(format!(
+                        "discrete actions must be an int64 numpy array of shape ({e}, {n}) = \
+                         (num_envs, num_agents), got {}",
+                        args::show(actions)
+                    ))
+                })?;
+                if a.shape() != [e, n] {
+                    return Err(Kind::Action.err(format!(
+                        "actions have shape {:?}, expected ({e}, {n}) = (num_envs, num_agents)",
+                        a.shape()
+                    )));
+                }
+                Owned::Discrete(a.as_array().iter().copied().collect())
+            } else {
+                let a: PyReadonlyArrayDyn<'_, f32> = actions.extract().map_err(|_| {
+                    Kind::ActionType.err(format!(
+                        "continuous actions must be a float32 numpy array of shape ({e}, {n}, 2) = \
+                         (num_envs, num_agents, wheels), got {}",
+                        args::show(actions)
+                    ))
+                })?;
+                if a.shape() != [e, n, 2] {
+                    return Err(Kind::Action.err(format!(
+                        "actions have shape {:?}, expected ({e}, {n}, 2) = (num_envs, num_agents, wheels)",
+                        a.shape()
+                    )));
+                }
+                Owned::Continuous(match a.as_slice() {
+                    Ok(src) => src.to_vec(),
+                    Err(_) => a.as_array().iter().copied().collect(),
+                })
+            };
+            py.detach(|| {
+                let mut g = self.lock();
+                match &acts {
+                    Owned::Discrete(a) => g.env.step(Actions::Discrete(a)),
+                    Owned::Continuous(a) => g.env.step(Actions::Continuous(a)),
+                }
+            })
+            .map_err(to_py)
+        })
     }
 
-    /// The screen of world `world` with the robots drawn on it, `(H, W, 3)` uint8.
-    #[pyo3(signature = (world=0, width=640))]
+    /// The screen of world `world` with the robots drawn on it, `(H, W, 3)` uint8, `width` pixels
+    /// wide (16..=7680; the height follows the screen's aspect).
+    #[pyo3(signature = (world=None, width=None))]
     fn render<'py>(
         &self,
         py: Python<'py>,
-        world: usize,
-        width: u32,
+        world: Option<&Bound<'py, PyAny>>,
+        width: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let img = py
-            .detach(|| self.lock().env.render(world, width))
-            .map_err(to_py)?;
-        let (w, h) = (img.width() as usize, img.height() as usize);
-        let flat = PyArray1::from_vec(py, img.into_raw());
-        Ok(flat.reshape([h, w, 3])?.into_any())
+        guard(|| {
+            let w = match world.filter(|w| !w.is_none()) {
+                Some(w) => self.world_index(w)?,
+                None => 0,
+            };
+            let width = match width.filter(|w| !w.is_none()) {
+                Some(x) => args::int_in(x, "width", 16, limits::MAX_RENDER_WIDTH)? as u32,
+                None => 640,
+            };
+            let img = py.detach(|| {
+                let g = self.lock();
+                let size = g.env.scenario().spec.screen.size;
+                let height = (width as f64 * size[1] as f64 / size[0] as f64).round();
+                let pixels = height * width as f64;
+                if pixels.is_nan() || pixels > limits::MAX_RENDER_PIXELS as f64 {
+                    return Err(Err(format!(
+                        "width = {width}: the image would be {width} x {height} pixels (the screen is \
+                         {} x {} m), more than {} pixels; use a smaller width",
+                        size[0],
+                        size[1],
+                        limits::MAX_RENDER_PIXELS
+                    )));
+                }
+                g.env.render(w, width).map_err(Ok)
+            })
+            .map_err(|e| match e {
+                Ok(env_err) => to_py(env_err),
+                Err(msg) => Kind::Task.err(msg),
+            })?;
+            let (w, h) = (img.width() as usize, img.height() as usize);
+            let flat = PyArray1::from_vec(py, img.into_raw());
+            Ok(flat.reshape([h, w, 3])?.into_any())
+        })
     }
 
     /// Steps taken in the current episode of `world`.
-    fn episode_steps(&self, world: usize) -> PyResult<u64> {
-        self.check_world(world)?;
-        Ok(self.lock().env.episode_steps(world))
+    fn episode_steps(&self, py: Python<'_>, world: &Bound<'_, PyAny>) -> PyResult<u64> {
+        guard(|| {
+            let w = self.world_index(world)?;
+            Ok(py.detach(|| self.lock().env.episode_steps(w)))
+        })
     }
 
     /// Episode number of `world` since the seed was last set.
-    fn episode(&self, world: usize) -> PyResult<u64> {
-        self.check_world(world)?;
-        Ok(self.lock().env.episode(world))
+    fn episode(&self, py: Python<'_>, world: &Bound<'_, PyAny>) -> PyResult<u64> {
+        guard(|| {
+            let w = self.world_index(world)?;
+            Ok(py.detach(|| self.lock().env.episode(w)))
+        })
     }
 
     /// True poses `(R, 3)`: x m, y m, heading rad, of every robot of `world` (for analysis, not for
     /// policies).
-    fn poses<'py>(&self, py: Python<'py>, world: usize) -> PyResult<Bound<'py, PyAny>> {
-        self.check_world(world)?;
-        let inner = self.lock();
-        let w = inner.env.world(world).expect("checked");
-        let flat: Vec<f32> = w
-            .poses()
-            .iter()
-            .flat_map(|p| [p.pos.x, p.pos.y, p.heading])
-            .collect();
-        let r = w.robot_count();
-        Ok(PyArray1::from_vec(py, flat).reshape([r, 3])?.into_any())
+    fn poses<'py>(
+        &self,
+        py: Python<'py>,
+        world: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let w = self.world_index(world)?;
+            let (flat, r) = py.detach(|| {
+                let g = self.lock();
+                let world = g.env.world(w);
+                let flat: Vec<f32> = world
+                    .iter()
+                    .flat_map(|w| w.poses())
+                    .flat_map(|p| [p.pos.x, p.pos.y, p.heading])
+                    .collect();
+                (flat, world.map_or(0, |w| w.robot_count()))
+            });
+            Ok(PyArray1::from_vec(py, flat).reshape([r, 3])?.into_any())
+        })
     }
 
     /// Roles of the robots of a world, in robot order.
-    fn roles(&self) -> Vec<String> {
-        let inner = self.lock();
-        let w = inner.env.world(0).expect("num_envs >= 1");
-        (0..w.robot_count())
-            .map(|i| w.role(i).to_string())
-            .collect()
+    fn roles(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        guard(|| {
+            Ok(py.detach(|| {
+                let g = self.lock();
+                g.env.world(0).map_or_else(Vec::new, |w| {
+                    (0..w.robot_count())
+                        .map(|i| w.role(i).to_string())
+                        .collect()
+                })
+            }))
+        })
     }
 
     /// What steps the grid pheromones: `"cpu"` or `"gpu"`.
     #[getter]
-    fn backend_name(&self) -> &'static str {
-        self.lock().env.backend().name()
+    fn backend_name(&self, py: Python<'_>) -> PyResult<&'static str> {
+        guard(|| Ok(py.detach(|| self.lock().env.backend().name())))
     }
 
     /// One line on the field backend: `gpu: <adapter>` or `cpu (<why>)`.
     #[getter]
-    fn backend_info(&self) -> String {
-        self.lock().env.backend().describe().to_string()
+    fn backend_info(&self, py: Python<'_>) -> PyResult<String> {
+        guard(|| Ok(py.detach(|| self.lock().env.backend().describe().to_string())))
     }
 
     /// The scenario actually used, as TOML.
-    fn scenario_toml(&self) -> String {
-        self.lock().env.scenario().to_toml()
+    fn scenario_toml(&self, py: Python<'_>) -> PyResult<String> {
+        guard(|| Ok(py.detach(|| self.lock().env.scenario().to_toml())))
     }
 
     /// Current base seed.
     #[getter]
-    fn seed(&self) -> u64 {
-        self.lock().env.seed()
+    fn seed(&self, py: Python<'_>) -> PyResult<u64> {
+        guard(|| Ok(py.detach(|| self.lock().env.seed())))
     }
 }
 
+/// Actions copied out of Python's array, so that the env's lock is taken without the GIL.
+enum Owned {
+    Continuous(Vec<f32>),
+    Discrete(Vec<i64>),
+}
+
 impl PyVecEnv {
-    fn check_world(&self, world: usize) -> PyResult<()> {
-        let e = self.lock().env.spec().num_envs;
-        if world >= e {
-            return Err(TaskError::new_err(format!(
-                "world {world} does not exist (num_envs = {e})"
+    /// A reset mask: a 1-D bool array (or sequence of bools) of length num_envs.
+    fn mask(&self, m: &Bound<'_, PyAny>) -> PyResult<Vec<bool>> {
+        let e = self.num_envs;
+        let a: PyReadonlyArrayDyn<'_, bool> = m.extract().map_err(|_| {
+            Kind::ArgumentType.err(format!(
+                "reset mask must be a bool numpy array of shape ({e},), got {}",
+                args::show(m)
+            ))
+        })?;
+        if a.shape() != [e] {
+            return Err(Kind::Task.err(format!(
+                "reset mask must have shape ({e},) = (num_envs,), got shape {:?}",
+                a.shape()
             )));
         }
-        Ok(())
+        Ok(a.as_array().iter().copied().collect())
     }
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    limits::register(m)?;
     m.add_class::<PyVecEnv>()
 }

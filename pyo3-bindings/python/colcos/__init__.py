@@ -8,24 +8,33 @@ wheel speeds.
 >>> env = colcos.parallel_env(task="aggregation", max_cycles=500)
 >>> obs, infos = env.reset(seed=0)
 
-| task          | agents                | observation           | action                         |
-|---------------|-----------------------|-----------------------|--------------------------------|
-| `aggregation` | followers (3)         | Box(-1, 1, (17,)) f32 | Box(-1, 1, (2,)) or Discrete(6) |
-| `foraging`    | foragers (2)          | Box(-1, 1, (17,)) f32 | same                           |
-| `trail`       | trail robots (4)      | Box(-1, 1, (17,)) f32 | same                           |
+| task          | agents                | observation     | action                          |
+|---------------|-----------------------|-----------------|---------------------------------|
+| `aggregation` | followers (3)         | Box((17,)) f32  | Box(-1, 1, (2,)) or Discrete(6) |
+| `foraging`    | foragers (2)          | Box((17,)) f32  | same                            |
+| `trail`       | trail robots (4)      | Box((17,)) f32  | same                            |
+
+Observation bounds per entry: colour intensities and bumpers in [0, 1], the last wheel command in
+[-1, 1]. Every error raised is a `colcos.ColcosError` (see docs/python.md, "Errors").
 """
 
 from __future__ import annotations
 
-from colcos import _core
+# `colcos.vector` and `colcos.gymnasium_vector` come with `import colcos` (they need only numpy and
+# gymnasium); the SB3 and TorchRL adapters import their libraries and stay opt-in.
+from colcos import _core, gymnasium_vector, vector
 from colcos._core import (
     ActionError,
+    ActionTypeError,
+    ArgumentTypeError,
     BackendError,
     ColcosError,
     DisplayError,
+    InternalError,
     ScenarioError,
     StateError,
     TaskError,
+    UnknownAgentError,
     default_scenario,
     discrete_actions,
     observation_names,
@@ -36,22 +45,28 @@ __version__ = _core.__version__
 
 __all__ = [
     "ActionError",
+    "ActionTypeError",
+    "ArgumentTypeError",
     "BackendError",
     "ColcosError",
     "DisplayError",
     "ColcosParallelEnv",
+    "InternalError",
     "ScenarioError",
     "StateError",
     "TaskError",
+    "UnknownAgentError",
     "behaviour_params",
     "behaviours",
     "default_scenario",
     "discrete_actions",
     "env",
+    "gymnasium_vector",
     "observation_names",
     "parallel_env",
     "raw_env",
     "tasks",
+    "vector",
 ]
 
 

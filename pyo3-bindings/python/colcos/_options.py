@@ -2,17 +2,19 @@
 
 from __future__ import annotations
 
+import inspect
 import json
 import logging
 import os
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from gymnasium import spaces
 
-from colcos import _core
-from colcos._core import TaskError
+from colcos import _checks, _core
+from colcos._core import ArgumentTypeError, TaskError
 
 log = logging.getLogger("colcos")
 
@@ -32,34 +34,29 @@ def core_kwargs(
 ) -> dict[str, Any]:
     """Keyword arguments of `colcos._core.VecEnv` (all but num_envs, seed, threads, autoreset)."""
     if not isinstance(task, str):
-        raise TaskError(f"task must be a task name (str), got {type(task).__name__}")
+        raise ArgumentTypeError(f"task must be a task name (str), got {task!r} ({type(task).__name__})")
     kw: dict[str, Any] = {"task": task}
     if scenario is not None:
         text = os.fspath(scenario) if isinstance(scenario, os.PathLike) else scenario
         if not isinstance(text, str):
-            raise TaskError(f"scenario must be a path or TOML text, got {type(scenario).__name__}")
+            raise ArgumentTypeError(f"scenario must be a path or TOML text, got {type(scenario).__name__}")
         if "\n" in text:
             kw["scenario_text"] = text
         else:
             kw["scenario"] = text
     if max_cycles is not None:
-        if isinstance(max_cycles, bool) or not isinstance(max_cycles, (int, np.integer)) or max_cycles < 1:
-            raise TaskError(f"max_cycles must be a positive integer, got {max_cycles!r}")
-        kw["max_cycles"] = int(max_cycles)
-    kw["action"] = "continuous" if continuous else "discrete"
-    kw["global_state"] = bool(global_state)
+        kw["max_cycles"] = _checks.integer(max_cycles, "max_cycles", 1, _checks.limit("max_cycles"))
+    kw["action"] = "continuous" if _checks.flag(continuous, "continuous") else "discrete"
+    kw["global_state"] = _checks.flag(global_state, "global_state")
     if patch is not None:
-        kw["patch_pixels"] = int(patch)
-        kw["patch_side"] = float(patch_side)
+        kw["patch_pixels"] = _checks.integer(patch, "patch", 1, _checks.limit("patch"))
+        kw["patch_side"] = _checks.real(patch_side, "patch_side", positive=True)
     if backend is not None:
         if not isinstance(backend, str) or backend.lower() not in BACKENDS:
             raise TaskError(f"backend must be one of {BACKENDS} (or None: the scenario's [field] backend), got {backend!r}")
         kw["backend"] = backend.lower()
     if params:
-        try:
-            kw["params_json"] = json.dumps(params)
-        except TypeError as e:
-            raise TaskError(f"task parameters must be plain numbers, strings, booleans and lists: {e}") from e
+        kw["params_json"] = json.dumps({k: _checks.plain(v, k) for k, v in params.items()})
     return kw
 
 
@@ -68,7 +65,29 @@ def make_space(d: dict[str, Any]) -> spaces.Space:
     if d["kind"] == "discrete":
         return spaces.Discrete(int(d["n"]))
     dtype = np.float32 if d["dtype"] == "float32" else np.uint8
-    return spaces.Box(low=d["low"], high=d["high"], shape=tuple(d["shape"]), dtype=dtype)
+    shape = tuple(d["shape"])
+    # Per-entry bounds (a list) where the values take tighter ones than the envelope.
+    low = np.asarray(d["low"], dtype=dtype).reshape(shape) if isinstance(d["low"], list) else d["low"]
+    high = np.asarray(d["high"], dtype=dtype).reshape(shape) if isinstance(d["high"], list) else d["high"]
+    return spaces.Box(low=low, high=high, shape=shape, dtype=dtype)
+
+
+def make_box(d: dict[str, Any]) -> spaces.Box:
+    """A Gymnasium Box from a native spec dict of kind `box`."""
+    space = make_space(d)
+    assert isinstance(space, spaces.Box), d
+    return space
+
+
+def share_signature(make: Callable[..., Any], cls: type) -> None:
+    """Gives `make` (a function returning a `cls`) the signature and documentation of `cls`'s
+    constructor, so that `help(make)` shows the real arguments rather than `**kwargs`."""
+    sig = inspect.signature(cls.__init__)  # type: ignore[misc]
+    params = [p for name, p in sig.parameters.items() if name != "self"]
+    returns = inspect.signature(make).return_annotation
+    make.__signature__ = sig.replace(parameters=params, return_annotation=returns)  # type: ignore[attr-defined]
+    own = inspect.getdoc(make) or ""
+    make.__doc__ = f"{own}\n\n{inspect.getdoc(cls) or ''}"
 
 
 def log_backend(core: Any, asked: str | None) -> None:

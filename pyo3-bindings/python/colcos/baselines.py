@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from colcos import _core
+from colcos import _checks, _core
 from colcos.vector import VecEnv
 
 __all__ = ["Baseline", "RandomPolicy"]
@@ -27,11 +27,14 @@ class Baseline:
     """
 
     def __init__(self, env: VecEnv, name: str, seed: int = 0, **params: Any) -> None:
+        if not isinstance(env, VecEnv):
+            raise _core.ArgumentTypeError(f"env must be a colcos.vector.VecEnv, got {type(env).__name__}")
         if not env.continuous:
             raise _core.TaskError("baseline policies produce continuous wheel speeds; make the env with continuous=True")
         self.env = env
         self.name = name
-        self._policy = _core.Baseline(env._core, name, json.dumps(params) if params else None, int(seed))
+        plain = {k: _checks.plain(v, k) for k, v in params.items()}
+        self._policy = _core.Baseline(env._core, name, json.dumps(plain) if plain else None, _checks.seed(seed))
 
     def act(self, obs: np.ndarray | None = None) -> np.ndarray:
         """Actions (E, N, 2) float32 for the env's current sensor readings (`obs` is ignored)."""
@@ -43,10 +46,11 @@ class RandomPolicy:
 
     def __init__(self, env: VecEnv, seed: int = 0) -> None:
         self.env = env
-        self.rng = np.random.default_rng(seed)
+        self.rng = np.random.default_rng(_checks.seed(seed))
 
     def act(self, obs: np.ndarray | None = None) -> np.ndarray:
         e, n = self.env.num_envs, self.env.num_agents
         if self.env.continuous:
             return self.rng.uniform(-1.0, 1.0, size=(e, n, 2)).astype(np.float32)
-        return self.rng.integers(0, self.env.single_action_space.n, size=(e, n))
+        n_actions = int(getattr(self.env.single_action_space, "n", 0))
+        return self.rng.integers(0, n_actions, size=(e, n))

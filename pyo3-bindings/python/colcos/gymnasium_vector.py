@@ -1,9 +1,19 @@
 """`colcos.vector.VecEnv` as a Gymnasium 1.x `VectorEnv`, each (world, agent) pair one sub-environment.
 
 Parameter sharing: `num_envs = E * N`; observations `(E*N, 17)`, actions `(E*N, 2)` or `(E*N,)`.
-A world's agents finish together in every built-in task but `foraging`, where an agent that has
-arrived waits (stopped, reward 0, flagged terminated) until its world ends. Arrays are views of Rust
-memory, overwritten by the next step.
+Arrays are views of Rust memory, overwritten by the next step.
+
+Agents that finish early (`foraging`: an agent that reaches a branch end) wait, stopped, until every
+agent of their world has finished or the world is truncated. A waiting agent's sub-environment
+reports reward 0 and `terminated=False` while it waits, and `terminated=True` at the step its world
+ends, so each sub-environment ends each episode exactly once (what Gymnasium's wrappers, e.g.
+`RecordEpisodeStatistics`, count) and its return is the agent's own. `infos["waiting"]` (with
+`infos["_waiting"]`) marks the waiting sub-environments: their actions are ignored, and a learner
+may drop those steps. In the other built-in tasks a world's agents finish together.
+
+`reset(options={"reset_mask": m})` takes a bool array of shape `(E*N,)` and resets every world with
+a marked agent (a world resets as a whole). `reset(seed=[...])` uses the first seed (one base seed
+for the whole batch).
 """
 
 from __future__ import annotations
@@ -14,6 +24,8 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from colcos import _checks
+from colcos._core import ActionError, ActionTypeError, ArgumentTypeError
 from colcos.vector import VecEnv
 
 _MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP, "disabled": AutoresetMode.DISABLED}
@@ -35,31 +47,57 @@ class ColcosVectorEnv(VectorEnv):
         n = self.num_envs
         self._obs = v.obs.reshape(n, -1)
         self._rew = v.rewards.reshape(n)
-        self._term = v.terminated.reshape(n)
-        self._trunc = v.truncated.reshape(n)
         self._act_shape = v._act_shape
+        self._flat_act_shape = (n, 2) if v.continuous else (n,)
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
         if isinstance(seed, (list, tuple)):
-            seed = seed[0] if seed else None
+            seeds = [_checks.seed(s, f"seed[{i}]") for i, s in enumerate(seed)]
+            seed = seeds[0] if seeds else None
+        if options is not None and not isinstance(options, dict):
+            raise ArgumentTypeError(f"options must be a dict or None, got {type(options).__name__}")
         if options and "reset_mask" in options:
-            m = np.asarray(options["reset_mask"]).reshape(self.venv.num_envs, self.venv.num_agents)
+            m = np.asarray(options["reset_mask"])
+            if m.dtype != np.bool_:
+                raise ActionTypeError(f"reset_mask must be a bool array of shape ({self.num_envs},), got dtype {m.dtype}")
+            if m.shape != (self.num_envs,):
+                raise ActionError(f"reset_mask must have shape ({self.num_envs},) = (num_envs,), got {m.shape}")
+            m = m.reshape(self.venv.num_envs, self.venv.num_agents)
             options = dict(options, reset_mask=m.any(axis=1))
         self.venv.reset(seed=seed, options=options)
-        return self._obs, self._infos()
+        return self._obs, self._infos(None)
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
-        self.venv.step(np.asarray(actions).reshape(self._act_shape))
-        return self._obs, self._rew, self._term, self._trunc, self._infos()
-
-    def _infos(self) -> dict:
+        try:
+            a = np.asarray(actions)
+        except (TypeError, ValueError) as e:
+            raise ActionTypeError(f"actions cannot be made an array: {e}") from None
+        if a.shape != self._flat_act_shape:
+            raise ActionError(f"actions have shape {a.shape}, expected {self._flat_act_shape} = (num_envs, ...)")
         v = self.venv
+        v.step(a.reshape(self._act_shape))
+        term, trunc = v.terminated, v.truncated
+        ended = (term | trunc).all(axis=1, keepdims=True)  # the worlds that end at this step
+        waiting = term & ~ended
+        n = self.num_envs
+        out_term = (term & ended).reshape(n)
+        out_trunc = (trunc & ~term & ended).reshape(n)
+        return self._obs, self._rew, out_term, out_trunc, self._infos(waiting.reshape(n))
+
+    def _infos(self, waiting: np.ndarray | None) -> dict:
+        v = self.venv
+        infos: dict[str, Any] = {}
         if v.autoreset_mode == "same_step" and v.final_mask.any():
             n = self.num_envs
-            return {"final_obs": v.final_obs.reshape(n, -1), "_final_obs": np.repeat(v.final_mask, v.num_agents)}
-        return {}
+            infos["final_obs"] = v.final_obs.reshape(n, -1)
+            infos["_final_obs"] = np.repeat(v.final_mask, v.num_agents)
+        if waiting is not None and waiting.any():
+            infos["waiting"] = waiting
+            infos["_waiting"] = waiting
+        return infos
 
-    def render(self) -> np.ndarray:
+    def render(self) -> Any:
+        """World 0's screen with its robots, (H, W, 3) uint8."""
         return self.venv.render(0)
 
     def close_extras(self, **kwargs: Any) -> None:

@@ -12,9 +12,9 @@ from pettingzoo import ParallelEnv
 from pettingzoo.utils import wrappers
 from pettingzoo.utils.conversions import parallel_to_aec_wrapper
 
-from colcos import _core
-from colcos._core import ActionError, StateError
-from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_space
+from colcos import _actions, _checks, _core
+from colcos._core import ActionError, StateError, UnknownAgentError
+from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_space, share_signature
 
 RENDER_WIDTH = 640
 
@@ -32,7 +32,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         render_mode: None, `"human"` (a window showing the screen with the robots, at the field's
             rate, updated by every `reset` and `step`; `close()` closes it) or `"rgb_array"` (that
             image as an array).
-        continuous: two wheel speeds in [-1, 1] (True) or `Discrete(6)` (False).
+        continuous: two wheel speeds in [-1, 1] (True) or `Discrete(6)` (False); a bool.
         global_state: offer `state()` (all robot poses) for centralised critics.
         patch: if set, each observation is a dict with `"vector"` and an egocentric `"patch"` of the
             screen, `patch x patch x 3` uint8, covering `patch_side` m under and ahead of the robot.
@@ -41,7 +41,12 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             is one, else the CPU); None: the scenario's `[field] backend` (default `cpu`). What was
             taken is in `backend_name` (`"cpu"` / `"gpu"`) and `backend_info`, and logged (logger
             `colcos`, INFO).
+        seed: the base seed, an integer in 0..=2**64-1 (as for `reset(seed=...)`).
         **params: task parameters (see the task's docs); unknown ones raise `colcos.TaskError`.
+
+    Actions (`step`): a dict with an action for every agent in `agents`; see docs/python.md
+    ("Actions"). Continuous values outside [-1, 1] are clipped to it; anything else wrong raises a
+    `colcos.ActionError` naming the agent.
     """
 
     metadata = {
@@ -69,10 +74,9 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             task=task, scenario=scenario, max_cycles=max_cycles, render_mode=render_mode, continuous=continuous,
             global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, backend=backend, **params,
         )
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise _core.TaskError(f"render_mode {render_mode!r} is not one of {self.metadata['render_modes']} or None")
+        _checks.choice(render_mode, "render_mode", [None, "human", "rgb_array"])
         kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend)
-        self._core = _core.VecEnv(num_envs=1, seed=int(seed), num_threads=1, autoreset_mode="disabled", **kw)
+        self._core = _core.VecEnv(num_envs=1, seed=_checks.seed(seed), num_threads=1, autoreset_mode="disabled", **kw)
         log_backend(self._core, backend)
         spec = self._core.spec()
         self._spec = spec
@@ -91,6 +95,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self.observation_spaces = {a: _copy_space(obs_space) for a in self.possible_agents}
         self.action_spaces = {a: make_space(spec["action"]) for a in self.possible_agents}
         self._continuous = spec["action"]["kind"] == "box"
+        self._n_actions = 0 if self._continuous else int(spec["action"]["n"])
         if spec["state"] is not None:
             self.state_space = make_space(spec["state"])
         self._views = self._core.views()
@@ -112,7 +117,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         return {"init_kwargs": self._init_kwargs}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__init__(**state["init_kwargs"])
+        ColcosParallelEnv.__init__(self, **state["init_kwargs"])
 
     def observation_space(self, agent: str) -> spaces.Space:
         return self.observation_spaces[agent]
@@ -132,7 +137,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
 
     def reset(self, seed: int | None = None, options: dict | None = None) -> tuple[dict, dict]:
         if seed is not None:
-            seed = _check_seed(seed)
+            seed = _checks.seed(seed)
         self._core.reset(seed)
         self.agents = self.possible_agents[:]
         self._needs_reset = False
@@ -151,27 +156,25 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
                 raise StateError("every agent is done: call reset() before stepping again")
             return {}, {}, {}, {}, {}
         if not isinstance(actions, dict):
-            raise ActionError(f"actions must be a dict {{agent name: action}}, got {type(actions).__name__}")
+            raise _core.ActionTypeError(f"actions must be a dict {{agent name: action}}, got {type(actions).__name__}")
         buf = self._actions
         buf.fill(0)
         index = self._index
+        fast = self._continuous
         for name, a in actions.items():
             i = index.get(name)
             if i is None:
-                raise ActionError(f"unknown agent {name!r}; the agents are {self.possible_agents}")
-            if a is None:
-                continue
-            try:
-                if self._continuous:
-                    buf[0, i] = a
-                else:
-                    v = int(a)
-                    if v != a:
-                        raise ValueError(f"{a!r} is not an integer")
-                    buf[0, i] = v
-            except (TypeError, ValueError) as e:
-                want = "two wheel speeds in [-1, 1]" if self._continuous else "an integer action"
-                raise ActionError(f"action of agent {name!r} must be {want}, got {a!r} ({e})") from None
+                raise UnknownAgentError(f"unknown agent {name!r}; the agents are {self.possible_agents}")
+            if fast and type(a) is np.ndarray and a.dtype == np.float32 and a.shape == (2,):
+                buf[0, i] = a  # the common case; the core refuses non-finite values, naming the agent
+            elif name in self.agents:
+                buf[0, i] = self.check_action(name, a)
+            # (actions for agents that are already done are ignored, whatever they are)
+        # With every agent live and one action each, none is missing; otherwise look.
+        if len(actions) != len(self.agents) or len(self.agents) != len(self.possible_agents):
+            missing = [a for a in self.agents if a not in actions]
+            if missing:
+                raise ActionError(f"no action for agents {missing}: every agent in env.agents needs one")
         self._core.step(buf)
         v = self._views
         # One copy and one conversion per buffer rather than per agent: each agent's observation is a
@@ -179,7 +182,11 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         rew, term, trunc = v["rewards"][0].tolist(), v["terminated"][0].tolist(), v["truncated"][0].tolist()
         all_obs = v["obs"][0].copy()
         patches = v["patch"][0].copy() if "patch" in v else None
-        obs, rewards, terminations, truncations, infos = {}, {}, {}, {}, {}
+        obs: dict[str, Any] = {}
+        rewards: dict[str, float] = {}
+        terminations: dict[str, bool] = {}
+        truncations: dict[str, bool] = {}
+        infos: dict[str, dict] = {}
         live = []
         for a in self.agents:
             i = index[a]
@@ -193,6 +200,15 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self.agents = live
         self._show()
         return obs, rewards, terminations, truncations, infos
+
+    def check_action(self, agent: str, action: Any) -> Any:
+        """`action` of `agent` checked against its action space (continuous values are clipped to
+        [-1, 1] when stepped); raises a `colcos.ActionError` naming the agent."""
+        if agent not in self._index:
+            raise UnknownAgentError(f"unknown agent {agent!r}; the agents are {self.possible_agents}")
+        if self._continuous:
+            return _actions.continuous(agent, action)
+        return _actions.discrete(agent, action, self._n_actions)
 
     def state(self) -> np.ndarray:
         if "state" not in self._views:
@@ -231,22 +247,22 @@ def _copy_space(s: spaces.Space) -> spaces.Space:
     return s
 
 
-def _check_seed(seed: Any) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise _core.TaskError(f"seed must be a non-negative integer, got {seed!r}")
-    return int(seed) & (2**64 - 1)
-
-
 def parallel_env(**kwargs: Any) -> ColcosParallelEnv:
     """A colcos task as a PettingZoo `ParallelEnv` (see `ColcosParallelEnv`)."""
     return ColcosParallelEnv(**kwargs)
 
 
 def raw_env(**kwargs: Any) -> parallel_to_aec_wrapper:
-    """The AEC form of `parallel_env`, without the order-enforcing wrapper."""
-    return parallel_to_aec_wrapper(ColcosParallelEnv(**kwargs))
+    """The AEC form of `parallel_env`, without the order-enforcing wrapper. A bad action raises at
+    the `step` that receives it."""
+    return _actions.CheckedAecWrapper(ColcosParallelEnv(**kwargs))
 
 
 def env(**kwargs: Any) -> wrappers.OrderEnforcingWrapper:
     """The AEC form of `parallel_env`, wrapped as PettingZoo's `env()` functions are."""
     return wrappers.OrderEnforcingWrapper(raw_env(**kwargs))
+
+
+# help(colcos.parallel_env) shows the environment's own arguments and documentation.
+for _make in (parallel_env, raw_env, env):
+    share_signature(_make, ColcosParallelEnv)

@@ -12,6 +12,8 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv as SB3VecEnv
 
+from colcos import _checks
+from colcos._core import ActionError
 from colcos.vector import VecEnv
 
 
@@ -35,7 +37,11 @@ class ColcosSB3VecEnv(SB3VecEnv):
 
     def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict]]:
         v = self.venv
-        obs, rew, term, trunc, _ = v.step(np.asarray(self._actions).reshape(v._act_shape))
+        a = np.asarray(self._actions)
+        want = (self.num_envs, 2) if v.continuous else (self.num_envs,)
+        if a.shape != want:
+            raise ActionError(f"actions have shape {a.shape}, expected {want} = (num_envs, ...)")
+        obs, rew, term, trunc, _ = v.step(a.reshape(v._act_shape))
         n = self.num_envs
         dones = np.repeat(v.final_mask, v.num_agents)
         final = v.final_obs.reshape(n, -1)
@@ -51,7 +57,7 @@ class ColcosSB3VecEnv(SB3VecEnv):
         self.venv.close()
 
     def seed(self, seed: int | None = None) -> list[int | None]:
-        self._seed = seed
+        self._seed = None if seed is None else _checks.seed(seed)
         return [seed] * self.num_envs
 
     def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:

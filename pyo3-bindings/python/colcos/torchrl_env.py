@@ -15,10 +15,12 @@ from typing import Any
 
 import numpy as np
 import torch
+from gymnasium import spaces
 from tensordict import TensorDict, TensorDictBase
 from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
+from colcos import _checks
 from colcos.vector import VecEnv
 
 
@@ -32,15 +34,21 @@ class ColcosTorchEnv(EnvBase):
         v = self.venv
         super().__init__(device=device, batch_size=torch.Size([v.num_envs]))
         e, n = v.num_envs, v.num_agents
-        obs = Bounded(low=-1.0, high=1.0, shape=(e, n, 17), dtype=torch.float32, device=self.device)
+        # The bounds the values take, per entry (as the Gymnasium spaces declare them).
+        o = v.single_observation_space
+        lo, hi = (torch.as_tensor(np.broadcast_to(b, (e, n, *o.shape)).copy()) for b in (o.low, o.high))
+        obs = Bounded(low=lo, high=hi, shape=(e, n, *o.shape), dtype=torch.float32, device=self.device)
         group = Composite(observation=obs, shape=(e, n), device=self.device)
         spec = Composite(robot=group, shape=(e,), device=self.device)
-        if v.state is not None:
-            spec["state"] = Bounded(low=-1.0, high=1.0, shape=(e, v.state.shape[1]), dtype=torch.float32, device=self.device)
+        if v.state is not None and v.state_space is not None:
+            s = v.state_space
+            lo, hi = (torch.as_tensor(np.broadcast_to(b, (e, *s.shape)).copy()) for b in (s.low, s.high))
+            spec["state"] = Bounded(low=lo, high=hi, shape=(e, *s.shape), dtype=torch.float32, device=self.device)
         self.observation_spec = spec
         if v.continuous:
             act = Bounded(low=-1.0, high=1.0, shape=(e, n, 2), dtype=torch.float32, device=self.device)
         else:
+            assert isinstance(v.single_action_space, spaces.Discrete)
             act = Categorical(n=int(v.single_action_space.n), shape=(e, n), dtype=torch.int64, device=self.device)
         self.action_spec = Composite(robot=Composite(action=act, shape=(e, n), device=self.device), shape=(e,), device=self.device)
         self.reward_spec = Composite(
@@ -101,5 +109,5 @@ class ColcosTorchEnv(EnvBase):
 
     def _set_seed(self, seed: int | None) -> None:
         if seed is not None:
-            self.venv.reset(seed=int(seed))
+            self.venv.reset(seed=_checks.seed(seed))
             self._started = True

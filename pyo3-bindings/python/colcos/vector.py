@@ -21,9 +21,9 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from colcos import _core
-from colcos._core import ActionError
-from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_space
+from colcos import _checks, _core
+from colcos._core import ActionError, ActionTypeError, ArgumentTypeError
+from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_box, make_space
 
 __all__ = ["VecEnv"]
 
@@ -35,9 +35,10 @@ class VecEnv(BackendInfo):
 
     Args:
         task: task name (`colcos.tasks()`).
-        num_envs: number of worlds `E`.
-        seed: base seed; `reset(seed=...)` replaces it.
-        num_threads: worker threads (None: one per core).
+        num_envs: number of worlds `E` (1..=65536; a batch whose worlds would not fit in memory is
+            refused, naming num_envs).
+        seed: base seed, an integer in 0..=2**64-1; `reset(seed=...)` replaces it.
+        num_threads: worker threads, 1..=1024 (None: one per core).
         scenario, max_cycles, continuous, global_state, patch, patch_side, **params: as for
             `colcos.parallel_env`.
         autoreset_mode: `"next_step"`, `"same_step"` or `"disabled"`.
@@ -64,23 +65,19 @@ class VecEnv(BackendInfo):
         render_mode: str | None = None,
         **params: Any,
     ) -> None:
-        if render_mode not in (None, "rgb_array", "human"):
-            raise _core.TaskError(f"render_mode {render_mode!r} is not one of ['human', 'rgb_array'] or None")
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
-            raise _core.TaskError(f"num_envs must be a positive integer, got {num_envs!r}")
-        if num_threads is not None and (not isinstance(num_threads, (int, np.integer)) or num_threads < 1):
-            raise _core.TaskError(f"num_threads must be a positive integer or None, got {num_threads!r}")
-        if autoreset_mode not in AUTORESET_MODES:
-            raise _core.TaskError(f"autoreset_mode {autoreset_mode!r} is not one of {AUTORESET_MODES}")
+        _checks.choice(render_mode, "render_mode", [None, "rgb_array", "human"])
+        num_envs = _checks.integer(num_envs, "num_envs", 1, _checks.limit("num_envs"))
+        if num_threads is not None:
+            num_threads = _checks.integer(num_threads, "num_threads", 1, _checks.limit("num_threads"))
+        _checks.choice(autoreset_mode, "autoreset_mode", AUTORESET_MODES)
+        seed = _checks.seed(seed)
         self._init_kwargs = dict(
             task=task, num_envs=num_envs, seed=seed, num_threads=num_threads, scenario=scenario, max_cycles=max_cycles,
             continuous=continuous, autoreset_mode=autoreset_mode, global_state=global_state, patch=patch,
             patch_side=patch_side, backend=backend, render_mode=render_mode, **params,
         )
         kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend)
-        self._core = _core.VecEnv(
-            num_envs=int(num_envs), seed=int(seed), num_threads=num_threads, autoreset_mode=autoreset_mode, **kw
-        )
+        self._core = _core.VecEnv(num_envs=num_envs, seed=seed, num_threads=num_threads, autoreset_mode=autoreset_mode, **kw)
         log_backend(self._core, backend)
         self.spec: dict[str, Any] = self._core.spec()
         self.render_mode = render_mode
@@ -91,10 +88,10 @@ class VecEnv(BackendInfo):
         self.agents: list[str] = list(self.spec["agent_names"])
         self.autoreset_mode = autoreset_mode
         self.continuous = self.spec["action"]["kind"] == "box"
-        self.single_observation_space: spaces.Box = make_space(self.spec["observation"])
+        self.single_observation_space: spaces.Box = make_box(self.spec["observation"])
         self.single_action_space: spaces.Space = make_space(self.spec["action"])
-        self.state_space: spaces.Box | None = make_space(self.spec["state"]) if self.spec["state"] else None
-        self.patch_space: spaces.Box | None = make_space(self.spec["patch"]) if self.spec["patch"] else None
+        self.state_space: spaces.Box | None = make_box(self.spec["state"]) if self.spec["state"] else None
+        self.patch_space: spaces.Box | None = make_box(self.spec["patch"]) if self.spec["patch"] else None
         v = self._core.views()
         self.obs: np.ndarray = v["obs"]
         self.rewards: np.ndarray = v["rewards"]
@@ -112,18 +109,22 @@ class VecEnv(BackendInfo):
         return {"init_kwargs": self._init_kwargs}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__init__(**state["init_kwargs"])
+        VecEnv.__init__(self, **state["init_kwargs"])
 
     def reset(self, seed: int | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
         """Resets all worlds, or those in `options["reset_mask"]` (bool array of length E)."""
         mask = None
-        if options and "reset_mask" in options:
+        if options is not None and not isinstance(options, dict):
+            raise ArgumentTypeError(f"options must be a dict or None, got {type(options).__name__}")
+        if options and options.get("reset_mask") is not None:
             mask = np.asarray(options["reset_mask"])
-            if mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
-                raise ActionError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {mask.dtype} {mask.shape}")
-        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
-            raise _core.TaskError(f"seed must be a non-negative integer, got {seed!r}")
-        self._core.reset(None if seed is None else int(seed), mask)
+            if mask.dtype != np.bool_:
+                raise ActionTypeError(f"reset_mask must be a bool array of shape ({self.num_envs},), got dtype {mask.dtype}")
+            if mask.shape != (self.num_envs,):
+                raise ActionError(f"reset_mask must have shape ({self.num_envs},) = (num_envs,), got {mask.shape}")
+        if seed is not None:
+            seed = _checks.seed(seed)
+        self._core.reset(seed, mask)
         if self._window is not None:
             self._window.show(self._core.render(0, 640))
         return self.obs, self._infos()
@@ -132,16 +133,19 @@ class VecEnv(BackendInfo):
         """Steps every world with `actions` of shape (E, N, 2) float (continuous) or (E, N) int."""
         a = actions
         if not (isinstance(a, np.ndarray) and a.dtype == self._act_dtype):
+            if a is None:
+                raise ActionTypeError(f"actions must be an array of shape {self._act_shape}, got None")
             try:
                 a = np.asarray(a)
             except (TypeError, ValueError) as e:
-                raise ActionError(f"actions cannot be made an array: {e}") from None
+                raise ActionTypeError(f"actions cannot be made an array: {e}") from None
+            if a.dtype.kind not in "iuf":
+                raise ActionTypeError(f"actions must be real numbers, got dtype {a.dtype}")
             if not self.continuous and a.dtype.kind == "f":
                 if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
                     raise ActionError("discrete actions must be integers")
-            if a.dtype.kind not in "biuf":
-                raise ActionError(f"actions must be numbers, got dtype {a.dtype}")
-            a = a.astype(self._act_dtype)
+            if a.shape == self._act_shape:
+                a = a.astype(self._act_dtype)
         if a.shape != self._act_shape:
             raise ActionError(f"actions have shape {a.shape}, expected {self._act_shape}")
         self._core.step(a)
@@ -161,11 +165,17 @@ class VecEnv(BackendInfo):
         return infos
 
     def render(self, world: int = 0, width: int = 640) -> np.ndarray:
-        """The screen of `world` with the robots drawn on it, (H, W, 3) uint8."""
+        """The screen of `world` with the robots drawn on it, (H, W, 3) uint8, `width` pixels wide
+        (16..=7680; the height follows the screen's aspect)."""
         return self._core.render(world, width)
 
     def episode_steps(self, world: int) -> int:
+        """Steps taken in the current episode of `world`."""
         return self._core.episode_steps(world)
+
+    def episode(self, world: int) -> int:
+        """Episode number of `world` since the seed was last set."""
+        return self._core.episode(world)
 
     def poses(self, world: int) -> np.ndarray:
         """True poses (R, 3) of every robot of `world` (analysis only)."""
