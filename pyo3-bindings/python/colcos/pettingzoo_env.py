@@ -17,6 +17,7 @@ from colcos._core import ActionError, StateError, UnknownAgentError
 from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_space, share_signature
 
 RENDER_WIDTH = 640
+_F32 = np.dtype(np.float32)
 
 
 class ColcosParallelEnv(BackendInfo, ParallelEnv):
@@ -165,7 +166,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             i = index.get(name)
             if i is None:
                 raise UnknownAgentError(f"unknown agent {name!r}; the agents are {self.possible_agents}")
-            if fast and type(a) is np.ndarray and a.dtype == np.float32 and a.shape == (2,):
+            if fast and type(a) is np.ndarray and a.dtype is _F32 and a.shape == (2,):
                 buf[0, i] = a  # the common case; the core refuses non-finite values, naming the agent
             elif name in self.agents:
                 buf[0, i] = self.check_action(name, a)
