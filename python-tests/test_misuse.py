@@ -199,6 +199,11 @@ def test_missing_and_unknown_agents_are_refused():
         env.step({**_acts(env), "robot_9": np.zeros(2, np.float32)})
     with pytest.raises(colcos.ActionTypeError, match="dict"):
         env.step([np.zeros(2, np.float32)] * 3)
+    for space in (env.observation_space, env.action_space):
+        with pytest.raises(colcos.UnknownAgentError, match="robot_7"):
+            space("robot_7")
+    with pytest.raises(colcos.TaskError, match="render mode"):
+        env.render("ascii")
 
 
 def test_out_of_range_continuous_actions_are_clipped():
@@ -240,6 +245,14 @@ def test_the_aec_env_raises_at_the_step_that_receives_a_bad_action():
     aec.step(np.zeros(2, np.float32))
     with pytest.raises(colcos.ActionTypeError, match=aec.agent_selection):
         aec.step(None)
+    # A done agent's action must be None (PettingZoo's convention), said as an ActionError.
+    while aec.agents:
+        agent = aec.agent_selection
+        done = aec.terminations[agent] or aec.truncations[agent]
+        if done:
+            with pytest.raises(colcos.ActionError, match=f"{agent}.*done"):
+                aec.step(np.zeros(2, np.float32))
+        aec.step(None if done else np.zeros(2, np.float32))
 
 
 def test_help_shows_the_real_signature_and_docs():

@@ -68,4 +68,6 @@ class CheckedAecWrapper(parallel_to_aec_wrapper):
         live = not (self.terminations.get(agent, False) or self.truncations.get(agent, False))
         if live:
             self.env.check_action(agent, action)
+        elif action is not None:
+            raise ActionError(f"agent {agent!r} is done: its action must be None, got {_show(action)}")
         super().step(action)

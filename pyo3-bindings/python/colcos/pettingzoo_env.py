@@ -121,9 +121,13 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         ColcosParallelEnv.__init__(self, **state["init_kwargs"])
 
     def observation_space(self, agent: str) -> spaces.Space:
+        if agent not in self.observation_spaces:
+            raise UnknownAgentError(f"unknown agent {agent!r}; the agents are {self.possible_agents}")
         return self.observation_spaces[agent]
 
     def action_space(self, agent: str) -> spaces.Space:
+        if agent not in self.action_spaces:
+            raise UnknownAgentError(f"unknown agent {agent!r}; the agents are {self.possible_agents}")
         return self.action_spaces[agent]
 
     @property
@@ -218,6 +222,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
 
     def render(self, mode: str | None = None) -> np.ndarray | None:
         mode = mode or self.render_mode
+        _checks.choice(mode, "render mode", [None, "human", "rgb_array"])
         if mode is None:
             warnings.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human'", stacklevel=2)
             return None
