@@ -197,12 +197,12 @@ const CASE2: &[(&str, u64)] = &[
 ];
 const EXPERIMENTS: &[(&str, u64)] = &[
     ("case1/arrivals.csv", 0x2b8abca265e0d18c),
-    ("case1/fig5_arrivals.png", 0xa0b4dca6654b7cbf),
-    ("case1/fig6_g3_trajectories.png", 0x3244cd256df5d44f),
-    ("case1/trajectories_all_groups.png", 0x82f003ab3f49aa7f),
+    ("case1/fig5_arrivals.png", 0x61705c05ab7e61ac),
+    ("case1/fig6_g3_trajectories.png", 0xdb9b6f9cc60c85fc),
+    ("case1/trajectories_all_groups.png", 0xf3ff53c232d8e3ae),
     ("case1/trials.csv", 0x5cf0e3ea7a11874a),
-    ("case2/fig7_snapshots.png", 0x82aa2691c6011d39),
-    ("case2/fig8_s_t.png", 0x5b86c92d5477e0b9),
+    ("case2/fig7_snapshots.png", 0x1e2ed21bbc05eaa9),
+    ("case2/fig8_s_t.png", 0xc7e92a7e2518f57a),
     ("case2/s_t.csv", 0x292c5b6fcdc98acd),
-    ("case2/trajectories.png", 0xa95b43dc93f02470),
+    ("case2/trajectories.png", 0x043f59ed69eb4dd8),
 ];

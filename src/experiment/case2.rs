@@ -1,7 +1,8 @@
 //! Case II: aggregation and alarm pheromones. `runs` independent runs of `scenarios/case2_alarm.toml`
 //! (a leader, three followers, a wandering predator), sampled every `sample_every` seconds: S(t) of
 //! eq. (9), whether any prey robot senses the alarm (which splits the run into aggregation and
-//! dispersion phases), every robot's position, and a screen snapshot every `snapshot_every` seconds.
+//! dispersion phases) and every robot's position. The figures' screen snapshots come from running the
+//! chosen run again to the chosen moments ([`snapshots_at`]): runs are deterministic per index.
 use anyhow::{Context, Result};
 use colcos_sim::behaviour::paper::RED;
 use colcos_sim::metrics::{
@@ -21,8 +22,6 @@ pub struct Case2Config {
     pub runs: usize,
     /// Seconds between S(t) samples.
     pub sample_every: f32,
-    /// Seconds between screen snapshots.
-    pub snapshot_every: f32,
     /// Width of the snapshots, pixels.
     pub snapshot_width: u32,
     /// Mean red intensity above which a robot senses the alarm (the behaviours' `alarm_threshold`).
@@ -39,7 +38,6 @@ impl Case2Config {
             scenario,
             runs,
             sample_every: 0.1,
-            snapshot_every: 5.0,
             snapshot_width: 480,
             alarm_threshold: 0.05,
         })
@@ -57,8 +55,6 @@ pub struct Case2Run {
     /// Per robot, its positions at the sample times.
     pub paths: Vec<Vec<Vec2>>,
     pub roles: Vec<String>,
-    /// (time, screen with the robots drawn on it).
-    pub snapshots: Vec<(f32, image::RgbImage)>,
     /// Largest relative fall of S over an aggregation phase (from the phase's start to its minimum).
     pub aggregation_fall: f32,
     /// Largest relative rise of S over a dispersion phase (from the alarm to the phase's maximum; None:
@@ -112,12 +108,10 @@ pub fn run_one(cfg: &Case2Config, index: usize) -> Result<Case2Run> {
     let prey: Vec<usize> = (0..n).filter(|&i| roles[i] != "predator").collect();
     let dt = world.dt();
     let every = ((cfg.sample_every / dt).round() as u64).max(1);
-    let snap_every = ((cfg.snapshot_every / dt).round() as u64).max(1);
     let (mut times, mut s, mut alarm) = (Vec::new(), Vec::new(), Vec::new());
     let mut paths = vec![Vec::new(); n];
-    let mut snapshots = Vec::new();
     let mut positions = Vec::with_capacity(n);
-    let mut record = |world: &World, snapshots: &mut Vec<(f32, image::RgbImage)>| {
+    let mut record = |world: &World| {
         positions.clear();
         positions.extend(world.poses().iter().map(|p| p.pos));
         times.push(world.time());
@@ -130,15 +124,12 @@ pub fn run_one(cfg: &Case2Config, index: usize) -> Result<Case2Run> {
         for (p, q) in paths.iter_mut().zip(&positions) {
             p.push(*q);
         }
-        if world.tick().is_multiple_of(snap_every) {
-            snapshots.push((world.time(), snapshot(world, cfg.snapshot_width)));
-        }
     };
-    record(&world, &mut snapshots);
+    record(&world);
     while !world.is_finished() {
         world.step();
         if world.tick().is_multiple_of(every) {
-            record(&world, &mut snapshots);
+            record(&world);
         }
     }
     let phases = phases(&times, &alarm);
@@ -159,10 +150,29 @@ pub fn run_one(cfg: &Case2Config, index: usize) -> Result<Case2Run> {
         phases,
         paths,
         roles,
-        snapshots,
         aggregation_fall,
         alarm_rise,
     })
+}
+
+/// The screen of run `index` with the robots drawn on it at each of `times` (s, ascending), by running
+/// that run again: the same world index gives the same run.
+pub fn snapshots_at(
+    cfg: &Case2Config,
+    index: usize,
+    times: &[f32],
+) -> Result<Vec<image::RgbImage>> {
+    let mut world = World::with_index(&cfg.scenario, index as u64)?;
+    let dt = world.dt();
+    let mut out = Vec::with_capacity(times.len());
+    for &t in times {
+        let tick = (t / dt).round() as u64;
+        while world.tick() < tick && !world.is_finished() {
+            world.step();
+        }
+        out.push(snapshot(&world, cfg.snapshot_width));
+    }
+    Ok(out)
 }
 
 /// Every run in parallel, gathered by run index. `tick` is called once per finished run.

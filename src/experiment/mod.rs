@@ -8,7 +8,10 @@
 //! results are gathered by trial index, never by completion order.
 pub mod case1;
 pub mod case2;
+pub mod fig6;
+pub mod fig78;
 pub mod layout;
+pub mod moments;
 pub mod plots;
 pub mod summary;
 
@@ -212,10 +215,10 @@ fn write_case1(r: &case1::Case1Result, dir: &Path) -> Result<Vec<PathBuf>> {
     plots::fig5_arrivals(r, &f5)?;
     files.push(f5);
     let f6 = dir.join("fig6_g3_trajectories.png");
-    plots::fig6_trajectories(r, 2, &f6)?;
+    fig6::fig6_trajectories(r, 2, &f6)?;
     files.push(f6);
     let all = dir.join("trajectories_all_groups.png");
-    plots::trajectories_all_groups(r, &all)?;
+    fig6::trajectories_all_groups(r, &all)?;
     files.push(all);
     Ok(files)
 }
@@ -228,13 +231,13 @@ fn write_case2(r: &case2::Case2Result, dir: &Path) -> Result<Vec<PathBuf>> {
         .with_context(|| format!("writing {}", csv.display()))?;
     files.push(csv);
     let f8 = dir.join("fig8_s_t.png");
-    plots::fig8_s_t(r, &f8)?;
+    fig78::fig8_s_t(r, &f8)?;
     files.push(f8);
     let f7 = dir.join("fig7_snapshots.png");
-    plots::fig7_snapshots(r, &f7)?;
+    fig78::fig7_snapshots(r, &f7)?;
     files.push(f7);
     let tr = dir.join("trajectories.png");
-    plots::case2_trajectories(r, &tr)?;
+    fig78::case2_trajectories(r, &tr)?;
     files.push(tr);
     Ok(files)
 }

@@ -225,19 +225,28 @@ pub fn markdown(r1: Option<&Case1Result>, r2: Option<&Case2Result>, wall: f64) -
                 .map_or("none".to_string(), |p| format!("{:.1} s", p.start));
             let rise = run
                 .alarm_rise
-                .map_or("-".to_string(), |x| format!("{:.0} %", 100.0 * x));
+                .map_or("none".to_string(), |x| format!("{:.0} %", 100.0 * x));
             let bounds: Vec<String> = run
                 .phases
                 .iter()
                 .skip(1)
                 .map(|p| format!("{:.1}", p.start))
                 .collect();
+            let bounds = if bounds.is_empty() {
+                vec!["none".to_string()]
+            } else {
+                bounds
+            };
             s.push_str(&format!(
                 "| {k} | {:.0} % | {alarm} | {rise} | {} |\n",
                 100.0 * run.aggregation_fall,
                 bounds.join(", ")
             ));
         }
+        s.push_str(&format!(
+            "\nFigs. 7 and 8 show run {} (the first run with an aggregation phase, an alarm and, where a run has one, aggregation again).\n",
+            super::moments::featured_run(r)
+        ));
         s.push_str("\n| claim (paper, Fig. 8) | paper | measured | holds |\n|---|---|---|---|\n");
         s.push_str(&format!(
             "| S(t) falls by at least half during aggregation | S decays | every run: {} | {} |\n",
@@ -246,7 +255,7 @@ pub fn markdown(r1: Option<&Case1Result>, r2: Option<&Case2Result>, wall: f64) -
         ));
         let rises: Vec<f32> = c.rises.iter().map(|r| r.unwrap_or(f32::NAN)).collect();
         s.push_str(&format!(
-            "| S(t) rises by at least half after an alarm | S increases | every run with an alarm (NaN: the predator never came near; alarms needed in half the runs): {} | {} |\n\n",
+            "| S(t) rises by at least half after an alarm | S increases | every run with an alarm (none: the predator never came near; alarms needed in half the runs): {} | {} |\n\n",
             fmt_list(&rises),
             yes(c.rise_ok)
         ));
