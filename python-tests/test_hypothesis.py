@@ -17,6 +17,14 @@ from hypothesis import strategies as st
 import colcos
 from isolate import run
 
+HAS_SB3 = importlib.util.find_spec("stable_baselines3") is not None
+HAS_TORCHRL = importlib.util.find_spec("torchrl") is not None
+# Imported here, so that the zygote the children are forked from has them (torch takes seconds).
+if HAS_SB3:
+    import colcos.sb3  # noqa: F401
+if HAS_TORCHRL:
+    import colcos.torchrl_env  # noqa: F401
+
 SETTINGS = settings(
     max_examples=50,
     deadline=None,
@@ -274,7 +282,7 @@ def test_baseline(name, seed, params):
     checked(run(baseline, name, seed, params))
 
 
-@pytest.mark.skipif(importlib.util.find_spec("stable_baselines3") is None, reason="needs stable-baselines3")
+@pytest.mark.skipif(not HAS_SB3, reason="needs stable-baselines3")
 @settings(SETTINGS, max_examples=10)
 @given(
     kwargs=st.fixed_dictionaries({"max_cycles": st.integers(1, 5)}, optional={"num_envs": sizes}),
@@ -285,7 +293,7 @@ def test_sb3_adapter(kwargs, seed, acts):
     checked(run(sb3, kwargs, seed, acts, timeout=60))
 
 
-@pytest.mark.skipif(importlib.util.find_spec("torchrl") is None, reason="needs torchrl")
+@pytest.mark.skipif(not HAS_TORCHRL, reason="needs torchrl")
 @settings(SETTINGS, max_examples=10)
 @given(
     kwargs=st.fixed_dictionaries({"max_cycles": st.integers(1, 5)}, optional={"num_envs": sizes}),
