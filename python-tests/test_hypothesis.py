@@ -7,6 +7,8 @@ the input, the call returns or raises a `colcos.ColcosError` with a message; an 
 from __future__ import annotations
 
 import importlib.util
+import os
+import time
 from typing import Any
 
 import numpy as np
@@ -151,6 +153,28 @@ def baseline(name: Any, seed: Any, params: dict) -> None:
     v = colcos.vector.VecEnv(num_envs=1, max_cycles=5)
     v.reset(seed=0)
     v.step(Baseline(v, name, seed=seed, **params).act())
+
+
+def abort() -> None:
+    os.abort()
+
+
+def hang() -> None:
+    time.sleep(600)
+
+
+def hog() -> None:
+    bytearray(3 << 30)
+
+
+def test_the_harness_reports_aborts_hangs_and_runaway_memory():
+    with pytest.raises(AssertionError, match="signal 6"):
+        run(abort)
+    with pytest.raises(AssertionError, match="hung"):
+        run(hang, timeout=1)
+    out = run(hog)
+    assert not out.ok and out.error_type == "builtins.MemoryError"
+    checked(run(make_vec, {"num_envs": 2}))
 
 
 # --- the properties ---
