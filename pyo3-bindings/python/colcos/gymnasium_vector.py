@@ -13,7 +13,7 @@ may drop those steps. In the other built-in tasks a world's agents finish togeth
 
 `reset(options={"reset_mask": m})` takes a bool array of shape `(E*N,)` and resets every world with
 a marked agent (a world resets as a whole). `reset(seed=[...])` uses the first seed (one base seed
-for the whole batch).
+for the whole batch; None entries are allowed, the others must be valid seeds).
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ class ColcosVectorEnv(VectorEnv):
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
         if isinstance(seed, (list, tuple)):
-            seeds = [_checks.seed(s, f"seed[{i}]") for i, s in enumerate(seed)]
+            seeds = [None if s is None else _checks.seed(s, f"seed[{i}]") for i, s in enumerate(seed)]
             seed = seeds[0] if seeds else None
         if options is not None and not isinstance(options, dict):
             raise ArgumentTypeError(f"options must be a dict or None, got {type(options).__name__}")
