@@ -6,6 +6,7 @@
 pub mod colour;
 pub mod homography;
 pub mod latency;
+pub mod run_latency;
 pub mod run_screen;
 pub mod screen;
 pub mod screen_map;

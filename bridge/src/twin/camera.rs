@@ -174,6 +174,10 @@ pub fn detect_fiducials(frame: &RgbImage, size: [f64; 2]) -> Vec<[f64; 2]> {
             whites += 1;
         } else if hi.unwrap_or(0) > 40 {
             others += 1;
+            // A pheromone screen: known after a few rows, not the whole frame.
+            if others * 50 > total {
+                return Vec::new();
+            }
         }
     }
     if others * 50 > total || whites * 5 > total || whites == 0 {

@@ -33,7 +33,8 @@ pub struct Twin {
     /// The overhead camera, when one is modelled (calibration): poses go through it, and the
     /// fiducials in the frames the bridge shows are reported as unidentified (`-01`) slots.
     camera: Option<(CameraModel, Noise)>,
-    /// Time of the frame the fiducials were found in, and their centres (our frame, m).
+    /// Time of the frame the fiducials were found in, and their centres (our frame, m): the
+    /// calibration patterns (white discs on black) in the frames the bridge shows.
     fiducials: (f64, Vec<[f64; 2]>),
     /// Twin time of the last block sent, s.
     last_block: f64,
@@ -94,7 +95,6 @@ impl Twin {
     pub fn tick(&mut self) {
         let latest = self.frames.as_ref().and_then(|f| f.latest());
         if let Some((img, t)) = &latest
-            && self.camera.is_some()
             && *t != self.fiducials.0
         {
             let size = self.plant.world().screen().size;
@@ -140,12 +140,18 @@ impl Twin {
                 (id, x, y, yaw, p.seen.then(|| epoch(p.stamp)))
             })
             .collect();
-        // Fiducials are seen in the same camera frame as the robots.
-        if let Some((cam, noise)) = &mut self.camera {
-            for f in &self.fiducials.1 {
-                if let Some((x, y)) = cam.see_fiducial(f[0], f[1], noise) {
-                    poses.push((-1, x, y, 0.0, Some(epoch(frame_t))));
+        // Fiducials are seen in the same camera frame as the robots (without a camera model, at
+        // the nominal frame change).
+        for f in &self.fiducials.1 {
+            let seen = match &mut self.camera {
+                Some((cam, noise)) => cam.see_fiducial(f[0], f[1], noise),
+                None => {
+                    let (x, y, _) = self.transform.to_tracker_f64(f[0], f[1], 0.0);
+                    Some((x, y))
                 }
+            };
+            if let Some((x, y)) = seen {
+                poses.push((-1, x, y, 0.0, Some(epoch(frame_t))));
             }
         }
         self.tracker.publish(epoch(frame_t), &poses);

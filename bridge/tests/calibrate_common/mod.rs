@@ -119,3 +119,31 @@ pub fn start_with(
         stop,
     }
 }
+
+/// Six robots wandering at `speed` m/s on the paper's panel, tracked every 20 ms step without a
+/// delay of the tracker model's own.
+pub fn wanderers(speed: f64) -> Scenario {
+    let text = format!(
+        r#"
+name = "wanderers"
+duration = 60.0
+seed = 8
+[tracker]
+rate_hz = 50
+latency = 0.0
+dropout = 0.0
+[[pheromones]]
+name = "a"
+colour = [0, 255, 0]
+model = "gaussian"
+evaporation = 5.0
+[[robots]]
+count = 6
+behaviour = "wander"
+params = {{ speed = {speed} }}
+placement = "grid"
+region = [0.2, 0.2, 1.2, 0.6]
+"#
+    );
+    Scenario::from_toml_str(&text, ".").unwrap()
+}
