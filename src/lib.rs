@@ -10,3 +10,4 @@ pub mod experiment;
 pub mod report;
 pub mod rig;
 pub mod run;
+pub mod sweep;

@@ -57,6 +57,9 @@ enum Command {
     /// The digital twin: the simulator serving the rig's wire formats (SwarmCon over TCP, the robots'
     /// serial protocol over a pseudo-terminal or UDP) for `colcos bridge` to drive.
     Twin(colcos::rig::TwinArgs),
+    /// Run a batch of scenarios over axes of parameters and seeds (a sweep file), in parallel and
+    /// resumable: results.csv, plots/ and summary.md (docs/sweeps.md).
+    Sweep(colcos::sweep::SweepArgs),
     /// Check a scenario file and print what it sets up, without running it.
     Check { scenario: PathBuf },
     /// List the behaviours a scenario can name.
@@ -97,6 +100,7 @@ fn run_command(command: Command, text: &mut String) -> Result<()> {
     match command {
         Command::Display(args) => colcos::display::main(args),
         Command::Experiment(args) => colcos::experiment::main(args),
+        Command::Sweep(args) => colcos::sweep::main(args),
         Command::Bridge(args) => colcos::rig::bridge(args, text),
         Command::Twin(args) => colcos::rig::twin(args, text),
         Command::Run {

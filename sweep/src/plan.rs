@@ -112,6 +112,23 @@ impl Plan {
                 ));
             }
         }
+        for (i, a) in axes.iter().enumerate() {
+            let metric = crate::metrics::METRICS.iter().any(|(m, _)| *m == a.name);
+            let fixed = ID_COLUMNS.contains(&a.name.as_str())
+                || a.name == SEED_COLUMN
+                || a.name == WALL_COLUMN;
+            if metric
+                || fixed
+                || a.name.starts_with("field_mass_")
+                || a.name.starts_with("time_to_")
+            {
+                return Err(SweepError::invalid(
+                    format!("axes[{i}].name"),
+                    format!("\"{}\"", a.name),
+                    "the name of a fixed or metric column of the table; give the axis another `name`",
+                ));
+            }
+        }
         let combos = combinations(&spec, &axes)?;
         let name = spec.name.clone().unwrap_or_else(|| {
             Path::new(file)
