@@ -54,19 +54,18 @@ impl GifRecorder {
     }
 }
 
-/// The screen at `width x height` with every robot drawn on it.
+/// The screen at `width x height` with every robot drawn on it in its group's colour, and a legend
+/// naming the groups.
 pub fn frame_image(world: &World, width: u32, height: u32) -> image::RgbImage {
     let mut img = screen::render(world.pheromones(), world.screen(), width, height);
-    let colours: Vec<Rgb<u8>> = (0..world.robot_count())
-        .map(|i| role_colour(world.role(i)))
-        .collect();
     super::draw::robots(
         &mut img,
         world.screen(),
         world.poses(),
         world.robot_params().radius,
-        &colours,
+        &super::draw::robot_colours(world),
     );
+    super::draw::legend(&mut img, &super::draw::group_legend(world));
     img
 }
 
