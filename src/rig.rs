@@ -130,7 +130,7 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
         ..LiveOptions::default()
     };
     let stop = stop_on_signal()?;
-    let report = live::run(&sc, source, link, frames, &live_opts, stop)?;
+    let report = live::run(&sc, source, link, frames, live_opts, stop)?;
     let summary = args.out.join("summary.json");
     std::fs::write(&summary, serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("writing {}", summary.display()))?;

@@ -3,11 +3,13 @@
 //! robots' behaviours deciding the wheel commands that go out over the link.
 use colcos_sim::behaviour::{Observation, WheelCommand};
 use colcos_sim::error::Result;
+use colcos_sim::robot::ColiasParams;
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::{Scenario, SensorSource as SensorMode};
 use colcos_sim::screen::ScreenSpec;
 use colcos_sim::tracker::TrackedPose;
-use colcos_sim::world::{WorldParts, stages};
+use colcos_sim::world::{ArenaView, RobotSlot, WorldParts, stages};
+use glam::Vec2;
 use image::RgbImage;
 
 /// The data sets of a world without bodies or a tracker model, stepped tick by tick.
@@ -29,19 +31,26 @@ pub struct Host {
     /// Each pose is predicted forward by this much (s) from the robot's last command before pheromone
     /// is injected or sensed there: the tracker's pose is this old when it is used.
     latency: f32,
-    /// The robots' wheel base, m (for the prediction).
-    wheel_base: f32,
+    /// The robots' parameters (the wheel base for the prediction, the drive's lag and limits).
+    params: ColiasParams,
+    arena: Vec2,
+    /// Each robot's role (its group's).
+    roles: Vec<String>,
 }
 
 impl Host {
     /// A host for `scenario`: its fields, injection rules, sensing state and behaviours, with no robot
     /// seen yet.
     pub fn new(scenario: &Scenario, mode: SensorMode) -> Result<Host> {
-        let parts = WorldParts::build(scenario, 0)?;
+        Self::with_index(scenario, mode, 0)
+    }
+
+    /// [`Host::new`] with the random streams of world index `index` (as `World::with_index`).
+    pub fn with_index(scenario: &Scenario, mode: SensorMode, index: u64) -> Result<Host> {
+        let parts = WorldParts::build(scenario, index)?;
         let n = parts.slots.len();
         Ok(Host {
             screen: scenario.spec.screen,
-            parts,
             time: 0.0,
             ticks: 0,
             tracked: vec![TrackedPose::default(); n],
@@ -51,7 +60,12 @@ impl Host {
             commands: vec![WheelCommand::STOP; n],
             mode,
             latency: 0.0,
-            wheel_base: scenario.spec.robot.wheel_base,
+            params: scenario.spec.robot,
+            arena: scenario.arena_size(),
+            roles: (parts.slots.iter())
+                .map(|s| scenario.spec.robots[s.group].role.clone())
+                .collect(),
+            parts,
         })
     }
 
@@ -100,6 +114,9 @@ impl Host {
     pub fn pheromones(&self) -> &[colcos_sim::field::Pheromone] {
         self.parts.fields.pheromones()
     }
+    pub fn pheromones_mut(&mut self) -> &mut [colcos_sim::field::Pheromone] {
+        self.parts.fields.pheromones_mut()
+    }
     /// Installs a field backend (`None`: the CPU).
     pub fn set_field_backend(&mut self, backend: Option<Box<dyn colcos_sim::field::FieldBackend>>) {
         self.parts.fields.set_backend(backend);
@@ -116,6 +133,19 @@ impl Host {
                 stamp,
                 seen: true,
             };
+        }
+    }
+
+    /// Takes over the tracked poses of `from` (a new episode's host on the same arena: the robots are
+    /// where the tracker last saw them, as old as they were).
+    pub fn adopt_tracking(&mut self, from: &Host) {
+        for (mine, theirs) in self.tracked.iter_mut().zip(from.tracked()) {
+            if theirs.seen {
+                *mine = TrackedPose {
+                    stamp: self.time - (from.time - theirs.stamp),
+                    ..*theirs
+                };
+            }
         }
     }
 
@@ -147,7 +177,7 @@ impl Host {
         };
         self.ticks += 1;
         self.time += dt;
-        let wheel_base = self.wheel_base;
+        let wheel_base = self.params.wheel_base;
         let parts = &mut self.parts;
         stages::step_fields(&mut parts.fields, dt, false);
         for ((p, t), cmd) in self.poses.iter_mut().zip(&self.tracked).zip(&self.commands) {
@@ -201,9 +231,57 @@ impl Host {
         &self.commands
     }
 
+    /// The commands as sent (after the shield and the stops) drive each robot's model of its wheels
+    /// for `dt` s: what [`ArenaView::robots`] shows of the drives, as the simulator's drive stage does.
+    pub fn drive(&mut self, sent: &[WheelCommand], dt: f32) {
+        for (slot, cmd) in self.parts.slots.iter_mut().zip(sent) {
+            slot.drive.update(*cmd, &self.params, dt);
+            slot.command = *cmd;
+        }
+    }
+
     /// The screen image, eq. (1), at `width x height` (the panel's resolution for the LCD).
     pub fn render(&self, width: u32, height: u32) -> RgbImage {
         colcos_sim::screen::render(self.parts.fields.pheromones(), &self.screen, width, height)
+    }
+}
+
+/// A rig's arena as the loop functions (task rewards, metrics) see it: the tracked poses as used this
+/// tick, the robots' observations and drives, the fields.
+impl ArenaView for Host {
+    fn arena(&self) -> Vec2 {
+        self.arena
+    }
+    fn screen(&self) -> &ScreenSpec {
+        &self.screen
+    }
+    fn robot_params(&self) -> &ColiasParams {
+        &self.params
+    }
+    fn poses(&self) -> &[Pose] {
+        &self.poses
+    }
+    fn observations(&self) -> &[Observation] {
+        self.parts.sensing.observations()
+    }
+    fn robots(&self) -> &[RobotSlot] {
+        &self.parts.slots
+    }
+    fn pheromones(&self) -> &[colcos_sim::field::Pheromone] {
+        self.parts.fields.pheromones()
+    }
+    fn pheromone_value_and_gradient_observed(
+        &self,
+        index: usize,
+        p: Vec2,
+        step: f32,
+    ) -> (f32, Vec2) {
+        self.parts
+            .fields
+            .value_and_gradient_observed(index, p, step)
+    }
+    fn role(&self, i: usize) -> &str {
+        &self.roles[i]
     }
 }
 

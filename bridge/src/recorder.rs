@@ -9,7 +9,8 @@ use std::path::Path;
 /// What a message is; each topic is one MCAP channel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Topic {
-    /// Poses as received, our frame: JSON `{"id", "x", "y", "heading", "stamp", "fresh"}` per robot.
+    /// Poses as the loop took them, our frame: JSON `[{"id", "x", "y", "heading", "age", "fresh"}]`
+    /// (age: s since capture, from the tracker's clock as estimated here).
     Poses,
     /// A command frame as sent to the link, the bytes on the wire.
     Commands,
@@ -19,15 +20,24 @@ pub enum Topic {
     Frames,
     /// Safety stops, reconnections, overruns: JSON `{"kind", "robot", "detail"}`.
     Events,
+    /// The end of a loop tick: JSON `{"tick", "t", "step", "stopped", "commands"}`: its time since the
+    /// start and the time the fields advanced (s), the robots the watchdog held stopped, and how many
+    /// command frames the tick sent (the `/commands` messages just before). With the poses and
+    /// telemetry before it, everything a replay needs to give the same command bytes again.
+    Ticks,
+    /// A stop frame the watchdog or the exit guard sent, the bytes on the wire.
+    Stops,
 }
 
 impl Topic {
-    pub const ALL: [Topic; 5] = [
+    pub const ALL: [Topic; 7] = [
         Topic::Poses,
         Topic::Commands,
         Topic::Telemetry,
         Topic::Frames,
         Topic::Events,
+        Topic::Ticks,
+        Topic::Stops,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -36,11 +46,13 @@ impl Topic {
             Topic::Telemetry => "/telemetry",
             Topic::Frames => "/frames",
             Topic::Events => "/events",
+            Topic::Ticks => "/ticks",
+            Topic::Stops => "/stops",
         }
     }
     fn encoding(self) -> &'static str {
         match self {
-            Topic::Commands | Topic::Telemetry => "application/octet-stream",
+            Topic::Commands | Topic::Telemetry | Topic::Stops => "application/octet-stream",
             _ => "json",
         }
     }
@@ -62,7 +74,7 @@ pub enum RecorderError {
 
 pub struct Recorder {
     writer: mcap::Writer<BufWriter<File>>,
-    channels: [u16; 5],
+    channels: [u16; 7],
     sequence: u32,
 }
 
@@ -78,7 +90,7 @@ impl Recorder {
             .compression(None)
             .profile("")
             .create(BufWriter::new(file))?;
-        let mut channels = [0u16; 5];
+        let mut channels = [0u16; 7];
         for (c, topic) in channels.iter_mut().zip(Topic::ALL) {
             *c = writer.add_channel(0, topic.name(), topic.encoding(), &BTreeMap::new())?;
         }

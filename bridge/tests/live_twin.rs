@@ -3,7 +3,7 @@
 //! stream; and the safety stops, measured from the twin's own record of what it received.
 use colcos_bridge::colias::{BROADCAST_ID, HostCommand};
 use colcos_bridge::frames::FrameServer;
-use colcos_bridge::live::{self, LiveOptions, LiveReport};
+use colcos_bridge::live::{self, LiveOptions, LiveReport, LoopCore, replay};
 use colcos_bridge::recorder::{Topic, read_log};
 use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
 use colcos_bridge::twin::{
@@ -71,7 +71,7 @@ fn run_rig(
         let sc = sc.clone();
         let stop = stop.clone();
         std::thread::spawn(move || {
-            live::run(&sc, source, link, Some(frames), &live_opts, stop).unwrap()
+            live::run(&sc, source, link, Some(frames), live_opts, stop).unwrap()
         })
     };
     during(&faults, &robot_faults);
@@ -179,7 +179,7 @@ fn case_two_drives_the_twin_over_udp() {
     let logged: Vec<&[u8]> = rig
         .log
         .iter()
-        .filter(|m| m.topic == Topic::Commands)
+        .filter(|m| m.topic == Topic::Commands || m.topic == Topic::Stops)
         .map(|m| m.data.as_slice())
         .collect();
     let wire: Vec<Vec<u8>> = received.iter().map(|c| c.packet.to_frame()).collect();
@@ -188,6 +188,21 @@ fn case_two_drives_the_twin_over_udp() {
         .filter(|w| !logged.contains(&w.as_slice()))
         .count();
     assert_eq!(missing, 0, "commands the twin received that the log lacks");
+    // The recorded poses, telemetry and tick times, put through a fresh loop, give the same command
+    // bytes; poses moved by 5 cm do not.
+    let mut ticks = replay::ticks_of(&rig.log, 5).unwrap();
+    assert_eq!(ticks.len() as u64, r.ticks);
+    let fresh_core = || LoopCore::new(&scenario(), Default::default()).unwrap();
+    let same = replay::replay(&mut fresh_core(), &ticks);
+    assert!(same.frames > 200, "{same:?}");
+    assert_eq!(same.mismatched_ticks, 0, "{same:?}");
+    for tick in ticks.iter_mut().filter(|t| t.t > 1.0) {
+        for p in &mut tick.poses {
+            p.pose.pos.x += 0.05;
+        }
+    }
+    let moved = replay::replay(&mut fresh_core(), &ticks);
+    assert!(moved.mismatched_ticks > 0, "{moved:?}");
     let _ = rig.faults;
 }
 

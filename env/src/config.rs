@@ -118,6 +118,9 @@ pub struct EnvConfig {
     pub seed: u64,
     /// Field backend of the grid pheromones; `None`: the scenario's `[field] backend`.
     pub backend: Option<colcos_sim::field::BackendChoice>,
+    /// Pass the agents' commands through the safety shield (`[rig] shield` of the scenario), as every
+    /// plant does on the rig, so that training sees what deployment does.
+    pub shield: bool,
 }
 
 impl EnvConfig {
@@ -135,6 +138,7 @@ impl EnvConfig {
             num_threads: None,
             seed: 0,
             backend: None,
+            shield: true,
         }
     }
 }

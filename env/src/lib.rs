@@ -19,7 +19,7 @@ pub mod patch;
 pub mod spaces;
 pub mod task;
 mod vec_env;
-mod world_output;
+pub mod world_output;
 mod world_slot;
 
 pub use backend::EnvBackend;
@@ -27,4 +27,5 @@ pub use config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig, ScenarioSour
 pub use error::{EnvError, Result};
 pub use spaces::{EnvSpec, Space};
 pub use task::Task;
-pub use vec_env::{Actions, VecEnv};
+pub use vec_env::{Actions, BufferPtrs, VecEnv, shield_bits};
+pub use world_slot::world_index;

@@ -14,6 +14,7 @@ pub use crate::world_output::render_world;
 use crate::world_output::{write_obs, write_patch, write_state};
 use crate::world_slot::WorldSlot;
 use colcos_sim::scenario::Scenario;
+use colcos_sim::shield::{Intervention, Shield};
 use colcos_sim::world::World;
 use rayon::prelude::*;
 
@@ -36,6 +37,7 @@ struct Out<'a> {
     patch: &'a mut [u8],
     final_obs: &'a mut [f32],
     final_mask: &'a mut bool,
+    shield: &'a mut [u8],
 }
 
 /// Everything a world's step needs besides its own slot and buffers.
@@ -48,6 +50,7 @@ struct Ctx<'a> {
     max_speed: f32,
     state_dim: usize,
     patch: Option<PatchConfig>,
+    shield: Option<Shield>,
 }
 
 pub struct VecEnv {
@@ -68,6 +71,9 @@ pub struct VecEnv {
     patch: Vec<u8>,
     final_obs: Vec<f32>,
     final_mask: Vec<bool>,
+    /// What the shield did to each agent's last command `[E, N]`: bit 0 capped, bit 1 walled.
+    shield_flags: Vec<u8>,
+    shield: Option<Shield>,
     /// Scratch: decoded wheel commands of the agents `[E, N]`.
     commands: Vec<colcos_sim::behaviour::WheelCommand>,
     state_dim: usize,
@@ -156,6 +162,9 @@ impl VecEnv {
             max_cycles,
             dt: scenario.spec.dt,
         };
+        let shield = cfg
+            .shield
+            .then(|| Shield::new(scenario.spec.rig.shield, scenario.arena_size()));
         let slots = pool.install(|| {
             (0..e)
                 .into_par_iter()
@@ -181,6 +190,8 @@ impl VecEnv {
             patch: vec![0; e * n * patch_len.max(1)],
             final_obs: vec![0.0; e * n * OBS_DIM],
             final_mask: vec![false; e],
+            shield_flags: vec![0; e * n],
+            shield,
             commands: vec![Default::default(); e * n],
             state_dim,
             patch_len,
@@ -264,6 +275,11 @@ impl VecEnv {
     pub fn final_mask(&self) -> &[bool] {
         &self.final_mask
     }
+    /// What the safety shield did to each agent's command in the last step `[E, N]`: bit 0 (1) the
+    /// speed was capped, bit 1 (2) it would have crossed a virtual wall. All zero without a shield.
+    pub fn shield_flags(&self) -> &[u8] {
+        &self.shield_flags
+    }
 
     /// Raw pointers to the buffers, for bindings that hand out views. They stay valid and fixed for
     /// the life of `self` (the buffers are never reallocated).
@@ -277,6 +293,7 @@ impl VecEnv {
             patch: self.patch.as_mut_ptr(),
             final_obs: self.final_obs.as_mut_ptr(),
             final_mask: self.final_mask.as_mut_ptr(),
+            shield: self.shield_flags.as_mut_ptr(),
         }
     }
 
@@ -348,6 +365,7 @@ impl VecEnv {
             max_speed: self.scenario.spec.robot.max_wheel_speed,
             state_dim: self.state_dim,
             patch: self.patch_cfg,
+            shield: self.shield,
         };
         if let [slot] = self.slots.as_mut_slice() {
             // One world (a PettingZoo `parallel_env`): step it on the calling thread. Handing a single
@@ -361,6 +379,7 @@ impl VecEnv {
                 patch: &mut self.patch,
                 final_obs: &mut self.final_obs,
                 final_mask: &mut self.final_mask[0],
+                shield: &mut self.shield_flags,
             };
             return step_world(&ctx, 0, slot, &self.commands, &mut out);
         }
@@ -377,10 +396,14 @@ impl VecEnv {
             .zip(self.patch.par_chunks_mut(n * pl))
             .zip(self.final_obs.par_chunks_mut(n * OBS_DIM))
             .zip(self.final_mask.par_iter_mut())
+            .zip(self.shield_flags.par_chunks_mut(n))
             .map(
                 |(
-                    ((((((obs, rewards), terminated), truncated), state), patch), final_obs),
-                    final_mask,
+                    (
+                        ((((((obs, rewards), terminated), truncated), state), patch), final_obs),
+                        final_mask,
+                    ),
+                    shield,
                 )| Out {
                     obs,
                     rewards,
@@ -390,6 +413,7 @@ impl VecEnv {
                     patch,
                     final_obs,
                     final_mask,
+                    shield,
                 },
             );
         self.pool.install(|| {
@@ -495,6 +519,7 @@ impl VecEnv {
         self.terminated.fill(false);
         self.truncated.fill(false);
         self.final_mask.fill(false);
+        self.shield_flags.fill(0);
     }
 
     /// The screen with the robots drawn on it, `width` pixels wide, of world `e`.
@@ -519,6 +544,7 @@ pub struct BufferPtrs {
     pub patch: *mut u8,
     pub final_obs: *mut f32,
     pub final_mask: *mut bool,
+    pub shield: *mut u8,
 }
 
 fn step_world(
@@ -530,6 +556,7 @@ fn step_world(
 ) -> Result<()> {
     let agents = ctx.task.agents();
     *out.final_mask = false;
+    out.shield.fill(0);
     if slot.done {
         // Next-step autoreset: this step only resets the world.
         *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
@@ -540,9 +567,19 @@ fn step_world(
         return Ok(());
     }
     slot.decide_scripted();
-    for ((&i, cmd), &term) in agents.iter().zip(cmds).zip(&slot.terminated) {
+    let poses = slot.world.poses();
+    for (((&i, cmd), &term), flags) in agents
+        .iter()
+        .zip(cmds)
+        .zip(&slot.terminated)
+        .zip(out.shield.iter_mut())
+    {
         slot.commands[i] = if term {
             colcos_sim::behaviour::WheelCommand::STOP
+        } else if let Some(shield) = &ctx.shield {
+            let (cmd, intervention) = shield.apply(&poses[i], *cmd);
+            *flags = shield_bits(intervention);
+            cmd
         } else {
             *cmd
         };
@@ -586,4 +623,9 @@ fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut Out) {
     if let Some(p) = &ctx.patch {
         write_patch(&slot.world, agents, p, out.patch);
     }
+}
+
+/// A shield intervention as the bits of [`VecEnv::shield_flags`].
+pub fn shield_bits(i: Intervention) -> u8 {
+    i.capped as u8 | (i.walled as u8) << 1
 }

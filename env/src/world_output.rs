@@ -1,10 +1,10 @@
-//! What a world of the batch shows its agents and users: observation rows, the global state, screen
-//! patches and the rendered screen with the robots on it.
+//! What an arena shows its agents and users: observation rows, the global state, screen patches and
+//! the rendered screen with the robots on it; for a simulated world of the batch or a rig's host alike.
 use crate::config::PatchConfig;
 use crate::encoding::{self, OBS_DIM};
-use colcos_sim::world::World;
+use colcos_sim::world::ArenaView;
 
-pub(crate) fn write_obs(world: &World, agents: &[usize], max_speed: f32, out: &mut [f32]) {
+pub fn write_obs(world: &dyn ArenaView, agents: &[usize], max_speed: f32, out: &mut [f32]) {
     let obs = world.observations();
     for (&i, o) in agents.iter().zip(out.chunks_exact_mut(OBS_DIM)) {
         encoding::encode(&obs[i], max_speed, o);
@@ -13,7 +13,7 @@ pub(crate) fn write_obs(world: &World, agents: &[usize], max_speed: f32, out: &m
 
 /// Global state: per robot `x / W * 2 - 1`, `y / H * 2 - 1`, `cos`, `sin` of the heading; then the
 /// episode's elapsed fraction.
-pub(crate) fn write_state(world: &World, steps: u64, max_cycles: u64, out: &mut [f32]) {
+pub fn write_state(world: &dyn ArenaView, steps: u64, max_cycles: u64, out: &mut [f32]) {
     let arena = world.arena();
     for (p, o) in world.poses().iter().zip(out.chunks_exact_mut(4)) {
         o[0] = (2.0 * p.pos.x / arena.x - 1.0).clamp(-1.0, 1.0);
@@ -26,7 +26,7 @@ pub(crate) fn write_state(world: &World, steps: u64, max_cycles: u64, out: &mut 
     }
 }
 
-pub(crate) fn write_patch(world: &World, agents: &[usize], cfg: &PatchConfig, out: &mut [u8]) {
+pub fn write_patch(world: &dyn ArenaView, agents: &[usize], cfg: &PatchConfig, out: &mut [u8]) {
     let len = cfg.pixels * cfg.pixels * 3;
     let poses = world.poses();
     for (&i, o) in agents.iter().zip(out.chunks_exact_mut(len)) {
@@ -35,7 +35,7 @@ pub(crate) fn write_patch(world: &World, agents: &[usize], cfg: &PatchConfig, ou
 }
 
 /// Screen image with robots: agents white, scripted robots coloured by order of their role.
-pub fn render_world(world: &World, agents: &[usize], width: u32) -> image::RgbImage {
+pub fn render_world(world: &dyn ArenaView, agents: &[usize], width: u32) -> image::RgbImage {
     let screen = world.screen();
     let width = width.max(16);
     let height = ((width as f32 * screen.size[1] / screen.size[0]).round() as u32).max(1);

@@ -58,7 +58,7 @@ impl WorldSlot {
             first += group.count;
         }
         let robots = world.robot_count();
-        if task.on_reset(&mut world) {
+        if task.on_reset(world.pheromones_mut()) {
             // One still step so that the sensors see what the task changed.
             world.step_with_commands(&vec![WheelCommand::STOP; robots]);
         }

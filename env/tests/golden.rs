@@ -1,6 +1,7 @@
 //! Golden outputs of the batched environment: observations, rewards, terminations and global state of
 //! every task, under fixed actions and under a baseline policy, hash to exactly these values. A
-//! refactoring that changes any of them changes behaviour.
+//! refactoring that changes any of them changes behaviour. Each is pinned with the safety shield off
+//! (the simulator alone) and on (the default: what every plant does to the agents' commands).
 //! `COLCOS_GOLDEN_PRINT=1 cargo test --release -p colcos-env --test golden -- --nocapture` prints them.
 use colcos_env::baseline::BaselinePolicy;
 use colcos_env::{Actions, EnvConfig, VecEnv};
@@ -31,8 +32,9 @@ fn record(env: &VecEnv, h: &mut Fnv) {
     h.flags(env.final_mask());
 }
 
-fn config(task: &str) -> EnvConfig {
+fn config(task: &str, shield: bool) -> EnvConfig {
     let mut c = EnvConfig::new(task);
+    c.shield = shield;
     c.num_envs = 4;
     c.max_cycles = 40;
     c.seed = 11;
@@ -41,8 +43,8 @@ fn config(task: &str) -> EnvConfig {
 }
 
 /// Fixed, varied actions (a sine over world, agent, wheel and step) through two episodes.
-fn scripted_actions(task: &str) -> u64 {
-    let mut env = VecEnv::new(&config(task)).unwrap();
+fn scripted_actions(task: &str, shield: bool) -> u64 {
+    let mut env = VecEnv::new(&config(task, shield)).unwrap();
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
     env.reset(Some(11), None).unwrap();
     record(&env, &mut h);
@@ -58,8 +60,8 @@ fn scripted_actions(task: &str) -> u64 {
 }
 
 /// The task's scenario behaviour as a baseline policy, through two episodes.
-fn baseline(task: &str, behaviour: &str, params: serde_json::Value) -> u64 {
-    let mut env = VecEnv::new(&config(task)).unwrap();
+fn baseline(task: &str, behaviour: &str, params: serde_json::Value, shield: bool) -> u64 {
+    let mut env = VecEnv::new(&config(task, shield)).unwrap();
     env.reset(Some(5), None).unwrap();
     let mut policy = BaselinePolicy::new(&env, behaviour, &params, 5).unwrap();
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
@@ -83,30 +85,55 @@ fn check(label: &str, got: u64, want: u64) {
 
 #[test]
 fn every_task_under_fixed_actions() {
-    for (task, want) in [
-        ("aggregation", 0xadf11341867d8529u64),
-        ("foraging", 0xe84fe0d65f7cb0d5),
-        ("trail", 0x673dabe31bf0b339),
+    for (task, without, with) in [
+        ("aggregation", 0xadf11341867d8529u64, 0x246f71c184135465u64),
+        ("foraging", 0xe84fe0d65f7cb0d5, 0xe84fe0d65f7cb0d5),
+        ("trail", 0x673dabe31bf0b339, 0x3143367b5283c4a6),
     ] {
-        check(task, scripted_actions(task), want);
+        check(task, scripted_actions(task, false), without);
+        check(
+            &format!("{task} (shield)"),
+            scripted_actions(task, true),
+            with,
+        );
     }
 }
 
 #[test]
 fn baselines() {
-    check(
-        "aggregation/aggregation_follower",
-        baseline("aggregation", "aggregation_follower", serde_json::json!({})),
-        0xaa4d94bce0cff459,
-    );
-    check(
-        "foraging/forage",
-        baseline("foraging", "forage", serde_json::json!({})),
-        0x0f924c66bd414548,
-    );
-    check(
-        "trail/follow",
-        baseline("trail", "follow", serde_json::json!({"channel": "b"})),
-        0x137cf18b419c7b0f,
-    );
+    for (task, behaviour, params, without, with) in [
+        (
+            "aggregation",
+            "aggregation_follower",
+            serde_json::json!({}),
+            0xaa4d94bce0cff459u64,
+            0x25f99dacd10e76c8u64,
+        ),
+        (
+            "foraging",
+            "forage",
+            serde_json::json!({}),
+            0x0f924c66bd414548,
+            0x0f924c66bd414548,
+        ),
+        (
+            "trail",
+            "follow",
+            serde_json::json!({"channel": "b"}),
+            0x137cf18b419c7b0f,
+            0x74607472e76cbfa4,
+        ),
+    ] {
+        let label = format!("{task}/{behaviour}");
+        check(
+            &label,
+            baseline(task, behaviour, params.clone(), false),
+            without,
+        );
+        check(
+            &format!("{label} (shield)"),
+            baseline(task, behaviour, params, true),
+            with,
+        );
+    }
 }

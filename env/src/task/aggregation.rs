@@ -20,7 +20,7 @@ use super::{Task, check_non_negative, parse_params, require_role};
 use crate::error::{EnvError, Result};
 use colcos_sim::behaviour::channel_index;
 use colcos_sim::scenario::Scenario;
-use colcos_sim::world::World;
+use colcos_sim::world::ArenaView;
 use glam::Vec2;
 use serde::Deserialize;
 
@@ -113,7 +113,7 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
 
 /// Screen level (0..1, not clamped) of channel `c` at `p`, the sum over pheromones of
 /// `colour_c * value`, and its gradient (analytic for Gaussian sources: one `exp` per source).
-fn level_and_gradient(world: &World, c: usize, p: Vec2) -> (f32, Vec2) {
+fn level_and_gradient(world: &dyn ArenaView, c: usize, p: Vec2) -> (f32, Vec2) {
     world
         .pheromones()
         .iter()
@@ -133,7 +133,7 @@ impl Task for Aggregation {
     fn agents(&self) -> &[usize] {
         &self.agents
     }
-    fn evaluate(&self, world: &World, rewards: &mut [f32], _terminated: &mut [bool]) {
+    fn evaluate(&self, world: &dyn ArenaView, rewards: &mut [f32], _terminated: &mut [bool]) {
         let poses = world.poses();
         let robots = world.robots();
         let obs = world.observations();
@@ -180,6 +180,7 @@ mod tests {
     use super::*;
     use colcos_sim::behaviour::WheelCommand;
     use colcos_sim::scenario::{EmitSpec, PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
+    use colcos_sim::world::World;
 
     /// Leader at (1.0, 0.4), one follower at (0.5, 0.4) with heading `heading` (degrees) driving forward
     /// for 10 steps; with `predator`, the predator is next to the leader, which makes the leader release

@@ -7,8 +7,9 @@
 //! steady state `e J` (the paper assumes the trails are already laid).
 use super::{Task, check_non_negative, parse_params, require_role};
 use crate::error::{EnvError, Result};
+use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
-use colcos_sim::world::World;
+use colcos_sim::world::ArenaView;
 use glam::Vec2;
 use serde::Deserialize;
 
@@ -105,13 +106,13 @@ impl Task for Foraging {
     fn agents(&self) -> &[usize] {
         &self.agents
     }
-    fn on_reset(&self, world: &mut World) -> bool {
+    fn on_reset(&self, pheromones: &mut [Pheromone]) -> bool {
         if !self.prefill {
             return false;
         }
-        super::prefill_static_maps(world)
+        super::prefill_static_maps(pheromones)
     }
-    fn evaluate(&self, world: &World, rewards: &mut [f32], terminated: &mut [bool]) {
+    fn evaluate(&self, world: &dyn ArenaView, rewards: &mut [f32], terminated: &mut [bool]) {
         let poses = world.poses();
         let r2 = self.reach_distance * self.reach_distance;
         for ((r, t), &i) in rewards

@@ -9,8 +9,9 @@ pub mod registry;
 pub mod trail;
 
 use crate::error::{EnvError, Result};
+use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
-use colcos_sim::world::World;
+use colcos_sim::world::ArenaView;
 use serde::de::DeserializeOwned;
 
 /// An RL problem over a scenario.
@@ -19,15 +20,14 @@ pub trait Task: Send + Sync {
     fn name(&self) -> &'static str;
     /// World robot indices of the agents, in agent order. Fixed for the task's lifetime.
     fn agents(&self) -> &[usize];
-    /// Prepares a freshly built world for a new episode (e.g. brings static maps to steady state).
-    /// Returns true if it changed the fields, so the environment takes one settling step to let the
-    /// sensors see the change.
-    fn on_reset(&self, _world: &mut World) -> bool {
+    /// Prepares a new episode's fields (e.g. brings static maps to steady state). Returns true if it
+    /// changed them, so the environment takes one settling step to let the sensors see the change.
+    fn on_reset(&self, _pheromones: &mut [Pheromone]) -> bool {
         false
     }
     /// Rewards after a step, one per agent, and which agents have reached a terminal state. Entries of
     /// `terminated` are only ever set to true here, never cleared.
-    fn evaluate(&self, world: &World, rewards: &mut [f32], terminated: &mut [bool]);
+    fn evaluate(&self, world: &dyn ArenaView, rewards: &mut [f32], terminated: &mut [bool]);
 }
 
 /// Deserialises a task's parameter object, naming the key at fault; unknown keys are refused.
@@ -90,9 +90,9 @@ pub fn check_non_negative(key: &str, v: f32) -> Result<f32> {
 
 /// Brings every grid pheromone with a static injection map and finite evaporation `e` to its steady
 /// state `e J` (exact without diffusion). Returns true if any field changed.
-pub fn prefill_static_maps(world: &mut World) -> bool {
+pub fn prefill_static_maps(pheromones: &mut [Pheromone]) -> bool {
     let mut changed = false;
-    for p in world.pheromones_mut() {
+    for p in pheromones {
         if let colcos_sim::field::FieldModel::Grid(g) = &mut p.model {
             let e = g.params().evaporation;
             if !(e.is_finite() && e > 0.0) {

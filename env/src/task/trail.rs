@@ -6,8 +6,9 @@
 use super::{Task, check_non_negative, parse_params, require_role};
 use crate::error::{EnvError, Result};
 use colcos_sim::behaviour::channel_index;
+use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
-use colcos_sim::world::World;
+use colcos_sim::world::ArenaView;
 use serde::Deserialize;
 
 pub const DESCRIPTION: &str =
@@ -65,10 +66,10 @@ impl Task for Trail {
     fn agents(&self) -> &[usize] {
         &self.agents
     }
-    fn on_reset(&self, world: &mut World) -> bool {
-        super::prefill_static_maps(world)
+    fn on_reset(&self, pheromones: &mut [Pheromone]) -> bool {
+        super::prefill_static_maps(pheromones)
     }
-    fn evaluate(&self, world: &World, rewards: &mut [f32], _terminated: &mut [bool]) {
+    fn evaluate(&self, world: &dyn ArenaView, rewards: &mut [f32], _terminated: &mut [bool]) {
         let obs = world.observations();
         let params = world.robot_params();
         for (r, &i) in rewards.iter_mut().zip(&self.agents) {

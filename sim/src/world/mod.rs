@@ -18,6 +18,7 @@ mod robots;
 mod sensing;
 mod step;
 mod tracking;
+mod view;
 
 pub use build::WorldParts;
 pub use fields::FieldSet;
@@ -25,6 +26,7 @@ pub use inject::Injection;
 pub use robots::{RobotSet, RobotSlot};
 pub use sensing::Sensing;
 pub use tracking::Tracking;
+pub use view::ArenaView;
 
 /// The stage functions of a step. Each takes the data sets it touches by reference and documents what
 /// it reads and writes; none keeps state of its own beyond scratch buffers inside the sets.

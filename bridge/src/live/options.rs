@@ -1,0 +1,56 @@
+//! What a live run is asked to do besides driving the robots, and what it measured.
+use crate::colias::LegacyDrive;
+use colcos_sim::shield::ShieldCounts;
+use std::path::PathBuf;
+
+/// A screen the loop shows its frames on: the window on the arena's LCD.
+pub trait FrameSink: Send {
+    /// Shows `frame` (row 0 at the top of the panel); false once the sink is gone (window closed).
+    fn show(&mut self, frame: &image::RgbImage) -> bool;
+}
+
+/// What a live run does besides driving the robots.
+#[derive(Default)]
+pub struct LiveOptions {
+    /// The LCD's window, shown `display_width` px wide at `display_hz` (the window scales it to the
+    /// panel). The CPU renders a 4K frame in ~90 ms, so the default is a smaller frame.
+    pub display: Option<std::sync::Mutex<Box<dyn FrameSink>>>,
+    pub display_width: u32,
+    pub display_hz: f64,
+    /// Stop after this many seconds (None: until stopped).
+    pub duration: Option<f64>,
+    /// Width of the frames sent to the frame stream (height from the panel's aspect); 0: none.
+    pub stream_width: u32,
+    /// Frames sent to the frame stream per second (at most one a tick; 0: every tick). Rendering
+    /// costs the loop: a 960-pixel frame of two Gaussian fields takes ~10 ms on one core.
+    pub stream_hz: f64,
+    /// Where the rig log (MCAP) goes; None: no log.
+    pub log: Option<PathBuf>,
+    /// Where the trajectory CSV goes (the simulator's columns, the tracked poses as used); None: none.
+    pub trajectory: Option<PathBuf>,
+    /// Print a status line every second.
+    pub status: bool,
+    /// How wheel speeds become motion commands for old firmware (`[rig] firmware = "motion"`).
+    pub legacy: LegacyDrive,
+}
+
+/// What a finished live run measured.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct LiveReport {
+    pub ticks: u64,
+    pub seconds: f64,
+    /// Ticks that ended after their slot.
+    pub overruns: u64,
+    /// Worst and 99th-percentile time of the loop's own work in a tick, ms.
+    pub worst_tick_ms: f64,
+    pub p99_tick_ms: f64,
+    pub shield: ShieldCounts,
+    /// Safety stops the watchdog sent, by kind, in order.
+    pub stops: Vec<String>,
+    pub commands_sent: u64,
+    pub telemetry_received: u64,
+    /// Robots (radio addresses) that stopped answering data requests, in the order they fell silent.
+    pub silent_robots: Vec<u8>,
+    /// Tracker blocks taken.
+    pub pose_blocks: u64,
+}

@@ -1,0 +1,119 @@
+//! Safety stops: the frames that stop one robot or all of them, sent ahead of anything queued, and the
+//! guard that sends them whichever way the loop ends (a panic included).
+use crate::RobotLink;
+use crate::clock::epoch_ns;
+use crate::colias::{BROADCAST_ID, CommandPacket, HostCommand, LegacyDrive, MotionKind};
+use crate::recorder::{Recorder, Topic};
+use crate::watchdog::StopReason;
+use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::scenario::Firmware;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+pub(crate) type SharedLink = Arc<Mutex<Box<dyn RobotLink>>>;
+pub(crate) type SharedLog = Arc<Mutex<Option<Recorder>>>;
+
+pub(crate) fn record(log: &SharedLog, topic: Topic, data: &[u8]) {
+    if let Ok(mut l) = log.lock()
+        && let Some(r) = l.as_mut()
+    {
+        let _ = r.record(topic, epoch_ns(), data);
+    }
+}
+
+/// The host's millisecond stamp of a frame sent `t` s after the loop started (wrapping at 2^32).
+pub fn t_ms(t: f64) -> u32 {
+    (t.max(0.0) * 1e3) as u64 as u32
+}
+
+/// The command that drives robot `id` with `cmd` on firmware `firmware`.
+pub fn drive_packet(
+    id: u8,
+    t: u32,
+    cmd: WheelCommand,
+    firmware: Firmware,
+    legacy: &LegacyDrive,
+) -> CommandPacket {
+    let command = match firmware {
+        Firmware::Wheels => HostCommand::WheelSpeeds {
+            left: cmd.left,
+            right: cmd.right,
+        },
+        Firmware::Motion => legacy.map(cmd),
+    };
+    CommandPacket::new(id, t, command)
+}
+
+/// The command that stops robot `id` (or all of them, [`BROADCAST_ID`]) at once.
+pub fn stop_packet(id: u8, t: u32, firmware: Firmware) -> CommandPacket {
+    let command = match firmware {
+        Firmware::Wheels => HostCommand::WheelSpeeds {
+            left: 0.0,
+            right: 0.0,
+        },
+        Firmware::Motion => HostCommand::Motion {
+            kind: MotionKind::Stop,
+            speed: 0.0,
+        },
+    };
+    CommandPacket::new(id, t, command)
+}
+
+/// What the watchdog and the exit guard need to stop robots.
+#[derive(Clone)]
+pub(crate) struct Stopper {
+    pub link: SharedLink,
+    pub log: SharedLog,
+    pub radio: Vec<u8>,
+    pub firmware: Firmware,
+    pub start: Instant,
+}
+
+impl Stopper {
+    /// Sends the stop `reason` calls for, ahead of anything queued, and logs it (on its own topic:
+    /// stops come from the watchdog's clock, not from the loop's inputs, so a replay leaves them out).
+    pub fn stop(&self, reason: &StopReason) {
+        let id = match reason.robot() {
+            None => BROADCAST_ID,
+            Some(i) => self.radio.get(i).copied().unwrap_or(BROADCAST_ID),
+        };
+        let packet = stop_packet(id, t_ms(self.start.elapsed().as_secs_f64()), self.firmware);
+        let sent = match self.link.lock() {
+            Ok(mut link) => link.stop_now(packet).map_err(|e| e.to_string()),
+            Err(_) => Err("link lock poisoned".to_string()),
+        };
+        if sent.is_ok() {
+            record(&self.log, Topic::Stops, &packet.to_frame());
+        }
+        let event = serde_json::json!({
+            "kind": reason.kind(),
+            "robot": reason.robot(),
+            "detail": format!("{reason:?}"),
+            "sent": sent.is_ok(),
+        });
+        record(&self.log, Topic::Events, event.to_string().as_bytes());
+        log::warn!(
+            "safety stop ({}): {reason:?}",
+            if id == BROADCAST_ID {
+                "all robots".to_string()
+            } else {
+                format!("radio {id}")
+            }
+        );
+    }
+}
+
+/// Stops every robot when dropped: the loop's last word, also when it unwinds from a panic.
+pub(crate) struct StopOnDrop(pub Stopper);
+
+impl Drop for StopOnDrop {
+    fn drop(&mut self) {
+        self.0
+            .stop(&StopReason::Shutdown("the live loop ended".into()));
+        if let Ok(mut l) = self.0.log.lock()
+            && let Some(r) = l.take()
+        {
+            let _ = r.finish();
+        }
+    }
+}

@@ -1,0 +1,151 @@
+//! What moves a plant's arena: a live loop against a rig or a twin (paced by the real clock), or a
+//! recorded rig run fed tick by tick; and the twin a `plant="twin"` starts in this process when it is
+//! given no addresses.
+use super::PlantError;
+use crate::colias::LegacyDrive;
+use crate::host::Host;
+use crate::live::replay::{RecordedTick, feed};
+use crate::live::{LiveSession, LoopCore};
+use crate::swarmcon::HeaderForm;
+use crate::twin::{TrackerServer, Twin, UdpChannel};
+use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::scenario::Scenario;
+use colcos_sim::shield::Intervention;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+pub(crate) enum Driver {
+    Live {
+        session: Box<LiveSession>,
+        /// Declared after the session: the session stops the robots before the twin goes.
+        _twin: Option<TwinThread>,
+    },
+    Replay {
+        core: Box<LoopCore>,
+        ticks: Vec<RecordedTick>,
+        next: usize,
+    },
+}
+
+impl Driver {
+    pub fn core(&self) -> &LoopCore {
+        match self {
+            Driver::Live { session, .. } => session.core(),
+            Driver::Replay { core, .. } => core,
+        }
+    }
+    pub fn host(&self) -> &Host {
+        self.core().host()
+    }
+    pub fn host_mut(&mut self) -> &mut Host {
+        match self {
+            Driver::Live { session, .. } => session.core_mut().host_mut(),
+            Driver::Replay { core, .. } => core.host_mut(),
+        }
+    }
+    pub fn interventions(&self) -> &[Intervention] {
+        self.core().interventions()
+    }
+
+    /// One tick with `overrides`; a live loop waits for its slot first. False when a replay has no
+    /// tick left (nothing happened).
+    pub fn tick(&mut self, overrides: &[Option<WheelCommand>]) -> Result<bool, PlantError> {
+        match self {
+            Driver::Live { session, .. } => {
+                session.wait_next();
+                session.tick(overrides)?;
+                Ok(true)
+            }
+            Driver::Replay { core, ticks, next } => {
+                let Some(tick) = ticks.get(*next) else {
+                    return Ok(false);
+                };
+                feed(core, tick, overrides);
+                *next += 1;
+                Ok(true)
+            }
+        }
+    }
+
+    /// Ticks left in a replay (None: live).
+    pub fn remaining(&self) -> Option<usize> {
+        match self {
+            Driver::Live { .. } => None,
+            Driver::Replay { ticks, next, .. } => Some(ticks.len().saturating_sub(*next)),
+        }
+    }
+
+    /// A new episode: fresh fields and behaviours (random streams of world index `index`) on the
+    /// same link and tracker; a replay starts again from its first tick.
+    pub fn restart(&mut self, scenario: &Scenario, index: u64) -> Result<(), PlantError> {
+        let mut core = LoopCore::with_index(scenario, LegacyDrive::default(), index)?;
+        match self {
+            Driver::Live { session, .. } => {
+                core.host_mut().adopt_tracking(session.core().host());
+                session.replace_core(core);
+            }
+            Driver::Replay { core: c, next, .. } => {
+                **c = core;
+                *next = 0;
+            }
+        }
+        Ok(())
+    }
+
+    /// Seconds since the plant started (live), or the replay's recorded time.
+    pub fn time(&self) -> f64 {
+        match self {
+            Driver::Live { session, .. } => session.elapsed(),
+            Driver::Replay { ticks, next, .. } => next
+                .checked_sub(1)
+                .and_then(|k| ticks.get(k))
+                .map_or(0.0, |t| t.t),
+        }
+    }
+}
+
+/// A digital twin on loopback, ticking on its own thread until dropped.
+pub(crate) struct TwinThread {
+    pub tracker_url: String,
+    pub robots_url: String,
+    stop: Arc<AtomicBool>,
+    handle: Option<std::thread::JoinHandle<()>>,
+}
+
+impl TwinThread {
+    pub fn start(scenario: &Scenario) -> Result<TwinThread, PlantError> {
+        let io = |what: &str, e: std::io::Error| {
+            PlantError::Io(format!("starting the twin's {what}: {e}"))
+        };
+        let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated)
+            .map_err(|e| io("tracker", e))?;
+        let channel = UdpChannel::bind("127.0.0.1:0").map_err(|e| io("robot link", e))?;
+        let tracker_url = format!("swarmcon://{}", tracker.local_addr());
+        let robots_url = format!(
+            "udp://{}",
+            channel.local_addr().map_err(|e| io("robot link", e))?
+        );
+        let mut twin = Twin::new(scenario, tracker, Box::new(channel), None)?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let s = stop.clone();
+        let handle = std::thread::Builder::new()
+            .name("colcos-twin".into())
+            .spawn(move || twin.run(None, &s))
+            .map_err(|e| io("thread", e))?;
+        Ok(TwinThread {
+            tracker_url,
+            robots_url,
+            stop,
+            handle: Some(handle),
+        })
+    }
+}
+
+impl Drop for TwinThread {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}

@@ -1,0 +1,539 @@
+//! Plants for the RL environments: the same task, spaces, outputs and safety shield as one world of the
+//! simulated batch (`colcos_env::VecEnv`), with the arena a real rig, the digital twin, or a recorded
+//! rig run. A policy written against one runs unchanged on the others.
+//!
+//! - `twin`: the digital twin over loopback (started in this process when no addresses are given);
+//! - `rig`: the lab's tracker and robots, by URL;
+//! - `replay`: a rig log (`rig.mcap`) fed tick by tick: the recorded poses, telemetry and tick times,
+//!   with the policy's commands in place of the recorded behaviours' (nothing moves in response).
+//!
+//! `step` is paced to the screen's 20 ms on the twin and the rig; `reset` drives the robots to the
+//! episode's start poses with a tracker-guided [`GoTo`], bounded in time, unless asked not to.
+mod driver;
+mod goto;
+
+pub use goto::GoTo;
+
+use crate::colias::LegacyDrive;
+use crate::host::Host;
+use crate::live::{LiveOptions, LiveSession, LoopCore, replay};
+use crate::swarmcon::FrameTransform;
+use crate::{SourceOptions, open_pose_source, open_robot_link};
+use colcos_env::encoding::{self, OBS_DIM};
+use colcos_env::task::registry;
+use colcos_env::world_output::{render_world, write_obs, write_patch, write_state};
+use colcos_env::{EnvConfig, EnvError, EnvSpec, Space, Task, VecEnv, shield_bits};
+use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::robot::Pose;
+use colcos_sim::scenario::Scenario;
+use colcos_sim::world::WorldParts;
+use driver::{Driver, TwinThread};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Where a plant's arena is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlantKind {
+    Twin,
+    Rig,
+    Replay,
+}
+
+impl std::str::FromStr for PlantKind {
+    type Err = PlantError;
+    fn from_str(s: &str) -> Result<Self, PlantError> {
+        match s {
+            "twin" => Ok(PlantKind::Twin),
+            "rig" => Ok(PlantKind::Rig),
+            "replay" => Ok(PlantKind::Replay),
+            _ => Err(PlantError::option(
+                "plant",
+                format!("{s:?} is not \"sim\", \"twin\", \"rig\" or \"replay\""),
+            )),
+        }
+    }
+}
+
+/// How to reach a plant.
+#[derive(Clone, Debug)]
+pub struct PlantOptions {
+    pub kind: PlantKind,
+    /// The tracker's URL (`swarmcon://HOST:PORT`, `udp://...`); a twin without one starts in-process.
+    pub tracker: Option<String>,
+    /// The robots' link URL (`serial://...`, `udp://...`).
+    pub robots: Option<String>,
+    /// `replay`: the rig log to replay. `twin`, `rig`: where to write the rig log (none: no log).
+    pub log: Option<PathBuf>,
+    /// `reset` drives the robots to the episode's start poses (twin, rig).
+    pub goto: bool,
+    /// Longest a reset's go-to may take, s.
+    pub goto_timeout: f64,
+}
+
+impl PlantOptions {
+    pub fn new(kind: PlantKind) -> PlantOptions {
+        PlantOptions {
+            kind,
+            tracker: None,
+            robots: None,
+            log: None,
+            goto: true,
+            goto_timeout: 30.0,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum PlantError {
+    #[error(transparent)]
+    Env(#[from] EnvError),
+    #[error(transparent)]
+    Sim(#[from] colcos_sim::error::SimError),
+    #[error("tracker: {0}")]
+    Source(#[from] crate::SourceError),
+    #[error("robot link: {0}")]
+    Link(#[from] crate::LinkError),
+    #[error(transparent)]
+    Replay(#[from] replay::ReplayError),
+    #[error("{0}")]
+    Io(String),
+    #[error("`{key}`: {reason}")]
+    Option { key: String, reason: String },
+    #[error("{0}")]
+    State(String),
+}
+
+impl PlantError {
+    fn option(key: &str, reason: impl Into<String>) -> PlantError {
+        PlantError::Option {
+            key: key.into(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// What the last reset's go-to did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GoToReport {
+    pub seconds: f64,
+    /// Robots at their start pose when it ended.
+    pub arrived: usize,
+    pub robots: usize,
+}
+
+/// One arena of a plant as an RL environment: the buffers of one world of `VecEnv` (`[1, N, ...]`),
+/// allocated once and overwritten by every `reset` and `step`.
+pub struct LiveEnv {
+    spec: EnvSpec,
+    task: Box<dyn Task>,
+    scenario: Scenario,
+    kind: PlantKind,
+    driver: Driver,
+    goto: Option<(GoTo, f64)>,
+    goto_report: GoToReport,
+    patch: Option<colcos_env::PatchConfig>,
+    max_speed: f32,
+    overrides: Vec<Option<WheelCommand>>,
+    steps: u64,
+    episode: u64,
+    needs_reset: bool,
+    done: bool,
+    agent_terminated: Vec<bool>,
+    prev_terminated: Vec<bool>,
+    obs: Vec<f32>,
+    rewards: Vec<f32>,
+    terminated: Vec<bool>,
+    truncated: Vec<bool>,
+    state: Vec<f32>,
+    patch_buf: Vec<u8>,
+    shield: Vec<u8>,
+}
+
+impl LiveEnv {
+    /// The environment `cfg` describes (one world) on the plant `plant` names.
+    pub fn new(cfg: &EnvConfig, plant: &PlantOptions) -> Result<LiveEnv, PlantError> {
+        // The simulated environment of the same configuration gives the spec, so every plant has
+        // the same spaces, names and sizes.
+        let one = EnvConfig {
+            num_envs: 1,
+            num_threads: Some(1),
+            ..cfg.clone()
+        };
+        let spec = VecEnv::new(&one)?.spec().clone();
+        let (task, mut scenario) = registry::build(&cfg.task, &cfg.scenario, &cfg.params)?;
+        scenario.spec.seed = cfg.seed;
+        let driver = Self::open(&scenario, plant)?;
+        let p = &scenario.spec.robot;
+        let goto = (plant.goto && plant.kind != PlantKind::Replay).then(|| {
+            let speed = p
+                .max_wheel_speed
+                .min(scenario.spec.rig.shield.max_wheel_speed)
+                * 0.5;
+            (
+                GoTo::new(speed, p.wheel_base, p.radius),
+                plant.goto_timeout.clamp(0.0, 600.0),
+            )
+        });
+        let (n, robots) = (spec.num_agents, spec.num_robots);
+        let state_dim = spec.state.as_ref().map_or(0, |s| s.flat_len());
+        let patch_len = spec.patch.as_ref().map_or(0, |s| s.flat_len());
+        Ok(LiveEnv {
+            max_speed: p.max_wheel_speed,
+            patch: cfg.patch,
+            task,
+            kind: plant.kind,
+            driver,
+            goto,
+            goto_report: GoToReport::default(),
+            overrides: vec![None; robots],
+            steps: 0,
+            episode: 0,
+            needs_reset: true,
+            done: false,
+            agent_terminated: vec![false; n],
+            prev_terminated: vec![false; n],
+            obs: vec![0.0; n * OBS_DIM],
+            rewards: vec![0.0; n],
+            terminated: vec![false; n],
+            truncated: vec![false; n],
+            state: vec![0.0; state_dim.max(1)],
+            patch_buf: vec![0; (n * patch_len).max(1)],
+            shield: vec![0; n],
+            spec,
+            scenario,
+        })
+    }
+
+    fn open(scenario: &Scenario, plant: &PlantOptions) -> Result<Driver, PlantError> {
+        if plant.kind == PlantKind::Replay {
+            let path = plant.log.as_ref().ok_or_else(|| {
+                PlantError::option("replay", "a replay plant needs a rig log (rig.mcap)")
+            })?;
+            let bytes = std::fs::read(path)
+                .map_err(|e| PlantError::option("replay", format!("{}: {e}", path.display())))?;
+            let ticks = replay::read_ticks(&bytes, scenario.robot_count())?;
+            return Ok(Driver::Replay {
+                core: Box::new(LoopCore::new(scenario, LegacyDrive::default())?),
+                ticks,
+                next: 0,
+            });
+        }
+        let twin = match (plant.kind, &plant.tracker, &plant.robots) {
+            (PlantKind::Twin, None, None) => Some(TwinThread::start(scenario)?),
+            (_, Some(_), Some(_)) => None,
+            (kind, _, _) => {
+                let which = if kind == PlantKind::Rig {
+                    "rig"
+                } else {
+                    "twin"
+                };
+                return Err(PlantError::option(
+                    "tracker",
+                    format!(
+                        "a {which} plant needs both `tracker` and `robots` URLs{}",
+                        if kind == PlantKind::Twin {
+                            " (or neither, to start a twin here)"
+                        } else {
+                            ""
+                        }
+                    ),
+                ));
+            }
+        };
+        let (tracker, robots) = match &twin {
+            Some(t) => (t.tracker_url.clone(), t.robots_url.clone()),
+            None => (
+                plant.tracker.clone().unwrap_or_default(),
+                plant.robots.clone().unwrap_or_default(),
+            ),
+        };
+        let opts = SourceOptions::new(FrameTransform::new(scenario.arena_size().y as f64));
+        let source = open_pose_source(&tracker, &opts)?;
+        let link = open_robot_link(&robots)?;
+        let live = LiveOptions {
+            log: plant.log.clone(),
+            ..LiveOptions::default()
+        };
+        let session = LiveSession::new(scenario, source, link, None, live)?;
+        Ok(Driver::Live {
+            session: Box::new(session),
+            _twin: twin,
+        })
+    }
+
+    pub fn spec(&self) -> &EnvSpec {
+        &self.spec
+    }
+    pub fn kind(&self) -> PlantKind {
+        self.kind
+    }
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+    /// The host: the tracked poses as used, the fields, the robots' observations.
+    pub fn host(&self) -> &Host {
+        self.driver.host()
+    }
+    pub fn episode(&self) -> u64 {
+        self.episode
+    }
+    pub fn episode_steps(&self) -> u64 {
+        self.steps
+    }
+    pub fn goto_report(&self) -> GoToReport {
+        self.goto_report
+    }
+    pub fn obs(&self) -> &[f32] {
+        &self.obs
+    }
+    pub fn rewards(&self) -> &[f32] {
+        &self.rewards
+    }
+    pub fn terminated(&self) -> &[bool] {
+        &self.terminated
+    }
+    pub fn truncated(&self) -> &[bool] {
+        &self.truncated
+    }
+    /// Global state `[S]` (empty if disabled).
+    pub fn state(&self) -> &[f32] {
+        if self.spec.state.is_some() {
+            &self.state
+        } else {
+            &[]
+        }
+    }
+    /// Screen patches `[N, P, P, 3]` (empty if disabled).
+    pub fn patch(&self) -> &[u8] {
+        if self.spec.patch.is_some() {
+            &self.patch_buf
+        } else {
+            &[]
+        }
+    }
+    /// What the shield did to each agent's last command: bit 0 capped, bit 1 walled.
+    pub fn shield_flags(&self) -> &[u8] {
+        &self.shield
+    }
+    /// Mutable pointers to the buffers, for bindings that hand out views; fixed for the life of self.
+    pub fn buffer_ptrs(&mut self) -> PlantBuffers {
+        PlantBuffers {
+            obs: self.obs.as_mut_ptr(),
+            rewards: self.rewards.as_mut_ptr(),
+            terminated: self.terminated.as_mut_ptr(),
+            truncated: self.truncated.as_mut_ptr(),
+            state: self.state.as_mut_ptr(),
+            patch: self.patch_buf.as_mut_ptr(),
+            shield: self.shield.as_mut_ptr(),
+        }
+    }
+
+    /// The screen with the robots on it (agents white), `width` px wide.
+    pub fn render(&self, width: u32) -> image::RgbImage {
+        render_world(self.driver.host(), self.task.agents(), width)
+    }
+
+    /// A new episode: a `seed` becomes the scenario's seed and restarts the episode count. On the
+    /// twin and the rig the robots are first driven to the episode's start poses (if asked to).
+    pub fn reset(&mut self, seed: Option<u64>) -> Result<(), PlantError> {
+        if let Some(s) = seed {
+            self.scenario.spec.seed = s;
+        }
+        self.episode = if seed.is_some() || self.needs_reset {
+            0
+        } else {
+            self.episode + 1
+        };
+        let index = colcos_env::world_index(0, self.episode);
+        if let Some((goto, timeout)) = self.goto {
+            let targets = WorldParts::build(&self.scenario, index)?.poses;
+            self.goto_report = self.drive_to(&goto, &targets, timeout)?;
+        }
+        self.driver.restart(&self.scenario, index)?;
+        self.task.on_reset(self.driver.host_mut().pheromones_mut());
+        // One tick with the agents still, so that their observations are of this episode.
+        self.overrides.fill(None);
+        for &i in self.task.agents() {
+            self.overrides[i] = Some(WheelCommand::STOP);
+        }
+        self.driver.tick(&self.overrides)?;
+        self.steps = 0;
+        self.done = false;
+        self.needs_reset = false;
+        self.agent_terminated.fill(false);
+        self.rewards.fill(0.0);
+        self.terminated.fill(false);
+        self.truncated.fill(false);
+        self.shield.fill(0);
+        self.write_outputs();
+        Ok(())
+    }
+
+    /// Drives every robot toward `targets` until all are there or `timeout` s have passed.
+    fn drive_to(
+        &mut self,
+        goto: &GoTo,
+        targets: &[Pose],
+        timeout: f64,
+    ) -> Result<GoToReport, PlantError> {
+        let start = Instant::now();
+        let n = targets.len();
+        let mut arrived = 0;
+        while start.elapsed().as_secs_f64() < timeout {
+            let host = self.driver.host();
+            let poses = host.poses();
+            arrived = 0;
+            for i in 0..n {
+                let (cmd, there) = if host.tracked()[i].seen {
+                    goto.command(i, poses, targets)
+                } else {
+                    (WheelCommand::STOP, false)
+                };
+                arrived += there as usize;
+                self.overrides[i] = Some(cmd);
+            }
+            if arrived == n {
+                break;
+            }
+            self.driver.tick(&self.overrides)?;
+        }
+        Ok(GoToReport {
+            seconds: start.elapsed().as_secs_f64(),
+            arrived,
+            robots: n,
+        })
+    }
+
+    /// One step: continuous actions `[N, 2]` in `[-1, 1]` (fractions of the largest wheel speed) or
+    /// discrete ones `[N]`. Terminated agents are stopped and their actions ignored.
+    pub fn step(
+        &mut self,
+        continuous: Option<&[f32]>,
+        discrete: Option<&[i64]>,
+    ) -> Result<(), PlantError> {
+        if self.needs_reset {
+            return Err(PlantError::State("call reset() before step()".into()));
+        }
+        if self.done {
+            return Err(PlantError::State(
+                "the episode has ended: call reset() before stepping again".into(),
+            ));
+        }
+        let agents = self.task.agents().to_vec();
+        let n = agents.len();
+        self.overrides.fill(None);
+        match (continuous, discrete, &self.spec.action) {
+            (Some(a), None, Space::Box { .. }) if a.len() == 2 * n => {
+                for (k, &i) in agents.iter().enumerate() {
+                    let (l, r) = (a[2 * k], a[2 * k + 1]);
+                    if !(l.is_finite() && r.is_finite()) {
+                        return Err(EnvError::Action(format!(
+                            "action of agent robot_{k} is [{l}, {r}] (must be finite)"
+                        ))
+                        .into());
+                    }
+                    self.overrides[i] = Some(encoding::continuous_command(l, r, self.max_speed));
+                }
+            }
+            (None, Some(a), Space::Discrete { n: count }) if a.len() == n => {
+                for (k, &i) in agents.iter().enumerate() {
+                    let cmd =
+                        encoding::discrete_command(a[k], self.max_speed).ok_or_else(|| {
+                            EnvError::Action(format!(
+                                "action of agent robot_{k} is {}, not in 0..{count}",
+                                a[k]
+                            ))
+                        })?;
+                    self.overrides[i] = Some(cmd);
+                }
+            }
+            _ => {
+                return Err(EnvError::Action(format!(
+                    "expected {} for the {n} agents",
+                    match self.spec.action {
+                        Space::Box { .. } => format!("{} continuous values ([N, 2])", 2 * n),
+                        Space::Discrete { .. } => format!("{n} discrete actions ([N])"),
+                    }
+                ))
+                .into());
+            }
+        }
+        for (k, &i) in agents.iter().enumerate() {
+            if self.agent_terminated[k] {
+                self.overrides[i] = Some(WheelCommand::STOP);
+            }
+        }
+        let ticked = self.driver.tick(&self.overrides)?;
+        self.steps += 1;
+        self.prev_terminated.copy_from_slice(&self.agent_terminated);
+        self.task.evaluate(
+            self.driver.host(),
+            &mut self.rewards,
+            &mut self.agent_terminated,
+        );
+        for (r, &was) in self.rewards.iter_mut().zip(&self.prev_terminated) {
+            if was || !ticked {
+                *r = 0.0;
+            }
+        }
+        let out_of_ticks = self.driver.remaining() == Some(0);
+        let truncate = self.steps >= self.spec.max_cycles || out_of_ticks || !ticked;
+        let interventions = self.driver.interventions();
+        let mut done = true;
+        for (k, &i) in agents.iter().enumerate() {
+            self.terminated[k] = self.agent_terminated[k];
+            self.truncated[k] = truncate && !self.agent_terminated[k];
+            done &= self.terminated[k] || self.truncated[k];
+            self.shield[k] = if self.prev_terminated[k] {
+                0
+            } else {
+                shield_bits(interventions[i])
+            };
+        }
+        self.done = done;
+        self.write_outputs();
+        Ok(())
+    }
+
+    fn write_outputs(&mut self) {
+        let host = self.driver.host();
+        let agents = self.task.agents();
+        write_obs(host, agents, self.max_speed, &mut self.obs);
+        if self.spec.state.is_some() {
+            write_state(host, self.steps, self.spec.max_cycles, &mut self.state);
+        }
+        if let Some(p) = &self.patch {
+            write_patch(host, agents, p, &mut self.patch_buf);
+        }
+    }
+
+    /// Stops every robot now (twin, rig).
+    pub fn stop_all(&self, why: &str) {
+        if let Driver::Live { session, .. } = &self.driver {
+            session.stop_all(why);
+        }
+    }
+
+    /// The live loop's measurements so far (ticks, overruns, shield, stops); None for a replay.
+    pub fn live_report(&self) -> Option<crate::live::LiveReport> {
+        match &self.driver {
+            Driver::Live { session, .. } => Some(session.report()),
+            Driver::Replay { .. } => None,
+        }
+    }
+    /// Seconds since the plant started (live) or the replay's recorded time.
+    pub fn time(&self) -> f64 {
+        self.driver.time()
+    }
+}
+
+/// Raw pointers to a [`LiveEnv`]'s buffers (see [`LiveEnv::buffer_ptrs`]).
+pub struct PlantBuffers {
+    pub obs: *mut f32,
+    pub rewards: *mut f32,
+    pub terminated: *mut bool,
+    pub truncated: *mut bool,
+    pub state: *mut f32,
+    pub patch: *mut u8,
+    pub shield: *mut u8,
+}

@@ -1,0 +1,105 @@
+//! The RL plants over loopback: the digital twin started in-process and a recorded run replayed, with
+//! the spaces and outputs of the simulated environment, and the shield keeping a policy that drives at
+//! the walls inside the arena.
+use colcos_bridge::plant::{LiveEnv, PlantKind, PlantOptions};
+use colcos_env::{EnvConfig, VecEnv};
+use colcos_sim::world::ArenaView;
+
+fn config() -> EnvConfig {
+    let mut cfg = EnvConfig::new("aggregation");
+    cfg.max_cycles = 120;
+    cfg
+}
+
+/// Every agent drives full speed ahead: on its way to a wall within a few seconds.
+fn full_ahead(n: usize) -> Vec<f32> {
+    vec![1.0; 2 * n]
+}
+
+#[test]
+fn the_twin_plant_keeps_a_wall_seeking_policy_inside_and_replays_its_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("rig.mcap");
+    let cfg = config();
+    let mut opts = PlantOptions::new(PlantKind::Twin);
+    opts.log = Some(log.clone());
+    let mut env = LiveEnv::new(&cfg, &opts).unwrap();
+    // The same spaces and sizes as the simulated environment.
+    let sim = VecEnv::new(&cfg).unwrap();
+    let (a, b) = (env.spec(), sim.spec());
+    assert_eq!(
+        (
+            &a.observation,
+            &a.action,
+            &a.state,
+            a.num_agents,
+            a.max_cycles
+        ),
+        (
+            &b.observation,
+            &b.action,
+            &b.state,
+            b.num_agents,
+            b.max_cycles
+        )
+    );
+    env.reset(Some(3)).unwrap();
+    let goto = env.goto_report();
+    assert_eq!(goto.arrived, goto.robots, "{goto:?}");
+    let n = env.spec().num_agents;
+    let arena = env.scenario().arena_size();
+    let r = env.scenario().spec.robot.radius;
+    let (mut walled, mut steps) = (0, 0);
+    while !env.truncated().iter().any(|t| *t) {
+        env.step(Some(&full_ahead(n)), None).unwrap();
+        steps += 1;
+        walled += env.shield_flags().iter().filter(|f| **f & 2 != 0).count();
+        assert!(
+            env.obs()
+                .iter()
+                .all(|v| v.is_finite() && (-1.0..=1.0).contains(v))
+        );
+        for p in ArenaView::poses(env.host()) {
+            assert!(
+                p.pos.x > r * 0.5 && p.pos.x < arena.x - r * 0.5,
+                "{p:?} left the arena"
+            );
+            assert!(p.pos.y > r * 0.5 && p.pos.y < arena.y - r * 0.5, "{p:?}");
+        }
+    }
+    assert_eq!(steps, 120);
+    assert!(walled > 0, "the shield never turned a robot from a wall");
+    let report = env.live_report().unwrap();
+    assert!(
+        report.shield.walled > 0 && report.stops.is_empty(),
+        "{report:?}"
+    );
+    drop(env);
+    // The run's log replayed: the recorded ticks, with the policy's commands again.
+    let mut opts = PlantOptions::new(PlantKind::Replay);
+    opts.log = Some(log);
+    let mut replay = LiveEnv::new(&cfg, &opts).unwrap();
+    replay.reset(None).unwrap();
+    let mut steps = 0;
+    while !replay.truncated().iter().any(|t| *t) {
+        replay.step(Some(&full_ahead(n)), None).unwrap();
+        steps += 1;
+    }
+    assert!(steps >= 100, "{steps} replayed steps");
+}
+
+#[test]
+fn a_plant_without_what_it_needs_names_it() {
+    let cfg = config();
+    let err = |opts: PlantOptions| LiveEnv::new(&cfg, &opts).err().unwrap().to_string();
+    assert!(err(PlantOptions::new(PlantKind::Replay)).contains("`replay`"));
+    let mut rig = PlantOptions::new(PlantKind::Rig);
+    assert!(err(rig.clone()).contains("`tracker`"));
+    rig.tracker = Some("swarmcon://127.0.0.1:1".into());
+    rig.robots = Some("bogus://x".into());
+    assert!(err(rig).contains("robot link"));
+    let mut replay = PlantOptions::new(PlantKind::Replay);
+    replay.log = Some("/nonexistent/rig.mcap".into());
+    assert!(err(replay).contains("/nonexistent/rig.mcap"));
+    assert!("simulator".parse::<PlantKind>().is_err());
+}
