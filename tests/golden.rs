@@ -161,7 +161,7 @@ const LARGE: &[(&str, u64)] = &[
     ("run.gif", 0x21cf3849ecb835b8),
     ("scenario.toml", 0x2dab784f4a77cac8),
     ("screen.png", 0x746a412740df9e7d),
-    ("trajectory.csv", 0x110c39510366a265),
+    ("trajectory.csv", 0x9a541762d89d6b69),
 ];
 const THREE_TRAILS: &[(&str, u64)] = &[
     ("fields/blue.npy", 0x84f3375c62076cfa),
@@ -170,7 +170,7 @@ const THREE_TRAILS: &[(&str, u64)] = &[
     ("run.gif", 0xc007b5e11957ec9c),
     ("scenario.toml", 0x74f711f92dc9113d),
     ("screen.png", 0xe56a857e55daf0dc),
-    ("trajectory.csv", 0x79ed9155e378aec3),
+    ("trajectory.csv", 0x271f7d04f28e7b5e),
 ];
 const CASE1_G3: &[(&str, u64)] = &[
     ("fields/LAP.npy", 0xe8cb475867314762),
@@ -178,14 +178,14 @@ const CASE1_G3: &[(&str, u64)] = &[
     ("fields/SRP.npy", 0x59f90e33281bf1e2),
     ("scenario.toml", 0xc8ca8ddd11a4a1fb),
     ("screen.png", 0x8d50e96e7620b236),
-    ("trajectory.csv", 0xb67dd32ded6ef012),
+    ("trajectory.csv", 0x52c7dee15bc6e136),
 ];
 const CASE1_B_G2: &[(&str, u64)] = &[
     ("fields/LAP.npy", 0xbb38b73bead5efa2),
     ("fields/SAP.npy", 0x3064cab20eeb52a2),
     ("scenario.toml", 0x8800dd7c0ed3ecb2),
     ("screen.png", 0x9dafe67cdf6df998),
-    ("trajectory.csv", 0x856a2281a0fb01cb),
+    ("trajectory.csv", 0x6e255977eb3ccd51),
 ];
 const CASE2: &[(&str, u64)] = &[
     ("fields/AGP.npy", 0x17190009229fb89e),
@@ -193,7 +193,7 @@ const CASE2: &[(&str, u64)] = &[
     ("run.gif", 0x3b1d1cf7031c1055),
     ("scenario.toml", 0xa5510f9a43eda2bf),
     ("screen.png", 0xbbf28eb896d3b7f8),
-    ("trajectory.csv", 0x1d4d917a7f639f11),
+    ("trajectory.csv", 0x91b0e44b95d9172c),
 ];
 const EXPERIMENTS: &[(&str, u64)] = &[
     ("case1/arrivals.csv", 0x2b8abca265e0d18c),

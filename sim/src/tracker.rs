@@ -6,7 +6,8 @@
 //! each frame is delivered `latency` s after its stamp. In a frame every robot gets Gaussian position
 //! and heading noise and is missing with probability `dropout`; a missing robot keeps its previous
 //! tracked pose. The very first call reports the true poses at once (`seen = true`) so the host has a
-//! place to inject from before the first frame arrives.
+//! place to inject from before the first frame arrives. Tracked headings are wrapped to (-pi, pi], as
+//! a real tracker reports them.
 use crate::rng::SimRng;
 use crate::robot::Pose;
 use serde::{Deserialize, Serialize};
@@ -68,6 +69,8 @@ pub struct Tracker {
     spare: Vec<Vec<Option<Pose>>>,
     /// Index of the next frame to capture.
     next_frame: u64,
+    /// Capture time of the newest delivered frame (the first call's time before any arrives).
+    latest_stamp: Option<f32>,
     started: bool,
 }
 
@@ -79,6 +82,7 @@ impl Tracker {
             queue: Default::default(),
             spare: Vec::new(),
             next_frame: 0,
+            latest_stamp: None,
             started: false,
         }
     }
@@ -88,12 +92,26 @@ impl Tracker {
         &self.tracked
     }
 
+    /// Capture time of the newest delivered frame, s; `None` before the first `update`.
+    pub fn latest_frame_stamp(&self) -> Option<f32> {
+        self.latest_stamp
+    }
+
+    /// Whether robot `i`'s tracked pose comes from the newest delivered frame (false when it dropped
+    /// out of that frame and keeps an older pose).
+    pub fn in_latest_frame(&self, i: usize) -> bool {
+        self.tracked
+            .get(i)
+            .is_some_and(|t| t.seen && Some(t.stamp) == self.latest_stamp)
+    }
+
     /// Forgets everything: the next `update` reports the true poses again, as the first did.
     pub fn reset(&mut self) {
         while let Some(f) = self.queue.pop_front() {
             self.spare.push(f.poses);
         }
         self.next_frame = 0;
+        self.latest_stamp = None;
         self.started = false;
         for p in &mut self.tracked {
             *p = TrackedPose::default();
@@ -115,6 +133,7 @@ impl Tracker {
         let rate_ok = self.params.rate_hz.is_finite() && self.params.rate_hz > 0.0;
         if !self.started {
             self.started = true;
+            self.latest_stamp = Some(t);
             for (tp, p) in self.tracked.iter_mut().zip(true_poses) {
                 *tp = TrackedPose {
                     pose: *p,
@@ -156,7 +175,7 @@ impl Tracker {
                         q.pos.y += pos_sd * crate::rng::normal(rng);
                     }
                     if head_sd > 0.0 {
-                        q.heading += head_sd * crate::rng::normal(rng);
+                        q.heading = wrap_pi(q.heading + head_sd * crate::rng::normal(rng));
                     }
                     poses.push(Some(q));
                 }
@@ -175,6 +194,7 @@ impl Tracker {
             let Some(frame) = self.queue.pop_front() else {
                 break;
             };
+            self.latest_stamp = Some(frame.stamp as f32);
             for (tp, p) in self.tracked.iter_mut().zip(&frame.poses) {
                 if let Some(p) = p {
                     *tp = TrackedPose {
@@ -187,5 +207,94 @@ impl Tracker {
             self.spare.push(frame.poses);
         }
         &self.tracked
+    }
+}
+
+/// `a` wrapped to (-pi, pi] (noise can carry a heading near +-pi across it).
+fn wrap_pi(a: f32) -> f32 {
+    use std::f32::consts::{PI, TAU};
+    let w = a.rem_euclid(TAU);
+    if w > PI { w - TAU } else { w }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f32::consts::PI;
+
+    fn params(dropout: f32, heading_noise: f32) -> TrackerParams {
+        TrackerParams {
+            rate_hz: 50.0,
+            latency: 0.0,
+            position_noise: 0.0,
+            heading_noise,
+            dropout,
+        }
+    }
+
+    #[test]
+    fn robots_missing_from_the_newest_frame_are_told_apart() {
+        let mut t = Tracker::new(params(0.5, 0.0), 8);
+        let mut r = crate::rng::stream(3, 0, 0);
+        let truth = vec![Pose::new(0.5, 0.5, 0.0); 8];
+        let (mut fresh, mut missing) = (0, 0);
+        for k in 0..200 {
+            let time = k as f32 * 0.02;
+            t.update(time, &truth, &mut r);
+            let latest = t.latest_frame_stamp().unwrap();
+            assert!((latest - time).abs() < 1e-6, "frame of {time} delivered");
+            for i in 0..8 {
+                let stamp = t.tracked()[i].stamp;
+                if t.in_latest_frame(i) {
+                    assert_eq!(stamp, latest);
+                    fresh += 1;
+                } else {
+                    assert!(stamp < latest, "robot {i}: {stamp} vs {latest}");
+                    missing += 1;
+                }
+            }
+        }
+        // About half of each: dropout 0.5 (the first step reports every robot).
+        assert!((600..1000).contains(&missing), "{missing} missing");
+        assert!((600..1000).contains(&fresh), "{fresh} fresh");
+        let mut quiet = Tracker::new(params(0.0, 0.0), 3);
+        for k in 0..20 {
+            quiet.update(k as f32 * 0.02, &truth[..3], &mut r);
+            assert!((0..3).all(|i| quiet.in_latest_frame(i)));
+        }
+    }
+
+    #[test]
+    fn noisy_headings_near_pi_stay_in_the_half_open_range() {
+        let mut t = Tracker::new(params(0.0, 0.3), 4);
+        let mut r = crate::rng::stream(5, 0, 0);
+        let truth = [
+            Pose::new(0.5, 0.5, PI),
+            Pose::new(0.5, 0.5, -PI + 1e-3),
+            Pose::new(0.5, 0.5, PI - 1e-3),
+            Pose::new(0.5, 0.5, 0.0),
+        ];
+        let mut crossed = 0;
+        for k in 0..300 {
+            for (i, p) in t.update(k as f32 * 0.02, &truth, &mut r).iter().enumerate() {
+                let h = p.pose.heading;
+                assert!(h > -PI && h <= PI, "heading {h}");
+                // Robots 0 and 2 head at about +pi: noise past it comes back near -pi.
+                crossed += usize::from(i != 1 && i != 3 && h < 0.0);
+            }
+        }
+        assert!(
+            crossed > 100,
+            "noise carried headings across pi {crossed} times"
+        );
+    }
+
+    #[test]
+    fn wrapping_keeps_the_half_open_range() {
+        assert_eq!(wrap_pi(PI), PI);
+        assert_eq!(wrap_pi(-PI), PI);
+        assert!((wrap_pi(3.0 * PI / 2.0) + PI / 2.0).abs() < 1e-6);
+        assert!((wrap_pi(-7.0) - (-7.0 + 2.0 * PI)).abs() < 1e-6);
+        assert_eq!(wrap_pi(0.25), 0.25);
     }
 }

@@ -99,25 +99,30 @@ impl TrajectoryLog {
             groups: &groups,
             group_specs: &world.scenario().spec.robots,
         };
-        let written = self.record_rows(&rows);
+        let latest = world.tracked_frame_stamp();
+        let written = self
+            .write_rows(&rows, rows.poses.len(), latest)
+            .and_then(|()| self.flush());
         (self.commands, self.groups) = (commands, groups);
         written
     }
 
     /// Appends one row per robot of `rows` and flushes them: for a host without a simulated world
-    /// (the hardware bridge, whose `poses` are the tracked ones as it used them).
+    /// (the hardware bridge, whose `poses` are the tracked ones as it used them). `tracked_seen` is
+    /// each tracked pose's own `seen`.
     pub fn record_rows(&mut self, rows: &TickRows) -> Result<()> {
-        self.write_rows(rows, rows.poses.len())?;
+        self.write_rows(rows, rows.poses.len(), None)?;
         // Rows reach the file whole: the buffer is flushed only at a tick boundary.
         self.flush()
     }
 
-    /// Formats and writes the `n` rows of one tick, in robot order.
-    fn write_rows(&mut self, rows: &TickRows, n: usize) -> Result<()> {
+    /// Formats and writes the `n` rows of one tick, in robot order; `latest`: the stamp of the
+    /// tracker's newest frame (see [`TickRows::push_row`]).
+    fn write_rows(&mut self, rows: &TickRows, n: usize, latest: Option<f32>) -> Result<()> {
         if n < 2 * ROWS_PER_CHUNK {
             let mut text = std::mem::take(&mut self.line);
             text.clear();
-            (0..n).for_each(|i| rows.push_row(&mut text, i));
+            (0..n).for_each(|i| rows.push_row(&mut text, i, latest));
             let res = self.write_str(&text);
             self.line = text;
             res?;
@@ -128,7 +133,7 @@ impl TrajectoryLog {
                 .map(|c| {
                     let mut text = String::with_capacity(ROWS_PER_CHUNK * 160);
                     (c * ROWS_PER_CHUNK..((c + 1) * ROWS_PER_CHUNK).min(n))
-                        .for_each(|i| rows.push_row(&mut text, i));
+                        .for_each(|i| rows.push_row(&mut text, i, latest));
                     text
                 })
                 .collect();
@@ -159,8 +164,10 @@ pub struct TickRows<'a> {
 }
 
 impl TickRows<'_> {
-    /// Appends robot `i`'s row, newline included.
-    fn push_row(&self, l: &mut String, i: usize) {
+    /// Appends robot `i`'s row, newline included. `tracked_seen` is 1 when the tracked pose comes from
+    /// the tracker's newest frame (stamped `latest`), 0 when the robot dropped out of it and keeps an
+    /// older pose; without `latest`, the pose's own `seen`.
+    fn push_row(&self, l: &mut String, i: usize, latest: Option<f32>) {
         let (p, t, o, cmd) = (
             &self.poses[i],
             &self.tracked[i],
@@ -191,7 +198,8 @@ impl TickRows<'_> {
             }
             push_fixed(l, value, decimals);
         }
-        l.push_str(if t.seen { ",1," } else { ",0," });
+        let seen = t.seen && latest.is_none_or(|s| t.stamp == s);
+        l.push_str(if seen { ",1," } else { ",0," });
         push_fixed(l, cmd.left, 4);
         l.push(',');
         push_fixed(l, cmd.right, 4);
@@ -206,5 +214,56 @@ impl TickRows<'_> {
             push_fixed(l, b, 3);
         }
         l.push('\n');
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Scenario;
+
+    /// `tracked_seen` is 0 exactly when a robot dropped out of the tracker's newest frame, and
+    /// `tracked_heading` stays in (-pi, pi] with heading noise.
+    #[test]
+    fn the_log_shows_dropouts_and_wrapped_headings() {
+        let text = "duration = 1.0\n[tracker]\ndropout = 0.4\nheading_noise = 0.5\n\
+                    [[robots]]\ncount = 6\nbehaviour = \"avoid\"\n";
+        let sc = Scenario::from_toml_str(text, ".").unwrap();
+        let mut world = World::new(&sc).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("trajectory.csv");
+        let mut log = TrajectoryLog::create(&path).unwrap();
+        let mut expected = Vec::new();
+        for _ in 0..50 {
+            world.step();
+            log.record(&world).unwrap();
+            let latest = world.tracked_frame_stamp().unwrap();
+            expected.extend(world.tracked().iter().map(|t| u8::from(t.stamp == latest)));
+        }
+        drop(log);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let cols: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        let at = |name: &str| cols.iter().position(|c| *c == name).unwrap();
+        let (seen_col, heading_col) = (at("tracked_seen"), at("tracked_heading"));
+        let rows: Vec<Vec<&str>> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect())
+            .collect();
+        let seen: Vec<u8> = rows.iter().map(|r| r[seen_col].parse().unwrap()).collect();
+        assert_eq!(seen, expected);
+        let dropped = seen.iter().filter(|&&s| s == 0).count();
+        assert!(
+            dropped > 20 && dropped < seen.len() - 20,
+            "{dropped} of {}",
+            seen.len()
+        );
+        for r in &rows {
+            let h: f32 = r[heading_col].parse().unwrap();
+            assert!(
+                h.abs() <= std::f32::consts::PI + 1e-4,
+                "tracked heading {h}"
+            );
+        }
     }
 }

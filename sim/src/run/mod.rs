@@ -93,7 +93,7 @@ pub fn run(
     clear_previous_outputs(out_dir)?;
     let mut files = Vec::new();
     let scenario_copy = out_dir.join("scenario.toml");
-    std::fs::write(&scenario_copy, scenario.to_toml())
+    std::fs::write(&scenario_copy, scenario.to_toml_standalone())
         .map_err(|e| SimError::io(format!("writing {}", scenario_copy.display()), e))?;
     files.push(scenario_copy);
 
@@ -299,6 +299,35 @@ mod tests {
         assert!(
             u64::from(w) * u64::from(h) <= MAX_PNG_PIXELS && h >= 1,
             "{w} x {h}"
+        );
+    }
+
+    /// The `scenario.toml` a run saves loads again from its output directory: relative image paths
+    /// are written absolute.
+    #[test]
+    fn the_saved_scenario_runs_again_from_the_output_directory() {
+        let src = tempfile::tempdir().unwrap();
+        std::fs::create_dir(src.path().join("maps")).unwrap();
+        image::RgbImage::from_pixel(8, 6, image::Rgb([0, 0, 200]))
+            .save(src.path().join("maps/loop.png"))
+            .unwrap();
+        let text = "duration = 0.04\n[output]\ngif_interval = 0\n[[pheromones]]\nname = \"trail\"\n\
+                    colour = [0, 0, 255]\nevaporation = 10.0\n\
+                    maps = [{ image = \"maps/loop.png\", channel = \"b\", rate = 1.0 }]\n\
+                    [[robots]]\ncount = 2\nbehaviour = \"avoid\"\n";
+        std::fs::write(src.path().join("s.toml"), text).unwrap();
+        let sc = Scenario::from_file(src.path().join("s.toml")).unwrap();
+        let out = tempfile::tempdir().unwrap();
+        run(&sc, out.path(), RunOptions::default()).unwrap();
+        let saved = Scenario::from_file(out.path().join("scenario.toml")).expect("the saved copy");
+        let image = saved.spec.pheromones[0].maps[0].image.clone().unwrap();
+        assert!(Path::new(&image).is_absolute(), "{image}");
+        let again = tempfile::tempdir().unwrap();
+        let report = run(&saved, again.path(), RunOptions::default()).expect("runs again");
+        assert_eq!(report.steps, 2);
+        assert_eq!(
+            std::fs::read(out.path().join("trajectory.csv")).unwrap(),
+            std::fs::read(again.path().join("trajectory.csv")).unwrap()
         );
     }
 

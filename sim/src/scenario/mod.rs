@@ -101,6 +101,26 @@ impl Scenario {
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(&self.spec).unwrap_or_default()
     }
+
+    /// The scenario as TOML with its file paths (image maps, rig calibrations) made absolute, so that
+    /// the copy a run saves in its output directory runs again from there.
+    pub fn to_toml_standalone(&self) -> String {
+        let mut spec = self.spec.clone();
+        let absolute = |p: &mut String| {
+            let joined = self.base_dir.join(&*p);
+            if let Ok(abs) = std::path::absolute(&joined) {
+                *p = abs.to_string_lossy().into_owned();
+            }
+        };
+        spec.pheromones
+            .iter_mut()
+            .flat_map(|ph| ph.maps.iter_mut())
+            .filter_map(|m| m.image.as_mut())
+            .for_each(absolute);
+        spec.rig.screen_calibration.iter_mut().for_each(absolute);
+        spec.rig.colour_calibration.iter_mut().for_each(absolute);
+        toml::to_string_pretty(&spec).unwrap_or_default()
+    }
 }
 
 /// TOML text to spec. Errors name the key path (`robots[0].count`) and what was wrong.

@@ -54,6 +54,11 @@ impl World {
     pub fn tracked(&self) -> &[TrackedPose] {
         self.tracking.tracked()
     }
+    /// Capture time of the tracker's newest delivered frame, s: a tracked pose stamped earlier is a
+    /// robot that dropped out of that frame.
+    pub fn tracked_frame_stamp(&self) -> Option<f32> {
+        self.tracking.latest_frame_stamp()
+    }
     /// What each robot senses now.
     pub fn observations(&self) -> &[Observation] {
         self.sensing.observations()

@@ -24,6 +24,10 @@ impl Tracking {
     pub fn tracked(&self) -> &[TrackedPose] {
         &self.tracked
     }
+    /// Capture time of the newest delivered frame (see [`Tracker::latest_frame_stamp`]).
+    pub fn latest_frame_stamp(&self) -> Option<f32> {
+        self.tracker.latest_frame_stamp()
+    }
 }
 
 /// Stage `track`: the tracker's view at `time` of the true `poses`.
