@@ -30,7 +30,10 @@ fn settings(t: &Table, axes: &[String], metric: usize) -> Vec<Setting> {
             let label = axes
                 .iter()
                 .zip(&axis_cols)
-                .map(|(a, &c)| format!("{a} = {}", text[c]))
+                .map(|(a, &c)| match text[c].parse::<f64>() {
+                    Ok(v) => format!("{a} = {}", short(v)),
+                    Err(_) => format!("{a} = {}", text[c]),
+                })
                 .collect::<Vec<_>>()
                 .join(", ");
             (
@@ -106,6 +109,12 @@ pub fn markdown(
         let (bl, bv) = cell(best);
         let (wl, wv) = cell(worst);
         let dir = if up { "higher" } else { "lower" };
+        if let (Some(b), Some(w)) = (best, worst)
+            && b.mean == w.mean
+        {
+            let _ = writeln!(s, "| `{m}` | {dir} | every setting the same | {bv} | | |");
+            continue;
+        }
         let _ = writeln!(s, "| `{m}` | {dir} | {bl} | {bv} | {wl} | {wv} |");
     }
     if !plots.is_empty() {

@@ -183,6 +183,20 @@ impl Plan {
         Ok(plan)
     }
 
+    /// The directory the base scenario's relative paths (image maps) resolve against.
+    pub fn scenario_dir(&self) -> &Path {
+        &self.scenario_dir
+    }
+
+    /// The sweep as self-contained TOML, the base scenario inlined: what a worker elsewhere rebuilds
+    /// the same runs from (with [`Plan::scenario_dir`] as its directory).
+    pub fn portable_toml(&self) -> String {
+        let mut spec = self.spec.clone();
+        spec.scenario = ScenarioRef::Inline(self.base.clone());
+        spec.name = Some(self.name.clone());
+        toml::to_string(&spec).unwrap_or_default()
+    }
+
     /// Runs in all.
     pub fn total(&self) -> u64 {
         (self.combos.len() * self.seeds.len()) as u64
