@@ -9,6 +9,7 @@ mod errors;
 mod limits;
 mod registry;
 mod spec;
+mod sweep;
 mod vec_env;
 mod window;
 
@@ -22,6 +23,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     baseline::register(m)?;
     registry::register(m)?;
     window::register(m)?;
+    sweep::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 # `colcos.vector` and `colcos.gymnasium_vector` come with `import colcos` (they need only numpy and
 # gymnasium); the SB3 and TorchRL adapters import their libraries and stay opt-in.
-from colcos import _core, gymnasium_vector, vector
+from colcos import _core, gymnasium_vector, sweep, vector
 from colcos._core import (
     ActionError,
     ActionTypeError,
@@ -65,6 +65,7 @@ __all__ = [
     "observation_names",
     "parallel_env",
     "raw_env",
+    "sweep",
     "tasks",
     "vector",
 ]
