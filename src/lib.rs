@@ -5,8 +5,10 @@ pub use colcos_bridge as bridge;
 pub use colcos_sim as sim;
 
 pub mod backend;
+pub mod calibrate;
 pub mod display;
 pub mod experiment;
+pub mod replay;
 pub mod report;
 pub mod rig;
 pub mod run;

@@ -7,6 +7,7 @@ mod args;
 mod baseline;
 mod errors;
 mod limits;
+mod plant;
 mod registry;
 mod spec;
 mod sweep;
@@ -20,6 +21,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let _ = pyo3_log::Logger::new(m.py(), pyo3_log::Caching::LoggersAndLevels)?.install();
     errors::register(m)?;
     vec_env::register(m)?;
+    plant::register(m)?;
     baseline::register(m)?;
     registry::register(m)?;
     window::register(m)?;

@@ -252,6 +252,7 @@ impl PyVecEnv {
                     view(&owner, ptrs.final_obs, vec![e, n, d_obs])?,
                 )?;
                 d.set_item("final_mask", view(&owner, ptrs.final_mask, vec![e])?)?;
+                d.set_item("shield", view(&owner, ptrs.shield, vec![e, n])?)?;
                 if let Some(s) = &spec.state {
                     d.set_item("state", view(&owner, ptrs.state, vec![e, s.flat_len()])?)?;
                 }

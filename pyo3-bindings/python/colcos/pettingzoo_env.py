@@ -13,11 +13,12 @@ from pettingzoo.utils import wrappers
 from pettingzoo.utils.conversions import parallel_to_aec_wrapper
 
 from colcos import _actions, _checks, _core
-from colcos._core import ActionError, StateError, UnknownAgentError
+from colcos._core import ActionError, StateError, TaskError, UnknownAgentError
 from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_space, share_signature
 
 RENDER_WIDTH = 640
 _F32 = np.dtype(np.float32)
+PLANTS = ("sim", "twin", "rig", "replay")
 
 
 class ColcosParallelEnv(BackendInfo, ParallelEnv):
@@ -43,6 +44,17 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             taken is in `backend_name` (`"cpu"` / `"gpu"`) and `backend_info`, and logged (logger
             `colcos`, INFO).
         seed: the base seed, an integer in 0..=2**64-1 (as for `reset(seed=...)`).
+        plant: where the arena is: `"sim"` (the simulator), `"twin"` (the digital twin over the rig's
+            wire formats: started in this process on loopback, or at `tracker`/`robots`), `"rig"`
+            (the lab's tracker and robots at `tracker` and `robots`) or `"replay"` (the rig log `log`
+            fed tick by tick with this policy's commands). Same spaces, dtypes and info keys in each;
+            `step` is paced to the screen's 20 ms on the twin and the rig. See docs/bridge.md.
+        tracker, robots: the URLs of the tracker (`swarmcon://HOST:PORT`) and the robots' link
+            (`serial:///dev/ttyUSB0?baud=115200`, `udp://HOST:PORT`), for `"twin"` and `"rig"`.
+        log: `"replay"`: the rig log (`rig.mcap`) to replay; `"twin"`/`"rig"`: where to write one.
+        goto: on the twin and the rig, `reset` first drives the robots to the episode's start poses
+            (tracker-guided, collision-aware), for at most `goto_timeout` s; False leaves them where
+            they are.
         **params: task parameters (see the task's docs); unknown ones raise `colcos.TaskError`.
 
     Actions (`step`): a dict with an action for every agent in `agents`; see docs/python.md
@@ -69,15 +81,36 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         patch_side: float = 0.08,
         seed: int = 0,
         backend: str | None = None,
+        plant: str = "sim",
+        tracker: str | None = None,
+        robots: str | None = None,
+        log: str | os.PathLike[str] | None = None,
+        goto: bool = True,
+        goto_timeout: float = 30.0,
         **params: Any,
     ) -> None:
         self._init_kwargs = dict(
             task=task, scenario=scenario, max_cycles=max_cycles, render_mode=render_mode, continuous=continuous,
-            global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, backend=backend, **params,
+            global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, backend=backend,
+            plant=plant, tracker=tracker, robots=robots, log=log, goto=goto, goto_timeout=goto_timeout, **params,
         )
         _checks.choice(render_mode, "render_mode", [None, "human", "rgb_array"])
         kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend)
-        self._core = _core.VecEnv(num_envs=1, seed=_checks.seed(seed), num_threads=1, autoreset_mode="disabled", **kw)
+        _checks.choice(plant, "plant", list(PLANTS))
+        self.plant = plant
+        self._core: _core.VecEnv | _core.Plant
+        if plant == "sim":
+            for name, value in (("tracker", tracker), ("robots", robots), ("log", log)):
+                if value is not None:
+                    raise TaskError(f"{name}={value!r} is for plant='twin', 'rig' or 'replay', not 'sim'")
+            self._core = _core.VecEnv(
+                num_envs=1, seed=_checks.seed(seed), num_threads=1, autoreset_mode="disabled", **kw
+            )
+        else:
+            self._core = _core.Plant(
+                plant=plant, tracker=tracker, robots=robots, log=None if log is None else os.fspath(log),
+                goto=_checks.flag(goto, "goto"), goto_timeout=goto_timeout, seed=_checks.seed(seed), **kw,
+            )
         log_backend(self._core, backend)
         spec = self._core.spec()
         self._spec = spec
@@ -185,6 +218,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         # One copy and one conversion per buffer rather than per agent: each agent's observation is a
         # row of this step's own copy (never a view of the native buffer, which the next step rewrites).
         rew, term, trunc = v["rewards"][0].tolist(), v["terminated"][0].tolist(), v["truncated"][0].tolist()
+        shield = v["shield"][0].tolist()
         all_obs = v["obs"][0].copy()
         patches = v["patch"][0].copy() if "patch" in v else None
         obs: dict[str, Any] = {}
@@ -199,7 +233,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             rewards[a] = rew[i]
             t = terminations[a] = term[i]
             u = truncations[a] = trunc[i]
-            infos[a] = {}
+            infos[a] = {"shield_capped": bool(shield[i] & 1), "shield_walled": bool(shield[i] & 2)}
             if not (t or u):
                 live.append(a)
         self.agents = live
@@ -234,9 +268,32 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         return None
 
     def close(self) -> None:
-        """Closes the `render_mode="human"` window, if one is open."""
+        """Closes the `render_mode="human"` window, if one is open; on the twin and the rig, stops
+        every robot."""
         if self._window is not None:
             self._window.close()
+        if self.plant != "sim":
+            assert isinstance(self._core, _core.Plant)
+            self._core.stop("the environment was closed")
+
+    def __enter__(self) -> ColcosParallelEnv:
+        return self
+
+    def __exit__(self, kind: Any, value: Any, tb: Any) -> None:
+        # A policy that raises inside `with env:` stops the robots at once, not after the watchdog's
+        # policy-stall limit.
+        if self.plant != "sim" and kind is not None:
+            assert isinstance(self._core, _core.Plant)
+            self._core.stop(f"the policy raised {kind.__name__}")
+        self.close()
+
+    def plant_info(self) -> dict[str, Any]:
+        """What the plant measured: ticks, overruns, worst and 99th-percentile tick (ms), the shield's
+        interventions, safety stops, the last reset's go-to (twin, rig); `{"plant": "sim"}` otherwise."""
+        if self.plant == "sim":
+            return {"plant": "sim"}
+        assert isinstance(self._core, _core.Plant)
+        return dict(self._core.plant_info())
 
     def poses(self) -> np.ndarray:
         """True poses (R, 3): x m, y m, heading rad, of every robot (for analysis, not for policies)."""

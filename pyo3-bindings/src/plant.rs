@@ -1,0 +1,355 @@
+//! `colcos._core.Plant`: one arena of a task on the digital twin, the lab's rig or a recorded rig run,
+//! with the buffers, spec and methods of a one-world `VecEnv`, so that the PettingZoo faces run on it
+//! unchanged. The GIL is released around every call that waits on the arena (reset, step).
+use crate::args::{self, guard};
+use crate::errors::{Kind, to_py};
+use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions};
+use colcos_env::Space;
+use numpy::ndarray::{ArrayView, IxDyn};
+use numpy::{
+    Element, PyArray, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods,
+};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::{Mutex, MutexGuard};
+
+#[pyclass(module = "colcos._core", name = "Plant", frozen)]
+pub struct PyPlant {
+    inner: Mutex<LiveEnv>,
+    num_agents: usize,
+    discrete: bool,
+}
+
+fn plant_err(e: PlantError) -> PyErr {
+    let msg = e.to_string();
+    match e {
+        PlantError::Env(e) => to_py(e),
+        PlantError::Sim(_) => Kind::Scenario.err(msg),
+        PlantError::Option { .. } => Kind::Task.err(msg),
+        PlantError::Source(_) | PlantError::Link(_) | PlantError::Io(_) => Kind::State.err(msg),
+        PlantError::Replay(_) | PlantError::State(_) => Kind::State.err(msg),
+    }
+}
+
+/// Raw buffer pointers carried out of a `detach` closure.
+struct Ptrs<T>(T);
+// SAFETY: plain addresses of buffers owned by the plant, only dereferenced with the GIL held while
+// the plant is alive (see `views`).
+unsafe impl<T> Send for Ptrs<T> {}
+
+/// A numpy view of the elements at `ptr` shaped `shape`, keeping `owner` alive.
+///
+/// # Safety
+/// `ptr..ptr + product(shape)` must stay valid for as long as `owner` lives.
+unsafe fn view<'py, T: Element>(
+    owner: &Bound<'py, PyAny>,
+    ptr: *mut T,
+    shape: Vec<usize>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let a = unsafe { ArrayView::from_shape_ptr(IxDyn(&shape), ptr as *const T) };
+    Ok(unsafe { PyArray::borrow_from_array(&a, owner.clone()) }.into_any())
+}
+
+impl PyPlant {
+    /// The lock. Call only with the GIL released (inside `py.detach`).
+    fn lock(&self) -> MutexGuard<'_, LiveEnv> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+#[pymethods]
+impl PyPlant {
+    /// `plant`: "twin", "rig" or "replay"; `tracker`/`robots`: the URLs (a twin without them starts
+    /// in this process on loopback); `log`: the rig log to replay, or to write (twin, rig);
+    /// `goto`: reset drives the robots to the episode's start poses, for at most `goto_timeout` s.
+    /// The other arguments are `VecEnv`'s (one world).
+    #[new]
+    #[pyo3(signature = (plant, task, tracker=None, robots=None, log=None, goto=None, goto_timeout=None, seed=None, scenario=None, scenario_text=None, max_cycles=None, action=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        plant: &Bound<'_, PyAny>,
+        task: &Bound<'_, PyAny>,
+        tracker: Option<&Bound<'_, PyAny>>,
+        robots: Option<&Bound<'_, PyAny>>,
+        log: Option<&Bound<'_, PyAny>>,
+        goto: Option<&Bound<'_, PyAny>>,
+        goto_timeout: Option<&Bound<'_, PyAny>>,
+        seed: Option<&Bound<'_, PyAny>>,
+        scenario: Option<&Bound<'_, PyAny>>,
+        scenario_text: Option<&Bound<'_, PyAny>>,
+        max_cycles: Option<&Bound<'_, PyAny>>,
+        action: Option<&Bound<'_, PyAny>>,
+        global_state: Option<&Bound<'_, PyAny>>,
+        patch_pixels: Option<&Bound<'_, PyAny>>,
+        patch_side: Option<&Bound<'_, PyAny>>,
+        params_json: Option<&Bound<'_, PyAny>>,
+        backend: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        guard(|| {
+            let kind: PlantKind = args::text(plant, "plant")?.parse().map_err(plant_err)?;
+            let mut opts = PlantOptions::new(kind);
+            opts.tracker = args::opt_text(tracker, "tracker")?;
+            opts.robots = args::opt_text(robots, "robots")?;
+            opts.log = match log.filter(|l| !l.is_none()) {
+                Some(l) => Some(l.extract::<std::path::PathBuf>().map_err(|_| {
+                    Kind::ArgumentType.err(format!(
+                        "log must be a path (str or os.PathLike), got {}",
+                        args::show(l)
+                    ))
+                })?),
+                None => None,
+            };
+            if let Some(g) = goto.filter(|g| !g.is_none()) {
+                opts.goto = args::flag(g, "goto")?;
+            }
+            let timeout = match goto_timeout.filter(|t| !t.is_none()) {
+                Some(t) => args::real(t, "goto_timeout")?,
+                None => opts.goto_timeout,
+            };
+            if !(0.0..=600.0).contains(&timeout) {
+                return Err(
+                    Kind::Task.err(format!("goto_timeout = {timeout}: must be in 0..=600 s"))
+                );
+            }
+            opts.goto_timeout = timeout;
+            let one = Some(1u64.into_pyobject(py)?.into_any());
+            let cfg = crate::vec_env::config(
+                task,
+                one.as_ref(),
+                seed,
+                one.as_ref(),
+                scenario,
+                scenario_text,
+                max_cycles,
+                action,
+                None,
+                global_state,
+                patch_pixels,
+                patch_side,
+                params_json,
+                backend,
+            )?;
+            let env = py.detach(|| LiveEnv::new(&cfg, &opts)).map_err(plant_err)?;
+            let s = env.spec();
+            let (num_agents, discrete) = (s.num_agents, matches!(s.action, Space::Discrete { .. }));
+            Ok(PyPlant {
+                inner: Mutex::new(env),
+                num_agents,
+                discrete,
+            })
+        })
+    }
+
+    /// Sizes, names and spaces, as a dict (those of the simulated environment).
+    fn spec<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        guard(|| {
+            let spec = py.detach(|| self.lock().spec().clone());
+            crate::spec::spec_dict(py, &spec, "Disabled")
+        })
+    }
+
+    /// Numpy views of the output buffers, overwritten by every reset and step: `obs [1,N,D]`,
+    /// `rewards [1,N]`, `terminated`/`truncated [1,N]`, `shield [1,N]` (bit 0 capped, bit 1 walled),
+    /// `state [1,S]` and `patch [1,N,P,P,3]` if enabled.
+    fn views<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
+        guard(|| {
+            let py = slf.py();
+            let owner = slf.clone().into_any();
+            let me: &PyPlant = slf.get();
+            let (ptrs, spec) = py.detach(|| {
+                let mut g = me.lock();
+                (Ptrs(g.buffer_ptrs()), g.spec().clone())
+            });
+            let p = ptrs.0;
+            let n = spec.num_agents;
+            let d = PyDict::new(py);
+            // SAFETY: the buffers are allocated once in LiveEnv::new and never reallocated; each view
+            // keeps `owner` (and so the plant) alive.
+            unsafe {
+                d.set_item(
+                    "obs",
+                    view(&owner, p.obs, vec![1, n, spec.observation.flat_len()])?,
+                )?;
+                d.set_item("rewards", view(&owner, p.rewards, vec![1, n])?)?;
+                d.set_item("terminated", view(&owner, p.terminated, vec![1, n])?)?;
+                d.set_item("truncated", view(&owner, p.truncated, vec![1, n])?)?;
+                d.set_item("shield", view(&owner, p.shield, vec![1, n])?)?;
+                if let Some(s) = &spec.state {
+                    d.set_item("state", view(&owner, p.state, vec![1, s.flat_len()])?)?;
+                }
+                if let Some(Space::Box { shape, .. }) = &spec.patch {
+                    d.set_item(
+                        "patch",
+                        view(&owner, p.patch, vec![1, n, shape[0], shape[1], shape[2]])?,
+                    )?;
+                }
+            }
+            Ok(d)
+        })
+    }
+
+    /// A new episode (on the twin and the rig: the robots driven to its start poses first); a seed
+    /// becomes the scenario's seed.
+    #[pyo3(signature = (seed=None, mask=None))]
+    fn reset(
+        &self,
+        py: Python<'_>,
+        seed: Option<&Bound<'_, PyAny>>,
+        mask: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        guard(|| {
+            if mask.is_some_and(|m| !m.is_none()) {
+                return Err(Kind::Task.err("a plant has one world: reset takes no mask"));
+            }
+            let seed = match seed.filter(|s| !s.is_none()) {
+                Some(s) => Some(args::seed(s, "seed")?),
+                None => None,
+            };
+            py.detach(|| self.lock().reset(seed)).map_err(plant_err)
+        })
+    }
+
+    /// One step (paced to the screen's rate on the twin and the rig): float32 `[1, N, 2]` or int64
+    /// `[1, N]`.
+    fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
+        guard(|| {
+            let n = self.num_agents;
+            if self.discrete {
+                let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
+                    Kind::ActionType.err(format!(
+                        "discrete actions must be an int64 numpy array of shape (1, {n}), got {}",
+                        args::show(actions)
+                    ))
+                })?;
+                if a.shape() != [1, n] {
+                    return Err(Kind::Action.err(format!(
+                        "actions have shape {:?}, expected (1, {n})",
+                        a.shape()
+                    )));
+                }
+                let v: Vec<i64> = a.as_array().iter().copied().collect();
+                py.detach(|| self.lock().step(None, Some(&v)))
+                    .map_err(plant_err)
+            } else {
+                let a: PyReadonlyArrayDyn<'_, f32> = actions.extract().map_err(|_| {
+                    Kind::ActionType.err(format!(
+                        "continuous actions must be a float32 numpy array of shape (1, {n}, 2), got {}",
+                        args::show(actions)
+                    ))
+                })?;
+                if a.shape() != [1, n, 2] {
+                    return Err(Kind::Action.err(format!(
+                        "actions have shape {:?}, expected (1, {n}, 2)",
+                        a.shape()
+                    )));
+                }
+                let v: Vec<f32> = a.as_array().iter().copied().collect();
+                py.detach(|| self.lock().step(Some(&v), None))
+                    .map_err(plant_err)
+            }
+        })
+    }
+
+    /// The screen with the robots drawn at their tracked poses, `(H, W, 3)` uint8.
+    #[pyo3(signature = (world=None, width=None))]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        world: Option<&Bound<'py, PyAny>>,
+        width: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            if let Some(w) = world.filter(|w| !w.is_none()) {
+                args::int_in(w, "world", 0, 0)?;
+            }
+            let width = match width.filter(|w| !w.is_none()) {
+                Some(x) => args::int_in(x, "width", 16, 4096)? as u32,
+                None => 640,
+            };
+            let img = py.detach(|| self.lock().render(width));
+            let (w, h) = (img.width() as usize, img.height() as usize);
+            let flat = PyArray1::from_vec(py, img.into_raw());
+            Ok(flat.reshape([h, w, 3])?.into_any())
+        })
+    }
+
+    #[pyo3(signature = (world=0))]
+    fn episode_steps(&self, py: Python<'_>, world: usize) -> PyResult<u64> {
+        check_world(world)?;
+        Ok(py.detach(|| self.lock().episode_steps()))
+    }
+
+    #[pyo3(signature = (world=0))]
+    fn episode(&self, py: Python<'_>, world: usize) -> PyResult<u64> {
+        check_world(world)?;
+        Ok(py.detach(|| self.lock().episode()))
+    }
+
+    /// The poses the loop used in the last tick `(R, 3)`: x m, y m, heading rad (tracked, latency
+    /// compensated).
+    #[pyo3(signature = (world=0))]
+    fn poses<'py>(&self, py: Python<'py>, world: usize) -> PyResult<Bound<'py, PyAny>> {
+        check_world(world)?;
+        let flat: Vec<f32> = py.detach(|| {
+            let g = self.lock();
+            colcos_sim::world::ArenaView::poses(g.host())
+                .iter()
+                .flat_map(|p| [p.pos.x, p.pos.y, p.heading])
+                .collect()
+        });
+        let r = flat.len() / 3;
+        Ok(PyArray1::from_vec(py, flat).reshape([r, 3])?.into_any())
+    }
+
+    #[getter]
+    fn backend_name(&self) -> &'static str {
+        "cpu"
+    }
+    #[getter]
+    fn backend_info(&self) -> &'static str {
+        "cpu (the host's field)"
+    }
+
+    /// What the plant measured: kind, time, the live loop's report (ticks, overruns, worst tick,
+    /// shield, safety stops), the last reset's go-to.
+    fn plant_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (kind, time, report, goto) = py.detach(|| {
+            let g = self.lock();
+            (g.kind(), g.time(), g.live_report(), g.goto_report())
+        });
+        let d = PyDict::new(py);
+        d.set_item("plant", format!("{kind:?}").to_lowercase())?;
+        d.set_item("time", time)?;
+        if let Some(r) = report {
+            d.set_item("ticks", r.ticks)?;
+            d.set_item("overruns", r.overruns)?;
+            d.set_item("worst_tick_ms", r.worst_tick_ms)?;
+            d.set_item("p99_tick_ms", r.p99_tick_ms)?;
+            d.set_item("shield_capped", r.shield.capped)?;
+            d.set_item("shield_walled", r.shield.walled)?;
+            d.set_item("stops", r.stops)?;
+            d.set_item("commands_sent", r.commands_sent)?;
+        }
+        d.set_item("goto_seconds", goto.seconds)?;
+        d.set_item("goto_arrived", goto.arrived)?;
+        Ok(d)
+    }
+
+    /// Stops every robot now (twin, rig): what to call when a policy fails.
+    #[pyo3(signature = (reason="stopped from Python"))]
+    fn stop(&self, py: Python<'_>, reason: &str) {
+        py.detach(|| self.lock().stop_all(reason));
+    }
+}
+
+fn check_world(world: usize) -> PyResult<()> {
+    if world != 0 {
+        return Err(Kind::Task.err(format!("world = {world}: a plant has one world (0)")));
+    }
+    Ok(())
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyPlant>()
+}
