@@ -69,7 +69,10 @@ impl GoTo {
             if bearing.abs() > 0.6 || wait {
                 (0.0, 4.0 * bearing)
             } else {
-                ((2.0 * dist).min(self.max_speed) * bearing.cos(), 4.0 * bearing)
+                (
+                    (2.0 * dist).min(self.max_speed) * bearing.cos(),
+                    4.0 * bearing,
+                )
             }
         } else {
             let err = wrap(target.heading - pose.heading);
