@@ -6,6 +6,7 @@
 pub mod colour;
 pub mod homography;
 pub mod latency;
+pub mod run_colour;
 pub mod run_latency;
 pub mod run_screen;
 pub mod screen;
@@ -75,6 +76,21 @@ impl RigCalibration {
             None => None,
         };
         Ok(RigCalibration { screen, colour })
+    }
+
+    /// Robot `radio`'s raw counts (simulator sensor order) as the scenario's `nominal` sensor model
+    /// would read the same screen, through the colour calibration's inverse (unchanged without
+    /// one): what the live loop hands the host with `sensors = "robot"`.
+    pub fn robot_counts(
+        &self,
+        radio: u8,
+        counts: [[u16; 3]; 4],
+        nominal: &colcos_sim::sensors::ColourSensor,
+    ) -> [[u16; 3]; 4] {
+        match &self.colour {
+            Some(c) => c.to_nominal(radio, counts, nominal),
+            None => counts,
+        }
     }
 
     /// The tracker-to-simulator conversion for `scenario`, with the screen calibration if any.

@@ -23,6 +23,9 @@ use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
+/// Fiducial centres (our frame, m) by the twin time they were first seen at.
+type FiducialHistory = std::collections::VecDeque<(f64, Vec<[f64; 2]>)>;
+
 pub struct Twin {
     plant: TwinPlant,
     tracker: TrackerServer,
@@ -33,9 +36,11 @@ pub struct Twin {
     /// The overhead camera, when one is modelled (calibration): poses go through it, and the
     /// fiducials in the frames the bridge shows are reported as unidentified (`-01`) slots.
     camera: Option<(CameraModel, Noise)>,
-    /// Time of the frame the fiducials were found in, and their centres (our frame, m): the
-    /// calibration patterns (white discs on black) in the frames the bridge shows.
-    fiducials: (f64, Vec<[f64; 2]>),
+    /// Time of the frame the fiducials were last looked for in, and per twin time they were seen
+    /// at, their centres (our frame, m): the calibration patterns (white discs on black) in the
+    /// frames the bridge shows. Reported with the tracker frame captured at or after that time, so
+    /// they come as late as the robots' poses do.
+    fiducials: (f64, FiducialHistory),
     /// Twin time of the last block sent, s.
     last_block: f64,
     block_period: f64,
@@ -63,7 +68,7 @@ impl Twin {
             transform: FrameTransform::new(scenario.arena_size().y as f64),
             tracker_ids: (0..n).map(|i| rig.tracker_id(i)).collect(),
             camera: None,
-            fiducials: (f64::NAN, Vec::new()),
+            fiducials: (f64::NAN, Default::default()),
             last_block: f64::NEG_INFINITY,
             block_period: 1.0 / rate,
         })
@@ -98,7 +103,19 @@ impl Twin {
             && *t != self.fiducials.0
         {
             let size = self.plant.world().screen().size;
-            self.fiducials = (*t, detect_fiducials(img, [size[0] as f64, size[1] as f64]));
+            let seen = detect_fiducials(img, [size[0] as f64, size[1] as f64]);
+            self.fiducials.0 = *t;
+            self.fiducials.1.push_back((self.plant.time(), seen));
+            // A second of history is more than any tracker latency.
+            while self.fiducials.1.len() > 2
+                && self
+                    .fiducials
+                    .1
+                    .get(1)
+                    .is_some_and(|(at, _)| self.plant.time() - at > 1.0)
+            {
+                self.fiducials.1.pop_front();
+            }
         }
         let frame = latest.map(|(img, _)| img);
         self.robots.poll(&mut self.plant, frame.as_deref());
@@ -142,7 +159,14 @@ impl Twin {
             .collect();
         // Fiducials are seen in the same camera frame as the robots (without a camera model, at
         // the nominal frame change).
-        for f in &self.fiducials.1 {
+        let history = &self.fiducials.1;
+        let shown = history
+            .iter()
+            .rev()
+            .find(|(at, _)| *at <= frame_t as f64 + 1e-6)
+            .map(|(_, f)| f.as_slice())
+            .unwrap_or(&[]);
+        for f in shown {
             let seen = match &mut self.camera {
                 Some((cam, noise)) => cam.see_fiducial(f[0], f[1], noise),
                 None => {
