@@ -1,1 +1,222 @@
+//! The `colcos` command line.
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use colcos::report::print_report;
+use colcos::run::{RunOptions, run};
+use colcos::sim::prelude::*;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
 
+// `pub(crate)`: the command-line fuzz target (fuzz/) compiles this file as a module and parses with it.
+#[derive(Parser)]
+#[command(
+    name = "colcos",
+    version,
+    about = "Multi-pheromone swarm robotics simulator (ColCOSPhi)"
+)]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scenario: writes trajectory.csv, screen.png, run.gif, fields/*.npy and summary.json.
+    Run {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+        /// Output directory [default: runs/<scenario name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override the scenario's seed.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Override the scenario's duration, s.
+        #[arg(long)]
+        duration: Option<f32>,
+        /// Worker threads, 1 to 1024 (default: all cores). Results do not depend on it.
+        // 0 would silently mean "all cores"; beyond 1024 each thread's stack only costs memory.
+        #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
+        threads: Option<usize>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+        /// Field backend: cpu, gpu or auto (overrides the scenario's `field.backend`).
+        #[arg(long)]
+        backend: Option<colcos::sim::field::BackendChoice>,
+    },
+    /// Show a scenario's screen image in a window (full screen on a chosen monitor, or windowed), or
+    /// render it headless to PNG.
+    Display(colcos::display::DisplayArgs),
+    /// Reproduce the paper's case studies (all trials in parallel): figures, CSVs, summary.json/.md.
+    Experiment(colcos::experiment::ExperimentArgs),
+    /// Drive real robots with a scenario's behaviours: poses from the tracker, pheromone injected and
+    /// the field stepped by the simulator, commands over the radio link, safety stops by a watchdog.
+    Bridge(colcos::rig::BridgeArgs),
+    /// The digital twin: the simulator serving the rig's wire formats (SwarmCon over TCP, the robots'
+    /// serial protocol over a pseudo-terminal or UDP) for `colcos bridge` to drive.
+    Twin(colcos::rig::TwinArgs),
+    /// Calibrate the rig over its own wires (screen <-> camera, latency, colour sensors); each writes
+    /// a file the scenario's `[rig]` section names.
+    Calibrate(colcos::calibrate::CalibrateArgs),
+    /// Put a rig log (`rig.mcap`) through the live loop again and check that the same inputs give
+    /// the same command bytes.
+    Replay(colcos::replay::ReplayArgs),
+    /// Run a batch of scenarios over axes of parameters and seeds (a sweep file), in parallel and
+    /// resumable: results.csv, plots/ and summary.md (docs/sweeps.md).
+    Sweep(colcos::sweep::SweepArgs),
+    /// Check a scenario file and print what it sets up, without running it.
+    Check { scenario: PathBuf },
+    /// List the behaviours a scenario can name.
+    Behaviours,
+}
+
+fn main() -> ExitCode {
+    init_logging();
+    match real_main() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The libraries report through the `log` crate; their messages reach the terminal (stderr) at info
+/// level unless `RUST_LOG` says otherwise. Dependencies such as wgpu stay quiet by default.
+fn init_logging() {
+    use std::io::Write as _;
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("colcos=info"))
+        .format(|buf, record| match record.level() {
+            log::Level::Info => writeln!(buf, "{}", record.args()),
+            log::Level::Warn => writeln!(buf, "warning: {}", record.args()),
+            level => writeln!(buf, "{}: {}", level.as_str().to_lowercase(), record.args()),
+        })
+        .init();
+}
+
+fn real_main() -> Result<()> {
+    let mut out = String::new();
+    run_command(Cli::parse().command, &mut out)?;
+    print_report(&out)
+}
+
+fn run_command(command: Command, text: &mut String) -> Result<()> {
+    match command {
+        Command::Display(args) => colcos::display::main(args),
+        Command::Experiment(args) => colcos::experiment::main(args),
+        Command::Sweep(args) => colcos::sweep::main(args),
+        Command::Bridge(args) => colcos::rig::bridge(args, text),
+        Command::Twin(args) => colcos::rig::twin(args, text),
+        Command::Calibrate(args) => colcos::calibrate::main(args, text),
+        Command::Replay(args) => colcos::replay::run(args, text),
+        Command::Run {
+            scenario,
+            out,
+            seed,
+            duration,
+            threads,
+            quiet,
+            backend,
+        } => {
+            if let Some(n) = threads {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build_global()
+                    .context("setting up the thread pool")?;
+            }
+            let mut sc = Scenario::from_file(&scenario)?.with_overrides(seed, duration)?;
+            if let Some(b) = backend {
+                sc.spec.field.backend = b;
+            }
+            let out = out.unwrap_or_else(|| {
+                PathBuf::from("runs").join(scenario.file_stem().unwrap_or_default())
+            });
+            // Ctrl-C and SIGTERM end the run after the current step, with every output written.
+            let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+            let flag = stop.clone();
+            ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed))
+                .context("installing the Ctrl-C / SIGTERM handler")?;
+            let report = run(
+                &sc,
+                &out,
+                &RunOptions {
+                    progress: !quiet,
+                    no_gif: false,
+                    stop: Some(stop),
+                },
+            )?;
+            if report.interrupted {
+                writeln!(
+                    text,
+                    "interrupted after {} of {} steps: the outputs hold what ran",
+                    report.steps,
+                    sc.steps()
+                )?;
+            }
+            writeln!(text, "field backend: {}", report.backend)?;
+            writeln!(
+                text,
+                "{} robots, {} steps ({} s simulated) in {:.2} s: {:.1}x real time",
+                report.robots,
+                report.steps,
+                report.sim_seconds,
+                report.wall_seconds,
+                report.real_time_factor()
+            )?;
+            for f in &report.files {
+                writeln!(text, "  wrote {}", f.display())?;
+            }
+            Ok(())
+        }
+        Command::Check { scenario } => {
+            let sc = Scenario::from_file(&scenario)?;
+            let a = sc.arena_size();
+            writeln!(text, "{}: ok", scenario.display())?;
+            writeln!(
+                text,
+                "  arena {} x {} m, {} s at dt {} s ({} steps), seed {}",
+                a.x,
+                a.y,
+                sc.spec.duration,
+                sc.spec.dt,
+                sc.steps(),
+                sc.spec.seed
+            )?;
+            for p in &sc.spec.pheromones {
+                writeln!(
+                    text,
+                    "  pheromone {:?}: {:?} model, colour {:?}",
+                    p.name, p.model, p.colour
+                )?;
+            }
+            for g in &sc.spec.robots {
+                writeln!(
+                    text,
+                    "  {} robot(s), role {:?}, behaviour {:?}",
+                    g.count, g.role, g.behaviour
+                )?;
+            }
+            Ok(())
+        }
+        Command::Behaviours => {
+            use colcos::sim::behaviour::registry;
+            writeln!(
+                text,
+                "A robot group names one with `behaviour = \"NAME\"` and sets its keys in `params = {{ ... }}`."
+            )?;
+            for (name, about) in registry::list() {
+                writeln!(text, "\n{name}: {about}")?;
+                for p in registry::params(name).unwrap_or_default() {
+                    writeln!(
+                        text,
+                        "  {:18} {:24} default {:6} {}",
+                        p.name, p.ty, p.default, p.meaning
+                    )?;
+                }
+            }
+            Ok(())
+        }
+    }
+}

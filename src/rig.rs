@@ -2,10 +2,11 @@
 //! and the radio link, and the digital twin that plays the rig over the same wire formats.
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use colcos_bridge::calibrate::RigCalibration;
 use colcos_bridge::frames::FrameServer;
 use colcos_bridge::live::{self, LiveOptions};
-use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
-use colcos_bridge::twin::{ByteChannel, PtyChannel, TrackerServer, Twin, UdpChannel};
+use colcos_bridge::swarmcon::HeaderForm;
+use colcos_bridge::twin::{ByteChannel, CameraModel, PtyChannel, TrackerServer, Twin, UdpChannel};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::scenario::Scenario;
 use std::fmt::Write as _;
@@ -80,6 +81,16 @@ pub struct TwinArgs {
     /// Allow serving on addresses other than loopback.
     #[arg(long)]
     pub public: bool,
+    /// See the arena through a modelled overhead camera: `lab` (1.6 m up, a little off centre and
+    /// tilted, markers 3.5 cm high), what `colcos calibrate screen` measures.
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Hold every tracker block back this long, s (plus or minus --tracker-jitter).
+    #[arg(long, default_value_t = 0.0)]
+    pub tracker_delay: f64,
+    /// Uniform jitter of the tracker delay, s.
+    #[arg(long, default_value_t = 0.0)]
+    pub tracker_jitter: f64,
 }
 
 /// A flag that Ctrl-C and SIGTERM set.
@@ -95,7 +106,8 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
     let sc = Scenario::from_file(&args.scenario)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating output directory {}", args.out.display()))?;
-    let opts = SourceOptions::new(FrameTransform::new(sc.arena_size().y as f64));
+    let calibration = RigCalibration::load(&sc)?;
+    let opts = SourceOptions::new(calibration.frame_transform(&sc));
     let source = open_pose_source(&args.tracker, &opts)
         .with_context(|| format!("--tracker {}", args.tracker))?;
     let link =
@@ -177,8 +189,17 @@ pub fn twin(args: TwinArgs, text: &mut String) -> Result<()> {
         "updated" => HeaderForm::Updated,
         other => bail!("--header {other:?}: must be plain, dot or updated"),
     };
-    let tracker = TrackerServer::bind(args.tracker, form)
+    let mut tracker = TrackerServer::bind(args.tracker, form)
         .with_context(|| format!("serving the tracker on {}", args.tracker))?;
+    for (key, v) in [
+        ("delay", args.tracker_delay),
+        ("jitter", args.tracker_jitter),
+    ] {
+        if !(0.0..=1.0).contains(&v) {
+            bail!("--tracker-{key} {v}: must be 0 to 1 s");
+        }
+    }
+    tracker.set_delay(args.tracker_delay, args.tracker_jitter, sc.spec.seed);
     let channel: Box<dyn ByteChannel> = if args.robots == "pty" {
         let pty = PtyChannel::open().context("opening a pseudo-terminal pair")?;
         eprintln!("robots: serial://{}?baud=115200", pty.peer_path());
@@ -201,6 +222,15 @@ pub fn twin(args: TwinArgs, text: &mut String) -> Result<()> {
     };
     eprintln!("tracker: swarmcon://{}", tracker.local_addr());
     let mut twin = Twin::new(&sc, tracker, channel, args.frames)?;
+    match args.camera.as_deref() {
+        None => {}
+        Some("lab") => {
+            let s = sc.spec.screen.size;
+            let camera = CameraModel::lab([s[0] as f64, s[1] as f64]);
+            twin.set_camera(Some(camera), sc.spec.seed);
+        }
+        Some(other) => bail!("--camera {other:?}: the camera models are: lab"),
+    }
     let stop = stop_on_signal()?;
     twin.run(args.duration, &stop);
     writeln!(
