@@ -2,8 +2,13 @@
 use crate::error::{Result, SimError};
 use crate::field::{FieldModel, FrozenSources, GridSampler, NearbyPoints, Pheromone};
 use glam::Vec2;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+
+mod expand;
+mod render;
+mod rows;
+mod simd;
+pub use render::{Instructions, ScreenRenderer};
 
 /// The display panel: resolution in pixels and physical size in metres. Pixel row 0 is at the top
 /// (`y = height`), as in images.
@@ -214,83 +219,33 @@ pub fn levels_at_portable<const N: usize>(
 ///
 /// Pixel `(px, row)` samples the fields at the centre of that pixel of a `width x height` grid stretched
 /// over the panel; row 0 is the top (`y = height`). Grid fields are resampled bilinearly (the same as
-/// [`crate::field::GridField::value_at`], with the horizontal weights computed once per image).
+/// [`crate::field::GridField::value_at`], bit for bit), Gaussian fields exactly per pixel. See
+/// [`render_into`] to reuse the image, and [`ScreenRenderer`] for how it is fast.
 pub fn render(
     pheromones: &[Pheromone],
     screen: &ScreenSpec,
     width: u32,
     height: u32,
 ) -> image::RgbImage {
-    let (w, h) = (width as usize, height as usize);
-    let mut img = image::RgbImage::new(width, height);
-    if w == 0 || h == 0 {
-        return img;
+    with_renderer(|r| r.render(pheromones, screen, width, height))
+}
+
+/// [`render`] into an existing image, at its size: no allocation once the calling thread has drawn
+/// at that size (each thread keeps a [`ScreenRenderer`] with its tables and buffers).
+pub fn render_into(pheromones: &[Pheromone], screen: &ScreenSpec, img: &mut image::RgbImage) {
+    with_renderer(|r| r.render_into(pheromones, screen, img))
+}
+
+/// Runs `f` with this thread's kept renderer.
+fn with_renderer<T>(f: impl FnOnce(&mut ScreenRenderer) -> T) -> T {
+    thread_local! {
+        static RENDERER: std::cell::RefCell<ScreenRenderer> = Default::default();
     }
-    let px = screen.size[0] / w as f32;
-    let py = screen.size[1] / h as f32;
-    let xs: Vec<f32> = (0..w).map(|i| (i as f32 + 0.5) * px).collect();
-    // Horizontal interpolation tables of the grid fields.
-    let tables: Vec<Option<Vec<(u32, u32, f32)>>> = pheromones
-        .iter()
-        .map(|ph| match &ph.model {
-            FieldModel::Grid(g) => {
-                let s = g.spec();
-                Some(
-                    xs.iter()
-                        .map(|&x| {
-                            let (i0, i1, t) = crate::field::lerp_index(x / s.cell - 0.5, s.nx);
-                            (i0 as u32, i1 as u32, t)
-                        })
-                        .collect(),
-                )
-            }
-            FieldModel::Gaussian(_) => None,
-        })
-        .collect();
-    let render_row = |(row, out): (usize, &mut [u8])| {
-        let y = (h - 1 - row) as f32 * py + 0.5 * py;
-        let mut acc = vec![[0f32; 3]; w];
-        let mut vals = vec![0f32; w];
-        for (ph, table) in pheromones.iter().zip(&tables) {
-            match (&ph.model, table) {
-                (FieldModel::Grid(g), Some(table)) => {
-                    let s = g.spec();
-                    let (j0, j1, ty) = crate::field::lerp_index(y / s.cell - 0.5, s.ny);
-                    let v = g.values();
-                    let lo = &v[j0 * s.nx..(j0 + 1) * s.nx];
-                    let hi = &v[j1 * s.nx..(j1 + 1) * s.nx];
-                    for (o, &(i0, i1, tx)) in vals.iter_mut().zip(table) {
-                        let (i0, i1) = (i0 as usize, i1 as usize);
-                        let a = lo[i0] + (lo[i1] - lo[i0]) * tx;
-                        let b = hi[i0] + (hi[i1] - hi[i0]) * tx;
-                        *o = a + (b - a) * ty;
-                    }
-                }
-                _ => {
-                    for (o, &x) in vals.iter_mut().zip(&xs) {
-                        *o = ph.value_at(Vec2::new(x, y));
-                    }
-                }
-            }
-            for (a, &v) in acc.iter_mut().zip(&vals) {
-                for (a, k) in a.iter_mut().zip(ph.colour) {
-                    *a += k * v;
-                }
-            }
-        }
-        for (o, a) in out.chunks_exact_mut(3).zip(&acc) {
-            o[0] = to_level(a[0]);
-            o[1] = to_level(a[1]);
-            o[2] = to_level(a[2]);
-        }
-    };
-    let buf: &mut [u8] = &mut img;
-    if w * h >= 1 << 16 {
-        buf.par_chunks_mut(3 * w).enumerate().for_each(render_row);
-    } else {
-        buf.chunks_mut(3 * w).enumerate().for_each(render_row);
-    }
-    img
+    RENDERER.with(|r| match r.try_borrow_mut() {
+        Ok(mut r) => f(&mut r),
+        // Drawing again on this thread while it draws (a rayon task stolen during the first).
+        Err(_) => f(&mut ScreenRenderer::new()),
+    })
 }
 
 /// Writes an image as PNG.
