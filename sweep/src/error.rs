@@ -40,6 +40,11 @@ pub enum SweepError {
          choose another output directory or delete {dir}/results.csv to start again"
     )]
     OtherSweep { dir: String },
+    /// Another process is writing the same table.
+    #[error(
+        "another sweep is writing {path}: wait for it to end, or choose another output directory"
+    )]
+    Busy { path: String },
     /// `resume` was asked for but there is nothing to resume.
     #[error("nothing to resume: {path} does not exist")]
     NothingToResume { path: String },

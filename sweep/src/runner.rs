@@ -149,7 +149,14 @@ pub struct SweepReport {
 /// Checks every combination, then runs what the table in `out_dir` does not yet hold.
 pub fn run_sweep(plan: &Plan, out_dir: &Path, opts: SweepOptions<'_>) -> Result<SweepReport> {
     let started = Instant::now();
-    let scenarios = plan.check_all()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| SweepError::Run {
+            id: 0,
+            message: format!("starting the thread pool: {e}"),
+        })?;
+    let scenarios = pool.install(|| plan.check_all())?;
     let table = ResultsTable::open(out_dir, plan, opts.resume)?;
     let skipped = table.done().len() as u64;
     let pending: Vec<u64> = (0..plan.total())
@@ -159,13 +166,6 @@ pub fn run_sweep(plan: &Plan, out_dir: &Path, opts: SweepOptions<'_>) -> Result<
     let done = AtomicU64::new(skipped);
     let ran = AtomicU64::new(0);
     let table = Mutex::new(table);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| SweepError::Run {
-            id: 0,
-            message: format!("starting the thread pool: {e}"),
-        })?;
     if let Some(f) = opts.on_row {
         f(skipped, total);
     }

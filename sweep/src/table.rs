@@ -63,17 +63,22 @@ impl ResultsTable {
                 }
             }
         }
+        let mut file = OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .map_err(|e| SweepError::io(format!("opening {}", path.display()), e))?;
+        // One writer per table: a second sweep into the same directory would run the same rows twice.
+        // The lock goes with the process, however it ends.
+        file.try_lock().map_err(|_| SweepError::Busy {
+            path: path.display().to_string(),
+        })?;
         write_plan(&plan_path, plan)?;
         let (rows, keep) = if exists {
             read_rows(&path, plan)?
         } else {
             (BTreeMap::new(), None)
         };
-        let mut file = OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&path)
-            .map_err(|e| SweepError::io(format!("opening {}", path.display()), e))?;
         match keep {
             // Drop a torn last line (and anything after the last complete row).
             Some(len) => file

@@ -155,3 +155,15 @@ food_points = [3, 10]
         assert_eq!(r.metrics, [Some(1.0), Some(1.0), Some(0.0)], "run {}", r.id);
     }
 }
+
+#[test]
+fn a_table_being_written_is_not_opened_twice() {
+    let plan = tiny();
+    let tmp = tempfile::tempdir().unwrap();
+    let open = colcos_sweep::ResultsTable::open(tmp.path(), &plan, false).unwrap();
+    let e = run_sweep(&plan, tmp.path(), SweepOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("another sweep is writing"), "{e}");
+    drop(open);
+    let report = run_sweep(&plan, tmp.path(), SweepOptions::default()).unwrap();
+    assert_eq!(report.ran, 8);
+}
