@@ -293,6 +293,6 @@ mod tests {
         assert!(parse_pair("0.7").unwrap_err().contains("X,Y"));
         assert_eq!(parse_grid("6x4").unwrap(), [6, 4]);
         assert!(parse_grid("0x4").unwrap_err().contains("1..=40"));
-        assert!(parse_grid("six").unwrap_err().contains("COLUMNSxROWS"));
+        assert!(parse_grid("6by4").unwrap_err().contains("COLUMNSxROWS"));
     }
 }
