@@ -8,6 +8,55 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
+/// Most frames in a run's GIF.
+pub const MAX_GIF_FRAMES: u64 = 1_000;
+/// Most pixels in a run's GIF, all frames together (about 300 MB of frames before compression).
+pub const MAX_GIF_PIXELS: u64 = 300_000_000;
+
+/// Which ticks a run's GIF shows. One frame per `gif_interval`, unless that makes more than
+/// [`MAX_GIF_FRAMES`] frames or more than [`MAX_GIF_PIXELS`] pixels in all: then a frame every
+/// `thinned` intervals, `thinned` the smallest whole number that fits, each frame shown that much
+/// longer so the GIF still plays in real time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GifPlan {
+    /// Ticks between frames (a frame at tick 0 and at every multiple of it).
+    pub every: u64,
+    /// Simulated seconds between frames.
+    pub interval: f32,
+    /// How many `gif_interval`s one frame stands for (1: none thinned out).
+    pub thinned: u64,
+    /// Frames in a run of all its steps.
+    pub frames: u64,
+}
+
+impl GifPlan {
+    /// The plan for `steps` ticks of `dt` s with frames `width x height` px every `interval` s.
+    pub fn new(steps: u64, dt: f32, interval: f32, width: u32, height: u32) -> GifPlan {
+        let base = ((interval / dt).round() as u64).max(1);
+        let pixels = (u64::from(width) * u64::from(height)).max(1);
+        let cap = MAX_GIF_FRAMES.min(MAX_GIF_PIXELS / pixels).max(2);
+        let wanted = steps / base + 1;
+        let thinned = if wanted > cap {
+            (wanted - 1).div_ceil(cap - 1)
+        } else {
+            1
+        };
+        let every = base.saturating_mul(thinned);
+        GifPlan {
+            every,
+            // To the microsecond: `every x dt` in f32 would print as 2.6000001.
+            interval: ((every as f64 * f64::from(dt) * 1e6).round() / 1e6) as f32,
+            thinned,
+            frames: steps / every + 1,
+        }
+    }
+}
+
+/// The height of a GIF frame `width` pixels wide, from the screen's aspect ratio.
+pub fn frame_height(screen: &crate::screen::ScreenSpec, width: u32) -> u32 {
+    ((width as f32 * screen.size[1] / screen.size[0]).round() as u32).max(1)
+}
+
 pub struct GifRecorder {
     encoder: GifEncoder<BufWriter<File>>,
     path: String,
@@ -17,13 +66,12 @@ pub struct GifRecorder {
 }
 
 impl GifRecorder {
-    /// A GIF `width` pixels wide (height from the screen's aspect ratio) with one frame per
-    /// `interval` seconds of simulated time, played back in real time.
+    /// A GIF `width` pixels wide (height from the screen's aspect ratio, [`frame_height`]) with one
+    /// frame per `interval` seconds of simulated time, played back in real time.
     pub fn create(path: &Path, world: &World, width: u32, interval: f32) -> Result<Self> {
         let file = File::create(path)
             .map_err(|e| SimError::io(format!("creating {}", path.display()), e))?;
-        let s = world.screen();
-        let height = ((width as f32 * s.size[1] / s.size[0]).round() as u32).max(1);
+        let height = frame_height(world.screen(), width);
         let mut encoder = GifEncoder::new_with_speed(BufWriter::new(file), 20);
         encoder
             .set_repeat(Repeat::Infinite)
@@ -83,4 +131,41 @@ pub fn role_colour(role: &str) -> Rgb<u8> {
         [255, 190, 120],
     ];
     Rgb(palette[(h as usize) % palette.len()])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_short_run_keeps_every_interval() {
+        let p = GifPlan::new(300, 0.02, 0.2, 480, 270);
+        assert_eq!((p.every, p.thinned, p.frames), (10, 1, 31));
+        assert!((p.interval - 0.2).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_long_run_is_thinned_to_the_frame_limit_and_plays_in_real_time() {
+        // Ten hours at 50 Hz, a frame every 0.2 s: 180,001 frames wanted.
+        let steps = 10 * 3600 * 50;
+        let p = GifPlan::new(steps, 0.02, 0.2, 480, 270);
+        assert!(p.frames <= MAX_GIF_FRAMES, "{p:?}");
+        assert!(
+            p.frames > MAX_GIF_FRAMES / 2,
+            "thinned no more than needed: {p:?}"
+        );
+        assert_eq!(p.every, 10 * p.thinned);
+        assert!((p.interval - 0.2 * p.thinned as f32).abs() < 1e-3);
+        // The smallest factor that fits: one less would not.
+        assert!(steps / (10 * (p.thinned - 1)) + 1 > MAX_GIF_FRAMES);
+    }
+
+    #[test]
+    fn large_frames_lower_the_frame_limit() {
+        let p = GifPlan::new(30_000, 0.02, 0.02, 7_680, 4_320);
+        assert!(p.frames * 7_680 * 4_320 <= MAX_GIF_PIXELS, "{p:?}");
+        assert!(p.frames >= 2);
+        // A frame every tick of a one-tick run stays as it is.
+        assert_eq!(GifPlan::new(1, 0.02, 0.02, 7_680, 4_320).frames, 2);
+    }
 }

@@ -9,6 +9,7 @@ mod summary;
 
 use crate::error::SimError;
 use crate::field::{BackendChoice, FieldModel, GridSpec};
+use crate::output::gif::{self, GifPlan};
 use crate::output::{GifRecorder, TrajectoryLog, npy};
 use crate::scenario::Scenario;
 use crate::screen;
@@ -45,6 +46,11 @@ pub struct RunReport {
     pub sim_seconds: f32,
     /// Wall time of the steps alone, s.
     pub wall_seconds: f64,
+    /// Wall time of the whole run, s: building the world, the steps, the log, the GIF and every
+    /// output file (what the user waited for).
+    pub total_wall_seconds: f64,
+    /// Which ticks the GIF shows (`None`: no GIF written).
+    pub gif: Option<GifPlan>,
     pub files: Vec<PathBuf>,
     /// The field backend that stepped the grids (`cpu (...)` or `gpu: <adapter>`).
     pub backend: String,
@@ -56,6 +62,11 @@ impl RunReport {
     /// Simulated seconds per wall-clock second (steps only, not the final files).
     pub fn real_time_factor(&self) -> f64 {
         self.sim_seconds as f64 / self.wall_seconds.max(1e-9)
+    }
+
+    /// Simulated seconds per wall-clock second of the whole run ([`RunReport::total_wall_seconds`]).
+    pub fn overall_real_time_factor(&self) -> f64 {
+        self.sim_seconds as f64 / self.total_wall_seconds.max(1e-9)
     }
 }
 
@@ -84,6 +95,8 @@ pub fn run(
         mut on_step,
         stop,
     } = opts;
+    // What the user waits for: from here to the last file written.
+    let started = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|e| {
         SimError::io(
             format!("creating output directory {}", out_dir.display()),
@@ -110,25 +123,43 @@ pub fn run(
     log.record(&world)?;
 
     let out = &scenario.spec.output;
+    let steps = scenario.steps();
     let gif_path = out_dir.join("run.gif");
-    let mut gif = if out.gif_interval > 0.0 && !no_gif {
-        Some(GifRecorder::create(
-            &gif_path,
-            &world,
-            out.gif_width,
+    let gif_plan = (out.gif_interval > 0.0 && !no_gif).then(|| {
+        let height = gif::frame_height(world.screen(), out.gif_width);
+        GifPlan::new(
+            steps,
+            scenario.spec.dt,
             out.gif_interval,
-        )?)
-    } else {
-        None
+            out.gif_width,
+            height,
+        )
+    });
+    let mut gif = match &gif_plan {
+        Some(plan) => {
+            if plan.thinned > 1 {
+                log::info!(
+                    "run.gif: a frame every {} s (every {} of `gif_interval`), {} frames in all",
+                    plan.interval,
+                    plan.thinned,
+                    plan.frames
+                );
+            }
+            Some(GifRecorder::create(
+                &gif_path,
+                &world,
+                out.gif_width,
+                plan.interval,
+            )?)
+        }
+        None => None,
     };
-    let gif_every = ((out.gif_interval / scenario.spec.dt).round() as u64).max(1);
+    let gif_every = gif_plan.map_or(1, |p| p.every);
     if let Some(g) = gif.as_mut() {
         g.frame(&world)?;
         files.push(gif_path);
     }
 
-    let steps = scenario.steps();
-    let started = Instant::now();
     let mut stepping = 0.0f64;
     let mut done_steps = 0;
     for done in 1..=steps {
@@ -168,12 +199,16 @@ pub fn run(
         robots: world.robot_count(),
         sim_seconds: world.time(),
         wall_seconds: stepping,
+        total_wall_seconds: 0.0,
+        gif: gif_plan,
         files,
         backend,
     };
     let summary = out_dir.join("summary.json");
-    summary::write(&summary, scenario, &report, started.elapsed().as_secs_f64())?;
+    report.total_wall_seconds = started.elapsed().as_secs_f64();
+    summary::write(&summary, scenario, &report)?;
     report.files.push(summary);
+    report.total_wall_seconds = started.elapsed().as_secs_f64();
     Ok(report)
 }
 
@@ -329,6 +364,35 @@ mod tests {
             std::fs::read(out.path().join("trajectory.csv")).unwrap(),
             std::fs::read(again.path().join("trajectory.csv")).unwrap()
         );
+    }
+
+    /// A run longer than the GIF's frame limit gets a frame every few intervals, and says so.
+    #[test]
+    fn a_long_runs_gif_is_thinned_to_the_frame_limit() {
+        use image::AnimationDecoder;
+        let text = "duration = 25.0\n[screen]\nsize = [0.3, 0.2]\nresolution = [300, 200]\n\
+                    [field]\ncell = 0.02\n[output]\ngif_interval = 0.02\ngif_width = 30\n\
+                    [[robots]]\ncount = 2\nbehaviour = \"avoid\"\n";
+        let sc = Scenario::from_toml_str(text, ".").unwrap();
+        let out = tempfile::tempdir().unwrap();
+        let report = run(&sc, out.path(), RunOptions::default()).unwrap();
+        // 1,251 frames wanted (one a tick): every second tick fits the 1,000 frame limit.
+        let plan = report.gif.unwrap();
+        assert_eq!((plan.every, plan.thinned, plan.frames), (2, 2, 626));
+        let file = std::fs::File::open(out.path().join("run.gif")).unwrap();
+        let frames = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(file))
+            .unwrap()
+            .into_frames()
+            .collect_frames()
+            .unwrap();
+        assert_eq!(frames.len() as u64, plan.frames);
+        // Each frame is shown for the two ticks it stands for: the GIF plays in real time.
+        let (n, d) = frames[1].delay().numer_denom_ms();
+        assert_eq!(n / d, 40);
+        let summary = std::fs::read_to_string(out.path().join("summary.json")).unwrap();
+        assert!(summary.contains("\"gif_interval\": 0.04,"), "{summary}");
+        assert!(summary.contains("\"gif_thinned\": 2,"), "{summary}");
+        assert!(report.total_wall_seconds >= report.wall_seconds);
     }
 
     #[test]
