@@ -26,7 +26,7 @@ enum Command {
     Run {
         /// Scenario file (TOML).
         scenario: PathBuf,
-        /// Output directory [default: runs/<scenario name>].
+        /// Output directory [default: runs/<scenario file name without .toml>].
         #[arg(long)]
         out: Option<PathBuf>,
         /// Override the scenario's seed.
@@ -73,14 +73,29 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    colcos::run::quiet_wayland_probe();
     init_logging();
     match real_main() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes on one line, each cause once: a library error that already ends with its
+/// cause (`reading scenario x.toml: No such file ...`) does not get it again.
+fn error_text(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1) {
+        let c = cause.to_string();
+        if !text.ends_with(&c) {
+            text.push_str(": ");
+            text.push_str(&c);
+        }
+    }
+    text
 }
 
 /// The libraries report through the `log` crate; their messages reach the terminal (stderr) at info
@@ -158,13 +173,12 @@ fn run_command(command: Command, text: &mut String) -> Result<()> {
             writeln!(text, "field backend: {}", report.backend)?;
             writeln!(
                 text,
-                "{} robots, {} steps ({} s simulated) in {:.2} s: {:.1}x real time",
+                "{} robots, {} steps ({:.2} s simulated) in {:.2} s: {:.1}x real time",
                 report.robots,
                 report.steps,
                 report.sim_seconds,
-                // The whole run (world build, log, GIF, files): what the user waited for.
-                report.total_wall_seconds,
-                report.overall_real_time_factor()
+                report.wall_seconds,
+                report.real_time_factor()
             )?;
             for f in &report.files {
                 writeln!(text, "  wrote {}", f.display())?;

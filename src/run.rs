@@ -60,3 +60,27 @@ fn progress_bar(steps: u64) -> indicatif::ProgressBar {
     );
     bar
 }
+
+/// Gives libwayland an empty private runtime directory when `XDG_RUNTIME_DIR` is unset or not an
+/// absolute path. GPU drivers' EGL probes for a Wayland compositor on every GPU run, and libwayland
+/// then prints "XDG_RUNTIME_DIR is invalid or not set in the environment" (ssh sessions, containers)
+/// although no window is wanted; in an empty directory the probe finds no socket and stays silent.
+/// A session's own valid value is kept. Call it first in `main`, before any thread starts: it sets an
+/// environment variable.
+pub fn quiet_wayland_probe() {
+    let valid = std::env::var_os("XDG_RUNTIME_DIR")
+        .is_some_and(|v| Path::new(&v).is_absolute() && Path::new(&v).is_dir());
+    if valid {
+        return;
+    }
+    let user = std::env::var("USER").unwrap_or_default();
+    let dir = std::env::temp_dir().join(format!("colcos-runtime-{user}"));
+    let mut builder = std::fs::DirBuilder::new();
+    builder.recursive(true);
+    #[cfg(unix)]
+    std::os::unix::fs::DirBuilderExt::mode(&mut builder, 0o700);
+    if builder.create(&dir).is_ok() && dir.is_absolute() {
+        // SAFETY: called at the start of `main`, before any other thread exists.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+    }
+}

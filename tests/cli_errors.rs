@@ -203,3 +203,134 @@ fn a_second_run_into_the_same_directory_replaces_the_first() {
         "mine"
     );
 }
+
+/// The error is printed once, on one line per cause, and says `needle` exactly once.
+#[track_caller]
+fn assert_says_once(args: &[&str], needles: &[&str], never: &[&str]) {
+    let out = colcos(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert_eq!(stderr.matches("error:").count(), 1, "{stderr}");
+    for n in needles {
+        assert_eq!(stderr.matches(n).count(), 1, "{n:?} in {stderr:?}");
+    }
+    for n in never {
+        assert!(!stderr.contains(n), "{n:?} in {stderr:?}");
+    }
+}
+
+/// Scenario mistakes a first scenario makes name the key the file wrote and its value, once.
+#[test]
+fn scenario_errors_name_the_key_and_value_the_file_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let with = |name: &str, from: &str, to: &str| write(dir.path(), name, &GOOD.replace(from, to));
+    // A behaviour parameter of the wrong type: its value, not a placeholder.
+    let params = with(
+        "params.toml",
+        "behaviour = \"avoid\"",
+        "behaviour = \"avoid\"\nparams = { speed = \"fast\" }",
+    );
+    assert_says_once(
+        &["check", &params],
+        &["`robots[0].params.speed` = \"fast\"", "expected f32"],
+        &["see message", "in `speed`"],
+    );
+    // A kernel's size: the key is the kernel's `radius`.
+    let kernel = with(
+        "kernel.toml",
+        "behaviour = \"avoid\"",
+        "behaviour = \"avoid\"\ndeposits = [{ pheromone = \"trail\", kernel = { shape = \"disc\", radius = -0.01 }, rate = 1.0 }]",
+    );
+    assert_says_once(
+        &["check", &kernel],
+        &["`robots[0].deposits[0].kernel.radius` = -0.01"],
+        &[],
+    );
+    // The screen's size is the screen's, even where the arena takes it.
+    let screen = with(
+        "screen.toml",
+        "[output]",
+        "[screen]\nsize = [-1.0, 0.8]\n[output]",
+    );
+    assert_says_once(&["check", &screen], &["`screen.size[0]` = -1"], &["arena"]);
+    let arena = with(
+        "arena.toml",
+        "[output]",
+        "[arena]\nsize = [1.0, 0.0]\n[output]",
+    );
+    assert_says_once(&["check", &arena], &["`arena.size[1]` = 0"], &[]);
+    // A heading that is not a number is a heading error, not a position one.
+    let heading = with(
+        "heading.toml",
+        "count = 3",
+        "count = 1\nplacement = \"explicit\"\nposes = [[0.5, 0.5, nan]]",
+    );
+    assert_says_once(
+        &["check", &heading],
+        &["`robots[0].poses[0][2]` = NaN", "heading"],
+        &["not inside the arena"],
+    );
+    let outside = with(
+        "outside.toml",
+        "count = 3",
+        "count = 1\nplacement = \"explicit\"\nposes = [[5.0, 0.5, 0.0]]",
+    );
+    assert_says_once(
+        &[
+            "run",
+            &outside,
+            "--quiet",
+            "--out",
+            dir.path().join("o").to_str().unwrap(),
+        ],
+        &[
+            "`robots[0].poses[0]`",
+            "not inside the arena: x must be in [0.02, ",
+        ],
+        &[],
+    );
+}
+
+/// A missing scenario file: the OS's reason once, not once per layer of the error.
+#[test]
+fn a_missing_file_is_reported_once() {
+    assert_says_once(
+        &["run", "no/such/scenario.toml", "--quiet"],
+        &["no/such/scenario.toml", "(os error 2)"],
+        &[],
+    );
+    assert_says_once(&["check", "no/such/scenario.toml"], &["(os error 2)"], &[]);
+}
+
+/// `--help` says what the default output directory is named after: the file, not the `name` key.
+#[test]
+fn run_help_says_the_default_out_uses_the_file_name() {
+    let out = colcos(&["run", "--help"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        text.contains("runs/<scenario file name without .toml>"),
+        "{text}"
+    );
+}
+
+/// A run's report prints the simulated time rounded, and a GPU-capable run prints no libwayland
+/// complaint when `XDG_RUNTIME_DIR` is unset (GPU drivers probe for Wayland through it).
+#[test]
+fn a_run_reports_cleanly_without_xdg_runtime_dir() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "good.toml", GOOD);
+    let out = Command::new(env!("CARGO_BIN_EXE_colcos"))
+        .args(["run", &file, "--backend", "auto", "--out"])
+        .arg(dir.path().join("o"))
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("(0.10 s simulated)"), "{stdout}");
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+}

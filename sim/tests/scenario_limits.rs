@@ -211,7 +211,7 @@ fn work_and_memory_are_bounded() {
                  deposits = [{ pheromone = \"trail\", kernel = { shape = \"disc\", radius = 1.0 }, rate = 1 }]"
             )
         ),
-        &["robots[0].deposits[0].kernel", "1e9"],
+        &["`robots[0].deposits[0].kernel.radius` = 1:", "1e9"],
     );
     // Every robot senses every source: 40,000 robots each emitting one is 1.6e9 pairs a step.
     let emitters = r#"

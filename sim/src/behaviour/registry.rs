@@ -139,17 +139,33 @@ pub fn build_with(
     }
 }
 
-/// Deserialises a behaviour's `params` table, naming the key at fault.
+/// Deserialises a behaviour's `params` table, naming the key at fault and its value.
 pub fn parse_params<T: DeserializeOwned>(params: &toml::Table, key: &str) -> Result<T> {
     let value = toml::Value::Table(params.clone());
-    serde_path_to_error::deserialize(value).map_err(|e| {
+    serde_path_to_error::deserialize(value.clone()).map_err(|e| {
         let path = e.path().to_string();
         let at = if path == "." {
             format!("{key}.params")
         } else {
             format!("{key}.params.{path}")
         };
-        SimError::invalid(at, "(see message)", e.into_inner().to_string())
+        // The value at the path as the file wrote it (the whole table for a missing or unknown key).
+        let mut shown = &value;
+        for seg in e.path().iter() {
+            let next = match seg {
+                serde_path_to_error::Segment::Map { key } => shown.get(key.as_str()),
+                serde_path_to_error::Segment::Seq { index } => shown.get(*index),
+                _ => None,
+            };
+            match next {
+                Some(v) => shown = v,
+                None => break,
+            }
+        }
+        // toml's message repeats the path on a second line (`in \`speed\``): the key says it.
+        let reason = e.into_inner().to_string();
+        let reason = reason.lines().next().unwrap_or_default().trim().to_string();
+        SimError::invalid(at, shown, reason)
     })
 }
 

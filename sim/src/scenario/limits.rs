@@ -194,9 +194,14 @@ pub(super) fn check_step_work(sc: &Scenario, grid: &GridSpec) -> Result<()> {
             let support = dep.kernel.support();
             cells += group.count as f64 * side(support, grid.nx) * side(support, grid.ny);
             if cells > MAX_DEPOSIT_CELLS {
+                let (name, size) = match dep.kernel {
+                    crate::field::Kernel::Disc { radius }
+                    | crate::field::Kernel::Cone { radius } => ("radius", radius),
+                    crate::field::Kernel::Gaussian { sigma } => ("sigma", sigma),
+                };
                 return Err(SimError::invalid(
-                    format!("robots[{g}].deposits[{d}].kernel"),
-                    format!("{:?}", dep.kernel),
+                    format!("robots[{g}].deposits[{d}].kernel.{name}"),
+                    size,
                     format!(
                         "the deposits would touch {cells:.0} cells a step, more than {MAX_DEPOSIT_CELLS:.0e}"
                     ),

@@ -49,9 +49,14 @@ pub(super) fn validate(sc: &Scenario) -> Result<()> {
             "more than 1e9 steps",
         ));
     }
-    let arena = sc.arena_size();
-    positive("arena.size[0]", arena.x)?;
-    positive("arena.size[1]", arena.y)?;
+    // The screen first: without `arena.size` the arena is the screen, and its errors name the key
+    // the file set.
+    positive("screen.size[0]", s.screen.size[0])?;
+    positive("screen.size[1]", s.screen.size[1])?;
+    if let Some(size) = s.arena.size {
+        positive("arena.size[0]", size[0])?;
+        positive("arena.size[1]", size[1])?;
+    }
     for (i, r) in s.screen.resolution.iter().enumerate() {
         if *r == 0 || *r > 65536 {
             return Err(SimError::invalid(
@@ -61,8 +66,6 @@ pub(super) fn validate(sc: &Scenario) -> Result<()> {
             ));
         }
     }
-    positive("screen.size[0]", s.screen.size[0])?;
-    positive("screen.size[1]", s.screen.size[1])?;
     let grid = validate_field(sc)?;
     validate_robot_params(sc)?;
     validate_pheromones(sc, &grid)?;
@@ -429,16 +432,22 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
                 ));
             }
             for (n, p) in group.poses.iter().enumerate() {
-                if !(p[0] >= r
-                    && p[0] <= arena.x - r
-                    && p[1] >= r
-                    && p[1] <= arena.y - r
-                    && p[2].is_finite())
-                {
+                if !p[2].is_finite() {
+                    return Err(SimError::invalid(
+                        format!("robots[{g}].poses[{n}][2]"),
+                        p[2],
+                        "the heading must be a finite number of degrees",
+                    ));
+                }
+                if !(p[0] >= r && p[0] <= arena.x - r && p[1] >= r && p[1] <= arena.y - r) {
                     return Err(SimError::invalid(
                         format!("robots[{g}].poses[{n}]"),
                         format!("{p:?}"),
-                        "the robot is not inside the arena",
+                        format!(
+                            "the robot (radius {r} m) is not inside the arena: x must be in [{r}, {}], y in [{r}, {}] m",
+                            arena.x - r,
+                            arena.y - r
+                        ),
                     ));
                 }
             }
@@ -460,13 +469,13 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
                 ));
             }
             non_negative(&format!("{key}.rate"), dep.rate)?;
-            let size = match dep.kernel {
+            let (name, size) = match dep.kernel {
                 crate::field::Kernel::Disc { radius } | crate::field::Kernel::Cone { radius } => {
-                    radius
+                    ("radius", radius)
                 }
-                crate::field::Kernel::Gaussian { sigma } => sigma,
+                crate::field::Kernel::Gaussian { sigma } => ("sigma", sigma),
             };
-            positive(&format!("{key}.kernel"), size)?;
+            positive(&format!("{key}.kernel.{name}"), size)?;
         }
         for (e, emit) in group.emits.iter().enumerate() {
             let key = format!("robots[{g}].emits[{e}]");
