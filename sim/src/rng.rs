@@ -33,6 +33,8 @@ pub enum Stream {
     Baseline(usize),
     /// The noise of robot `i`'s telemetry readings in a digital twin.
     Telemetry(usize),
+    /// The world's draws of its `[randomize]` ranges.
+    Randomize,
 }
 
 impl Stream {
@@ -43,6 +45,8 @@ impl Stream {
     const BASELINE0: u64 = 1 << 40;
     /// First id of the twin's telemetry streams.
     const TELEMETRY0: u64 = 1 << 41;
+    /// The domain randomisation's stream.
+    const RANDOMIZE: u64 = 1 << 42;
 
     /// The stream's id under [`stream`].
     pub fn id(self) -> u64 {
@@ -53,6 +57,7 @@ impl Stream {
             Stream::Scripted(i) => Self::SCRIPTED0 + i as u64,
             Stream::Baseline(i) => Self::BASELINE0 + i as u64,
             Stream::Telemetry(i) => Self::TELEMETRY0 + i as u64,
+            Stream::Randomize => Self::RANDOMIZE,
         }
     }
 }
@@ -175,6 +180,7 @@ mod tests {
         assert!(last_robot < Stream::Scripted(0).id());
         assert!(Stream::Scripted(1 << 30).id() < Stream::Baseline(0).id());
         assert!(Stream::Baseline(1 << 30).id() < Stream::Telemetry(0).id());
+        assert!(Stream::Telemetry(1 << 30).id() < Stream::Randomize.id());
         assert_eq!(Stream::Placement.id(), 0);
         assert_eq!(Stream::Tracker.id(), 1);
         assert_eq!(Stream::Robot(0).id(), 2);

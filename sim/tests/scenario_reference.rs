@@ -111,6 +111,15 @@ tracker_silence = 0.2
 pose_age = 0.4
 policy_stall = 0.3
 shield = { max_wheel_speed = 0.3, margin = 0.04, horizon = 0.2 }
+
+[randomize]
+tracker_latency = [0.03, 0.08]
+position_noise = [0.0, 0.003]
+heading_noise = [0.0, 0.05]
+sensor_gain = [0.8, 1.2]
+crosstalk = [0.0, 0.05]
+motor_lag = [0.02, 0.1]
+max_wheel_speed = [0.2, 0.3]
 "#;
 
 /// One step from the root to a nested table.

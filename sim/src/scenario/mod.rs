@@ -4,6 +4,7 @@
 mod builder;
 mod limits;
 pub(crate) mod placement;
+mod randomize;
 mod rig;
 mod spec;
 mod validate;
@@ -14,6 +15,7 @@ pub use limits::{
     MAX_POLYLINE_POINTS, MAX_POSES_IN_FLIGHT, MAX_ROBOTS, MAX_SOURCE_PAIRS, MAX_SUBSTEPS,
     MAX_TRACKER_LATENCY, MAX_TRACKER_RATE_HZ,
 };
+pub use randomize::RandomizeSpec;
 pub use rig::{BROADCAST_ID, Firmware, RigSpec, SensorSource};
 pub use spec::*;
 

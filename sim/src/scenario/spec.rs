@@ -49,6 +49,12 @@ pub struct ScenarioSpec {
     /// How the scenario runs on the lab's hardware (`colcos bridge`) and its twin.
     #[serde(default, skip_serializing_if = "super::rig::RigSpec::is_default")]
     pub rig: super::rig::RigSpec,
+    /// Domain randomisation: ranges some parameters are drawn from when a world is built.
+    #[serde(
+        default,
+        skip_serializing_if = "super::randomize::RandomizeSpec::is_default"
+    )]
+    pub randomize: super::randomize::RandomizeSpec,
 }
 
 fn default_dt() -> f32 {

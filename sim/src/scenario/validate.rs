@@ -71,6 +71,7 @@ pub(super) fn validate(sc: &Scenario) -> Result<()> {
     validate_pheromones(sc, &grid)?;
     validate_robots(sc)?;
     s.rig.validate(sc.robot_count())?;
+    s.randomize.validate()?;
     Ok(())
 }
 

@@ -36,6 +36,17 @@ impl World {
     /// A world for `scenario` whose random streams derive from `(seed, world_index)`: the worlds of a
     /// batch differ, and none depends on how many threads step them.
     pub fn with_index(scenario: &Scenario, world_index: u64) -> Result<World> {
+        // Domain randomisation: this world's own draw of the `[randomize]` ranges.
+        let drawn;
+        let scenario = if scenario.spec.randomize.is_default() {
+            scenario
+        } else {
+            let mut sc = scenario.clone();
+            let mut rng = rng::stream_of(sc.spec.seed, world_index, Stream::Randomize);
+            scenario.spec.randomize.apply(&mut sc.spec, &mut rng);
+            drawn = sc;
+            &drawn
+        };
         let spec = &scenario.spec;
         let arena = scenario.arena_size();
         let parts = WorldParts::build(scenario, world_index)?;

@@ -1,0 +1,103 @@
+//! The `[randomize]` section: domain randomisation. Each key is a range `[low, high]` that a world draws
+//! its value from, uniformly, once when it is built (every episode of a batched environment draws
+//! anew), so that a policy trained on the simulator meets rigs whose numbers differ from the defaults:
+//! latency, pose noise, sensor gain and crosstalk, motor lag, wheel-speed limit. Centre the ranges on
+//! the rig's calibrated values.
+use super::spec::ScenarioSpec;
+use crate::error::{Result, SimError};
+use crate::rng::SimRng;
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RandomizeSpec {
+    /// `[tracker] latency`, s.
+    pub tracker_latency: Option<[f32; 2]>,
+    /// `[tracker] position_noise`, m.
+    pub position_noise: Option<[f32; 2]>,
+    /// `[tracker] heading_noise`, rad.
+    pub heading_noise: Option<[f32; 2]>,
+    /// A factor on `[sensor] gain`.
+    pub sensor_gain: Option<[f32; 2]>,
+    /// Added to each off-diagonal entry of `[sensor] crosstalk` (each drawn on its own).
+    pub crosstalk: Option<[f32; 2]>,
+    /// `[robot] motor_lag`, s.
+    pub motor_lag: Option<[f32; 2]>,
+    /// `[robot] max_wheel_speed`, m/s.
+    pub max_wheel_speed: Option<[f32; 2]>,
+}
+
+impl RandomizeSpec {
+    pub fn is_default(&self) -> bool {
+        *self == RandomizeSpec::default()
+    }
+
+    /// Each range finite, `low <= high`, and inside what its key allows.
+    pub fn validate(&self) -> Result<()> {
+        let ranges = [
+            ("tracker_latency", self.tracker_latency, 0.0, 1.0),
+            ("position_noise", self.position_noise, 0.0, 0.1),
+            ("heading_noise", self.heading_noise, 0.0, 1.0),
+            ("sensor_gain", self.sensor_gain, 1e-3, 100.0),
+            ("crosstalk", self.crosstalk, -0.5, 0.5),
+            ("motor_lag", self.motor_lag, 0.0, 1.0),
+            ("max_wheel_speed", self.max_wheel_speed, 1e-3, 2.0),
+        ];
+        for (key, range, lo, hi) in ranges {
+            let Some([a, b]) = range else { continue };
+            let key = format!("randomize.{key}");
+            let show = format!("[{a}, {b}]");
+            if !(a.is_finite() && b.is_finite()) || a > b {
+                return Err(SimError::invalid(
+                    key,
+                    show,
+                    "must be [low, high] with finite low <= high",
+                ));
+            }
+            if a < lo || b > hi {
+                return Err(SimError::invalid(
+                    key,
+                    show,
+                    format!("must lie within [{lo}, {hi}]"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Draws every randomised value into `spec` from `rng`, in a fixed order.
+    pub fn apply(&self, spec: &mut ScenarioSpec, rng: &mut SimRng) {
+        let mut draw =
+            |r: Option<[f32; 2]>| r.map(|[a, b]| if a < b { rng.random_range(a..=b) } else { a });
+        if let Some(v) = draw(self.tracker_latency) {
+            spec.tracker.latency = v;
+        }
+        if let Some(v) = draw(self.position_noise) {
+            spec.tracker.position_noise = v;
+        }
+        if let Some(v) = draw(self.heading_noise) {
+            spec.tracker.heading_noise = v;
+        }
+        if let Some(v) = draw(self.sensor_gain) {
+            spec.sensor.gain *= v;
+        }
+        if self.crosstalk.is_some() {
+            for c in 0..3 {
+                for k in 0..3 {
+                    if c != k
+                        && let Some(v) = draw(self.crosstalk)
+                    {
+                        spec.sensor.crosstalk[c][k] = (spec.sensor.crosstalk[c][k] + v).max(0.0);
+                    }
+                }
+            }
+        }
+        if let Some(v) = draw(self.motor_lag) {
+            spec.robot.motor_lag = v;
+        }
+        if let Some(v) = draw(self.max_wheel_speed) {
+            spec.robot.max_wheel_speed = v;
+        }
+    }
+}
