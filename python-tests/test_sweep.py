@@ -99,3 +99,20 @@ def test_bad_arguments(tmp_path):
         colcos.sweep.load(42)
     with pytest.raises(colcos.ScenarioError, match="nothing to resume"):
         colcos.sweep.load(TINY).run_local(str(tmp_path / "none"), 1, True)
+
+
+def test_traced_runs_give_the_poses_at_the_sample_times():
+    sweep = colcos.sweep.load(TINY).with_metrics(["mine"])
+    assert sweep.columns[-2:] == ["mine", "wall_s"]
+    [(run_id, cells, run)] = sweep.run_traced([3], 1)
+    assert run_id == 3 and cells[sweep.columns.index("mine")] == ""
+    # 2 s sampled every 0.1 s from t = 0; a leader, 3 followers and a predator.
+    assert run["times"].shape == (21,)
+    assert run["positions"].shape == (21, 5, 2)
+    assert run["headings"].shape == (21, 5)
+    assert run["roles"] == ["leader", "follower", "follower", "follower", "predator"]
+    # The same run without tracing gives the same built-in metrics.
+    [(_, plain)] = sweep.run_ids([3], 1)
+    assert plain[:-1] == cells[:-1]
+    with pytest.raises(colcos.ScenarioError, match="s_mean"):
+        colcos.sweep.load(TINY).with_metrics(["s_mean"])

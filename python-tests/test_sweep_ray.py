@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import ray
@@ -61,3 +62,22 @@ def test_ray_resumes_a_partial_table(cluster, tmp_path):
     pd.testing.assert_frame_equal(without_wall(full), without_wall(df))
     # The three rows found were kept as they were.
     pd.testing.assert_frame_equal(df.iloc[:3], full.iloc[:3])
+
+
+def leader_travel(run: dict) -> float:
+    """How far the leader ended from where it started, m."""
+    k = run["roles"].index("leader")
+    return float(np.linalg.norm(run["positions"][-1, k] - run["positions"][0, k]))
+
+
+def test_python_metrics_locally_and_on_ray(cluster, tmp_path):
+    metrics = {"leader_travel": leader_travel, "seed_twice": lambda run: 2 * run["seed"]}
+    local = colcos.sweep.run(TINY, out=tmp_path / "local", threads=2, metrics=metrics)
+    on_ray = colcos.sweep.run(TINY, backend="ray", out=tmp_path / "ray", metrics=metrics, group_size=3)
+    pd.testing.assert_frame_equal(without_wall(local), without_wall(on_ray))
+    assert list(local.columns[-3:]) == ["leader_travel", "seed_twice", "wall_s"]
+    assert (local["seed_twice"] == 2 * local["seed"]).all()
+    assert (local["leader_travel"] > 0).all()
+    # The built-in columns are those of a sweep without Python metrics.
+    plain = colcos.sweep.run(TINY, out=tmp_path / "plain", threads=2)
+    pd.testing.assert_frame_equal(without_wall(plain), without_wall(local).drop(columns=["leader_travel", "seed_twice"]))

@@ -2,11 +2,15 @@
 //! (what a Ray task calls) and the resumable results table the rows go into. The GIL is released while
 //! runs execute.
 use crate::errors::Kind;
-use colcos_sweep::{Plan, ResultsTable, SweepError, SweepOptions};
+use colcos_sweep::{Plan, ResultsTable, SweepError, SweepOptions, Trace};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyRuntimeError};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// A run's id, its cells and its poses (`run_traced`).
+type TracedRow<'py> = (u64, Vec<String>, Bound<'py, pyo3::types::PyDict>);
 
 fn to_py(e: SweepError) -> PyErr {
     let msg = e.to_string();
@@ -147,6 +151,69 @@ impl Sweep {
             Ok(rows.iter().map(|r| (r.id, r.fields(&plan))).collect())
         })
         .map_err(to_py)
+    }
+
+    /// The same sweep with metric columns computed by the caller (after the built-in metrics).
+    fn with_metrics(&self, names: Vec<String>) -> PyResult<Sweep> {
+        let plan = (*self.plan)
+            .clone()
+            .with_extra_metrics(&names)
+            .map_err(to_py)?;
+        Ok(Sweep {
+            plan: Arc::new(plan),
+            scenario_dir: self.scenario_dir.clone(),
+        })
+    }
+
+    /// Like `run_ids`, with each run's poses at the sample times: a list of
+    /// `(id, cells, {"times": (T,), "positions": (T, N, 2), "headings": (T, N), "roles": [N]})`;
+    /// the cells of `with_metrics` columns are empty, for the caller to fill.
+    #[pyo3(signature = (ids, threads=None))]
+    fn run_traced<'py>(
+        &self,
+        py: Python<'py>,
+        ids: Vec<u64>,
+        threads: Option<usize>,
+    ) -> PyResult<Vec<TracedRow<'py>>> {
+        let plan = self.plan.clone();
+        let runs: Vec<(u64, Vec<String>, Trace)> = py
+            .detach(move || {
+                use rayon::prelude::*;
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads.unwrap_or(0))
+                    .build()
+                    .map_err(|e| SweepError::Run {
+                        id: 0,
+                        message: e.to_string(),
+                    })?;
+                pool.install(|| {
+                    ids.par_iter()
+                        .map(|&id| {
+                            let (row, trace) =
+                                colcos_sweep::run_traced(&plan, id, &plan.scenario(id)?)?;
+                            Ok((id, row.fields(&plan), trace))
+                        })
+                        .collect::<Result<Vec<_>, SweepError>>()
+                })
+            })
+            .map_err(to_py)?;
+        runs.into_iter()
+            .map(|(id, cells, t)| {
+                let (steps, n) = (t.times.len(), t.roles.len());
+                let d = pyo3::types::PyDict::new(py);
+                d.set_item("times", PyArray1::from_vec(py, t.times))?;
+                d.set_item(
+                    "positions",
+                    PyArray1::from_vec(py, t.positions).reshape([steps, n, 2])?,
+                )?;
+                d.set_item(
+                    "headings",
+                    PyArray1::from_vec(py, t.headings).reshape([steps, n])?,
+                )?;
+                d.set_item("roles", t.roles)?;
+                Ok((id, cells, d))
+            })
+            .collect()
     }
 
     /// Opens (or starts) this sweep's results table in `out`.

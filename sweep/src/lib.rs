@@ -25,5 +25,7 @@ pub mod table;
 
 pub use error::SweepError;
 pub use plan::Plan;
-pub use runner::{RunRow, SweepOptions, SweepReport, run_ids, run_one, run_sweep};
+pub use runner::{
+    RunRow, SweepOptions, SweepReport, Trace, run_ids, run_one, run_sweep, run_traced,
+};
 pub use table::ResultsTable;

@@ -31,6 +31,8 @@ pub struct Plan {
     pub columns: Vec<String>,
     /// A hash of everything that decides the table: a directory's table is resumed only by the same.
     pub fingerprint: String,
+    /// Metric columns computed outside this crate (Python callables), after the built-in ones.
+    pub extra_metrics: Vec<String>,
     base: toml::Table,
     scenario_dir: PathBuf,
 }
@@ -144,6 +146,7 @@ impl Plan {
             seeds,
             columns: Vec::new(),
             fingerprint: String::new(),
+            extra_metrics: Vec::new(),
             base,
             scenario_dir,
         };
@@ -181,6 +184,33 @@ impl Plan {
             ])
         );
         Ok(plan)
+    }
+
+    /// The same sweep with metric columns computed elsewhere (after the built-in metrics, before
+    /// `wall_s`); they take part in the fingerprint, so a table is resumed only with the same ones.
+    pub fn with_extra_metrics(mut self, names: &[String]) -> Result<Plan> {
+        for (n, name) in names.iter().enumerate() {
+            let bad = name.is_empty() || name.contains([',', '"', '\n', '\r']);
+            if bad || self.columns.contains(name) || names[..n].contains(name) {
+                return Err(SweepError::invalid(
+                    format!("metrics (extra) [{n}]"),
+                    format!("\"{name}\""),
+                    "a new column name: not empty, no commas, quotes or line breaks, not used twice",
+                ));
+            }
+        }
+        let wall = self.columns.pop().unwrap_or_else(|| WALL_COLUMN.into());
+        self.columns.extend(names.iter().cloned());
+        self.columns.push(wall);
+        self.extra_metrics = names.to_vec();
+        self.fingerprint = format!(
+            "{:016x}",
+            fnv1a(&[
+                self.fingerprint.as_bytes(),
+                self.columns.join(",").as_bytes()
+            ])
+        );
+        Ok(self)
     }
 
     /// The directory the base scenario's relative paths (image maps) resolve against.

@@ -39,6 +39,8 @@ impl RunRow {
             Some(v) if v.is_finite() => v.to_string(),
             _ => String::new(),
         }));
+        // Columns of metrics computed elsewhere, filled in by their caller.
+        f.extend(plan.extra_metrics.iter().map(|_| String::new()));
         f.push(format!("{:.6}", self.wall_s));
         f
     }
@@ -57,6 +59,23 @@ pub fn value_text(v: &toml::Value) -> String {
 
 /// Runs `id` of `plan` on its (checked) scenario.
 pub fn run_one(plan: &Plan, id: u64, scenario: &Scenario) -> Result<RunRow> {
+    run_inner(plan, id, scenario, None)
+}
+
+/// The same run, also recording the robots' poses at the metrics' sample times (for metrics computed
+/// elsewhere, such as Python callables).
+pub fn run_traced(plan: &Plan, id: u64, scenario: &Scenario) -> Result<(RunRow, Trace)> {
+    let mut trace = Trace::default();
+    let row = run_inner(plan, id, scenario, Some(&mut trace))?;
+    Ok((row, trace))
+}
+
+fn run_inner(
+    plan: &Plan,
+    id: u64,
+    scenario: &Scenario,
+    mut trace: Option<&mut Trace>,
+) -> Result<RunRow> {
     let (combo, seed) = plan.locate(id)?;
     let started = Instant::now();
     let mut world = World::new(scenario).map_err(|e| SweepError::Run {
@@ -70,10 +89,22 @@ pub fn run_one(plan: &Plan, id: u64, scenario: &Scenario) -> Result<RunRow> {
         world.step_with_commands(&stop);
     }
     let mut recorder = Recorder::new(&plan.metrics, &world);
+    let every = ((plan.metrics.options.sample_every / world.dt()).round() as u64).max(1);
+    if let Some(t) = trace.as_deref_mut() {
+        t.roles = (0..world.robot_count())
+            .map(|i| world.role(i).to_string())
+            .collect();
+        t.record(&world);
+    }
     let end_on_arrival = plan.metrics.options.end_on_arrival;
     while !world.is_finished() {
         world.step();
         recorder.after_step(&world);
+        if let Some(t) = trace.as_deref_mut()
+            && world.tick().is_multiple_of(every)
+        {
+            t.record(&world);
+        }
         if end_on_arrival && recorder.all_arrived() {
             break;
         }
@@ -86,6 +117,28 @@ pub fn run_one(plan: &Plan, id: u64, scenario: &Scenario) -> Result<RunRow> {
         metrics,
         wall_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// The robots' true poses at the sample times of a run (t = 0 and every `sample_every`).
+#[derive(Clone, Debug, Default)]
+pub struct Trace {
+    /// Sample times, s.
+    pub times: Vec<f32>,
+    /// `[t][robot][x, y]`, m, flattened.
+    pub positions: Vec<f32>,
+    /// `[t][robot]`, rad, flattened.
+    pub headings: Vec<f32>,
+    pub roles: Vec<String>,
+}
+
+impl Trace {
+    fn record(&mut self, world: &World) {
+        self.times.push(world.time());
+        for p in world.poses() {
+            self.positions.extend([p.pos.x, p.pos.y]);
+            self.headings.push(p.heading);
+        }
+    }
 }
 
 /// Runs the given ids (each scenario built and checked here), in parallel on the current rayon pool,

@@ -167,3 +167,20 @@ fn a_table_being_written_is_not_opened_twice() {
     let report = run_sweep(&plan, tmp.path(), SweepOptions::default()).unwrap();
     assert_eq!(report.ran, 8);
 }
+
+#[test]
+fn traced_runs_give_the_same_row_and_the_poses_at_the_sample_times() {
+    let plan = tiny().with_extra_metrics(&["mine".to_string()]).unwrap();
+    assert_eq!(plan.columns[plan.columns.len() - 2..], ["mine", "wall_s"]);
+    assert_ne!(plan.fingerprint, tiny().fingerprint);
+    let scenario = plan.scenario(3).unwrap();
+    let plain = colcos_sweep::run_one(&plan, 3, &scenario).unwrap();
+    let (row, trace) = colcos_sweep::run_traced(&plan, 3, &scenario).unwrap();
+    assert_eq!(row.metrics, plain.metrics);
+    // 2 s sampled every 0.1 s from t = 0; 5 robots (3 followers).
+    assert_eq!(trace.times.len(), 21);
+    assert_eq!(trace.roles.len(), 5);
+    assert_eq!(trace.positions.len(), 21 * 5 * 2);
+    assert_eq!(row.fields(&plan)[plan.columns.len() - 2], "");
+    assert!(tiny().with_extra_metrics(&["s_mean".to_string()]).is_err());
+}
