@@ -47,7 +47,7 @@ def load(spec: str | os.PathLike | dict, base_dir: str | os.PathLike | None = No
 
 def read_table(path: str | os.PathLike):
     """A results table as a pandas DataFrame."""
-    import pandas as pd
+    import pandas as pd  # type: ignore[import-untyped]  # optional: not where the package is checked
 
     return pd.read_csv(path)
 
@@ -97,7 +97,7 @@ def _fill(columns: list[str], traced, metrics: dict) -> tuple[int, list[str]]:
     run = dict(run)
     run["run_id"] = run_id
     run["seed"] = int(cells[seed_col])
-    run["params"] = dict(zip(columns[first:seed_col], cells[first:seed_col]))
+    run["params"] = dict(zip(columns[first:seed_col], cells[first:seed_col], strict=True))
     for name, fn in metrics.items():
         v = fn(run)
         v = float("nan") if v is None else float(v)
@@ -137,7 +137,7 @@ def _run_group(text: str, scenario_dir: str, ids: list[int], threads, metrics: d
 
 
 def _run_ray(sweep, out: Path, threads, resume, group_size, retries, metrics, die_once) -> str:
-    import ray
+    import ray  # type: ignore[import-not-found]  # optional: not where the package is checked
 
     if group_size is not None and (not isinstance(group_size, int) or group_size < 1):
         raise _core.ScenarioError(f"group_size = {group_size!r}: a positive integer")
