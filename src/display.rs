@@ -45,8 +45,17 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     if w == 0 || h == 0 {
         return Err("the size must be positive".into());
     }
+    // wgpu's default texture limit; beyond it a frame is gigabytes and its allocation aborts.
+    if w > MAX_SIDE || h > MAX_SIDE {
+        return Err(format!(
+            "{w}x{h}: each side must be at most {MAX_SIDE} pixels"
+        ));
+    }
     Ok((w, h))
 }
+
+/// Widest and tallest image `--size` accepts, px.
+const MAX_SIDE: u32 = 8192;
 
 fn rgba(img: image::RgbImage) -> Vec<u8> {
     image::DynamicImage::ImageRgb8(img).to_rgba8().into_raw()
@@ -267,5 +276,18 @@ pub fn main(args: DisplayArgs) -> Result<()> {
     {
         let _ = world;
         anyhow::bail!("this colcos was built without the `display` feature")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn sizes_are_bounded_before_anything_is_allocated() {
+        assert_eq!(super::parse_size("640x360"), Ok((640, 360)));
+        assert_eq!(super::parse_size("8192x8192"), Ok((8192, 8192)));
+        let e = super::parse_size("100000x100000").unwrap_err();
+        assert!(e.contains("100000x100000") && e.contains("8192"), "{e}");
+        assert!(super::parse_size("0x10").is_err());
+        assert!(super::parse_size("10").is_err());
     }
 }
