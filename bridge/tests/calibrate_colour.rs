@@ -130,3 +130,18 @@ fn per_robot_sensors_are_fitted_and_reproduce_held_out_counts() {
     let err = ColourCalibration::load(&path).unwrap_err().to_string();
     assert!(err.contains("robots[1].sensors[2]"), "{err}");
 }
+
+/// The live loop loads the scenario's calibrations: a file that is not there stops it before it
+/// starts, naming the file.
+#[test]
+fn the_live_loop_refuses_a_missing_calibration_file() {
+    let sc = scenario(
+        &[(0.3, 0.3, 0.0)],
+        "colour_calibration = \"/nonexistent/colour.json\"",
+    );
+    let err = colcos_bridge::live::LoopCore::new(&sc, Default::default())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(err.contains("/nonexistent/colour.json"), "{err}");
+}

@@ -73,6 +73,10 @@ pub struct LoopCore {
     sent: Vec<WheelCommand>,
     interventions: Vec<Intervention>,
     events: Vec<String>,
+    /// The rig's calibrations (`[rig] colour_calibration`: robots' counts through their calibrated
+    /// inverse onto the scenario's sensor model).
+    calibration: crate::calibrate::RigCalibration,
+    nominal: colcos_sim::sensors::ColourSensor,
 }
 
 impl LoopCore {
@@ -85,6 +89,9 @@ impl LoopCore {
     /// [`LoopCore::new`] with the behaviours' random streams of world index `index` (an episode).
     pub fn with_index(scenario: &Scenario, legacy: LegacyDrive, index: u64) -> Result<LoopCore> {
         let rig = scenario.spec.rig.clone();
+        let calibration = crate::calibrate::RigCalibration::load(scenario).map_err(|e| {
+            colcos_sim::error::SimError::invalid("rig", "(calibration)", e.to_string())
+        })?;
         let mut host = Host::with_index(scenario, rig.sensors, index)?;
         host.set_latency(rig.latency);
         let n = host.robot_count();
@@ -115,6 +122,8 @@ impl LoopCore {
             sent: vec![WheelCommand::STOP; n],
             interventions: vec![Intervention::default(); n],
             events: Vec::new(),
+            calibration,
+            nominal: colcos_sim::sensors::ColourSensor::new(scenario.spec.sensor),
             host,
         })
     }
@@ -191,7 +200,10 @@ impl LoopCore {
                 self.silent[i] = false;
                 let bumpers =
                     std::array::from_fn(|k| bumper_reading(tm.tcrt_on[k], tm.tcrt_off[k]));
-                self.host.set_readings(i, colour_to_sim(tm.colour), bumpers);
+                let counts =
+                    self.calibration
+                        .robot_counts(tm.id, colour_to_sim(tm.colour), &self.nominal);
+                self.host.set_readings(i, counts, bumpers);
             }
         }
         // A robot that has answered before and not for `answer_timeout`: its radio is gone, so it can
