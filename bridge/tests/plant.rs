@@ -96,8 +96,15 @@ fn a_plant_without_what_it_needs_names_it() {
     let mut rig = PlantOptions::new(PlantKind::Rig);
     assert!(err(rig.clone()).contains("`tracker`"));
     rig.tracker = Some("swarmcon://127.0.0.1:1".into());
-    rig.robots = Some("bogus://x".into());
-    assert!(err(rig).contains("robot link"));
+    rig.robots = Some("udp://127.0.0.1:1".into());
+    // No robot is driven without a current screen calibration.
+    assert!(
+        err(rig).contains("`rig.screen_calibration`: the rig plant needs a screen calibration")
+    );
+    let mut twin = PlantOptions::new(PlantKind::Twin);
+    twin.tracker = Some("swarmcon://127.0.0.1:1".into());
+    twin.robots = Some("bogus://x".into());
+    assert!(err(twin).contains("robot link"));
     let mut replay = PlantOptions::new(PlantKind::Replay);
     replay.log = Some("/nonexistent/rig.mcap".into());
     assert!(err(replay).contains("/nonexistent/rig.mcap"));

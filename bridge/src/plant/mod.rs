@@ -9,15 +9,16 @@
 //!
 //! `step` is paced to the screen's 20 ms on the twin and the rig; `reset` drives the robots to the
 //! episode's start poses with a tracker-guided [`GoTo`], bounded in time, unless asked not to.
+mod calibration_gate;
 mod driver;
 mod goto;
 
 pub use goto::GoTo;
 
+use crate::calibrate::RigCalibration;
 use crate::colias::LegacyDrive;
 use crate::host::Host;
 use crate::live::{LiveOptions, LiveSession, LoopCore, replay};
-use crate::swarmcon::FrameTransform;
 use crate::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_env::encoding::{self, OBS_DIM};
 use colcos_env::task::registry;
@@ -68,6 +69,10 @@ pub struct PlantOptions {
     pub goto: bool,
     /// Longest a reset's go-to may take, s.
     pub goto_timeout: f64,
+    /// `rig`: the screen calibration may be at most this old, s (a week by default) ...
+    pub calibration_max_age: f64,
+    /// ... and its RMS reprojection error at most this, mm.
+    pub calibration_max_error_mm: f64,
 }
 
 impl PlantOptions {
@@ -79,6 +84,8 @@ impl PlantOptions {
             log: None,
             goto: true,
             goto_timeout: 30.0,
+            calibration_max_age: 7.0 * 86400.0,
+            calibration_max_error_mm: 3.0,
         }
     }
 }
@@ -247,7 +254,12 @@ impl LiveEnv {
                 plant.robots.clone().unwrap_or_default(),
             ),
         };
-        let opts = SourceOptions::new(FrameTransform::new(scenario.arena_size().y as f64));
+        let calibration = RigCalibration::load(scenario)
+            .map_err(|e| PlantError::option("rig.screen_calibration", e.to_string()))?;
+        if plant.kind == PlantKind::Rig {
+            calibration_gate::check(&calibration, plant)?;
+        }
+        let opts = SourceOptions::new(calibration.frame_transform(scenario));
         let source = open_pose_source(&tracker, &opts)?;
         let link = open_robot_link(&robots)?;
         let live = LiveOptions {
