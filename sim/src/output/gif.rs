@@ -35,7 +35,7 @@ impl GifPlan {
         let base = ((interval / dt).round() as u64).max(1);
         let pixels = (u64::from(width) * u64::from(height)).max(1);
         let cap = MAX_GIF_FRAMES.min(MAX_GIF_PIXELS / pixels).max(2);
-        let wanted = steps / base + 1;
+        let wanted = (steps / base).saturating_add(1);
         let thinned = if wanted > cap {
             (wanted - 1).div_ceil(cap - 1)
         } else {
@@ -47,7 +47,7 @@ impl GifPlan {
             // To the microsecond: `every x dt` in f32 would print as 2.6000001.
             interval: ((every as f64 * f64::from(dt) * 1e6).round() / 1e6) as f32,
             thinned,
-            frames: steps / every + 1,
+            frames: (steps / every).saturating_add(1),
         }
     }
 }
