@@ -9,13 +9,14 @@ fn colcos() -> Command {
     Command::new(env!("CARGO_BIN_EXE_colcos"))
 }
 
-/// A case-II sweep of 24 runs long enough (10 s simulated each) for the harness to catch it midway.
+/// A case-II sweep of 24 runs long enough (30 s simulated each, ~10 ms of wall time) for the harness to
+/// catch it midway.
 fn sweep_file(dir: &Path) -> PathBuf {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let base = repo.join("scenarios/case2_alarm.toml");
     let text = format!(
         r#"scenario = "{}"
-duration = 10.0
+duration = 30.0
 seeds = 4
 metrics = ["s_mean", "s_final", "nn_distance", "collisions", "area_covered"]
 [[axes]]
