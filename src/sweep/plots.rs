@@ -204,6 +204,15 @@ fn line(
     save(buf, path)
 }
 
+/// An axis title, saying when its values are binned.
+fn binned(a: &AxisInfo, g: &Groups) -> String {
+    if g.discrete {
+        a.name.clone()
+    } else {
+        format!("{} (binned)", a.name)
+    }
+}
+
 /// Viridis-like colour ramp at `f` in [0, 1].
 fn ramp(f: f64) -> RGBColor {
     const STOPS: [(f64, [f64; 3]); 5] = [
@@ -236,7 +245,11 @@ fn heat(
     {
         let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let caption = format!("{metric}: mean over seeds ({} to {})", short(lo), short(hi));
+        let caption = format!(
+            "{metric}: mean of each cell's runs ({} to {})",
+            short(lo),
+            short(hi)
+        );
         let mut chart = ChartBuilder::on(&root)
             .caption(caption, ("sans-serif", 18))
             .margin(12)
@@ -255,8 +268,8 @@ fn heat(
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc(a.name.as_str())
-            .y_desc(b.name.as_str())
+            .x_desc(binned(a, ga))
+            .y_desc(binned(b, gb))
             .x_labels(2 * na + 1)
             .y_labels(2 * nb + 1)
             .x_label_formatter(&|v| label(ga, *v))
