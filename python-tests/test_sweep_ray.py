@@ -18,6 +18,9 @@ TINY = REPO / "scenarios" / "sweeps" / "tiny.toml"
 
 @pytest.fixture(scope="module")
 def cluster():
+    # A cluster of our own, whatever an earlier suite of the session left running.
+    if ray.is_initialized():
+        ray.shutdown()
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     yield
     ray.shutdown()
