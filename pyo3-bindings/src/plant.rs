@@ -302,6 +302,11 @@ impl PyPlant {
         Ok(PyArray1::from_vec(py, flat).reshape([r, 3])?.into_any())
     }
 
+    /// The scenario actually used, as TOML.
+    fn scenario_toml(&self, py: Python<'_>) -> PyResult<String> {
+        guard(|| Ok(py.detach(|| self.lock().scenario().to_toml())))
+    }
+
     #[getter]
     fn backend_name(&self) -> &'static str {
         "cpu"

@@ -1,0 +1,140 @@
+"""Pre-flight check: a policy runs a few episodes on the digital twin (with the scenario's calibration
+and latency) before it may drive the real robots; it is refused, with the limit named, when the
+safety shield had to step in too often, robots reached the arena's edge or ran into each other, or the
+loop overran its ticks.
+
+    from colcos.preflight import preflight
+    report = preflight(policy, task="aggregation", episodes=3)   # raises PreflightError if refused
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+import tomllib
+
+from colcos import _core
+from colcos.pettingzoo_env import ColcosParallelEnv
+
+
+class PreflightError(_core.StateError):
+    """The policy broke a pre-flight limit; `.report` holds the measurements."""
+
+    def __init__(self, message: str, report: PreflightReport) -> None:
+        super().__init__(message)
+        self.report = report
+
+
+@dataclass
+class PreflightLimits:
+    """What a policy may do on the twin and still be let onto the rig (fractions of agent-steps or
+    ticks, and counts)."""
+
+    walled: float = 0.05
+    """Agent-steps the shield turned from a virtual wall."""
+    capped: float = 0.05
+    """Agent-steps whose wheel speeds the shield capped."""
+    boundary: int = 0
+    """Steps with a robot's body past the arena's edge (by its tracked pose)."""
+    collisions: float = 0.02
+    """Steps with two robots overlapping by more than `overlap` m (by their tracked poses)."""
+    overruns: float = 0.02
+    """Loop ticks that ended after their 20 ms slot."""
+    overlap: float = 0.005
+
+
+@dataclass
+class PreflightReport:
+    episodes: int = 0
+    agent_steps: int = 0
+    steps: int = 0
+    ticks: int = 0
+    walled: int = 0
+    capped: int = 0
+    boundary: int = 0
+    collisions: int = 0
+    overruns: int = 0
+    returns: list[float] = field(default_factory=list)
+    broken: list[str] = field(default_factory=list)
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def preflight(
+    policy: Callable[[np.ndarray], Any],
+    task: str = "aggregation",
+    episodes: int = 3,
+    max_cycles: int = 500,
+    limits: PreflightLimits | None = None,
+    **env_kwargs: Any,
+) -> PreflightReport:
+    """Runs `policy` (observation -> action, per agent) for `episodes` episodes of `max_cycles` steps
+    on the digital twin (`plant="twin"`; pass `tracker=`/`robots=` for a twin started by
+    `colcos twin`), and returns the measurements, or raises `PreflightError` naming every limit
+    broken."""
+    limits = limits or PreflightLimits()
+    if not isinstance(episodes, int) or isinstance(episodes, bool) or episodes < 1:
+        raise _core.TaskError(f"episodes must be a positive integer, got {episodes!r}")
+    env_kwargs.setdefault("plant", "twin")
+    report = PreflightReport()
+    for episode in range(episodes):
+        env = ColcosParallelEnv(task=task, max_cycles=max_cycles, **env_kwargs)
+        with env:
+            radius, arena = _geometry(env)
+            obs, _ = env.reset(seed=episode)
+            total = 0.0
+            while env.agents:
+                actions = {a: policy(obs[a]) for a in env.agents}
+                obs, rewards, _, _, infos = env.step(actions)
+                total += sum(rewards.values())
+                report.steps += 1
+                report.agent_steps += len(infos)
+                report.walled += sum(bool(i["shield_walled"]) for i in infos.values())
+                report.capped += sum(bool(i["shield_capped"]) for i in infos.values())
+                poses = env.poses()
+                report.boundary += int(_past_edge(poses, radius, arena))
+                report.collisions += int(_overlapping(poses, radius, limits.overlap))
+            info = env.plant_info()
+            report.ticks += int(info.get("ticks", report.steps))
+            report.overruns += int(info.get("overruns", 0))
+            report.returns.append(total)
+        report.episodes += 1
+    checks = [
+        ("walled", report.walled / max(report.agent_steps, 1), limits.walled),
+        ("capped", report.capped / max(report.agent_steps, 1), limits.capped),
+        ("boundary", report.boundary, limits.boundary),
+        ("collisions", report.collisions / max(report.steps, 1), limits.collisions),
+        ("overruns", report.overruns / max(report.ticks, 1), limits.overruns),
+    ]
+    for name, value, limit in checks:
+        if value > limit:
+            report.broken.append(f"{name} = {value:.4g} over the limit {limit:g}")
+    if report.broken:
+        raise PreflightError(
+            f"pre-flight refused over {report.episodes} twin episodes: " + "; ".join(report.broken), report
+        )
+    return report
+
+
+def _geometry(env: ColcosParallelEnv) -> tuple[float, tuple[float, float]]:
+    scenario = tomllib.loads(env._core.scenario_toml())
+    radius = float(scenario.get("robot", {}).get("radius", 0.02))
+    size = scenario["screen"]["size"]
+    return radius, (float(size[0]), float(size[1]))
+
+
+def _past_edge(poses: np.ndarray, radius: float, arena: tuple[float, float]) -> bool:
+    x, y = poses[:, 0], poses[:, 1]
+    return bool(((x < radius) | (y < radius) | (x > arena[0] - radius) | (y > arena[1] - radius)).any())
+
+
+def _overlapping(poses: np.ndarray, radius: float, overlap: float) -> bool:
+    p = poses[:, :2]
+    d = np.sqrt(((p[:, None, :] - p[None, :, :]) ** 2).sum(-1))
+    np.fill_diagonal(d, math.inf)
+    return bool((d < 2 * radius - overlap).any())
