@@ -188,7 +188,8 @@ impl LoopCore {
             if let Some(i) = self.robot_of(p.id)
                 && p.fresh
             {
-                let stamp = (self.host.time() as f64 - p.age) as f32;
+                // Captured `age` s before this tick, whose host time is `time + step`.
+                let stamp = (self.host.time() as f64 + input.step - p.age) as f32;
                 self.host.set_pose(i, p.pose, stamp);
                 self.fresh.push(i);
             }

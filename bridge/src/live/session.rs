@@ -166,24 +166,15 @@ impl LiveSession {
         let now = Instant::now();
         let t = now.duration_since(self.start).as_secs_f64();
         self.take_poses();
-        self.take_telemetry();
-        let n = self.core.robot_count();
-        for (i, s) in self.stopped.iter_mut().enumerate().take(n) {
-            *s = self.beats.is_stopped(i);
-        }
         // Fields, injection, sensing, decisions, on the measured time since the last tick.
         let step = self
             .last_tick
             .map_or(self.dt, |last| now.duration_since(last).as_secs_f64());
         self.last_tick = Some(now);
-        self.core.tick(&TickInput {
-            t,
-            step,
-            poses: &self.poses,
-            telemetry: &self.telemetry,
-            stopped: &self.stopped,
-            overrides,
-        });
+        let link_error = self.exchange(t, step, overrides);
+        if let Some(e) = link_error {
+            self.stopper.stop(&StopReason::LinkError(e));
+        }
         self.beats.policy();
         for &i in self.core.fresh() {
             self.beats.pose(i);
@@ -193,8 +184,12 @@ impl LiveSession {
             record(self.log(), Topic::Events, e.as_bytes());
         }
         self.show_screen(t);
-        self.send(t, step)?;
         self.write_trajectory()?;
+        if let Ok(mut l) = self.log().lock()
+            && let Some(r) = l.as_mut()
+        {
+            let _ = r.flush();
+        }
         let work = now.elapsed().as_secs_f64() * 1e3;
         self.tick_ms.push(work);
         if self.opts.status && now.duration_since(self.last_status) >= Duration::from_secs(1) {
@@ -202,6 +197,51 @@ impl LiveSession {
             self.print_status(t, work);
         }
         Ok(())
+    }
+
+    /// Telemetry in, the core's tick, the frames out, under the link's lock: a watchdog stop (which
+    /// takes the lock) goes out after this tick's frames, never before a motion frame that was decided
+    /// without it, and the stops read here are the ones the frames obey. Returns a link error.
+    fn exchange(
+        &mut self,
+        t: f64,
+        step: f64,
+        overrides: &[Option<WheelCommand>],
+    ) -> Option<String> {
+        let link = Arc::clone(&self.stopper.link);
+        let mut l = link.lock().unwrap_or_else(|e| e.into_inner());
+        self.telemetry = l.take_telemetry();
+        for tm in &self.telemetry {
+            record(&self.stopper.log, Topic::Telemetry, &tm.to_frame());
+        }
+        let n = self.core.robot_count();
+        for (i, s) in self.stopped.iter_mut().enumerate().take(n) {
+            *s = self.beats.is_stopped(i);
+        }
+        self.core.tick(&TickInput {
+            t,
+            step,
+            poses: &self.poses,
+            telemetry: &self.telemetry,
+            stopped: &self.stopped,
+            overrides,
+        });
+        for packet in self.core.packets() {
+            l.send(*packet);
+            record(&self.stopper.log, Topic::Commands, &packet.to_frame());
+        }
+        let error = l.pump().err().map(|e| e.to_string());
+        let stopped: Vec<usize> = (self.stopped.iter().enumerate())
+            .filter(|(_, s)| **s)
+            .map(|(i, _)| i)
+            .collect();
+        let marker = serde_json::json!({"tick": self.report.ticks + 1, "t": t, "step": step, "stopped": stopped, "commands": self.core.packets().len()});
+        record(
+            &self.stopper.log,
+            Topic::Ticks,
+            marker.to_string().as_bytes(),
+        );
+        error
     }
 
     /// Waits for the next tick's slot; a tick that ended after its slot is an overrun, and the next
@@ -259,18 +299,6 @@ impl LiveSession {
         }
     }
 
-    fn take_telemetry(&mut self) {
-        self.telemetry = self
-            .stopper
-            .link
-            .lock()
-            .map(|mut l| l.take_telemetry())
-            .unwrap_or_default();
-        for tm in &self.telemetry {
-            record(self.log(), Topic::Telemetry, &tm.to_frame());
-        }
-    }
-
     /// The screen to the frame stream and the LCD's window, each at its own rate.
     fn show_screen(&mut self, t: f64) {
         let host = self.core.host();
@@ -310,35 +338,6 @@ impl LiveSession {
                 log::warn!("the display window was closed; the loop goes on without it");
             }
         }
-    }
-
-    /// The tick's frames to the link and the log, then the tick's marker.
-    fn send(&mut self, t: f64, step: f64) -> Result<()> {
-        let mut link_error = None;
-        if let Ok(mut l) = self.stopper.link.lock() {
-            for packet in self.core.packets() {
-                l.send(*packet);
-                record(&self.stopper.log, Topic::Commands, &packet.to_frame());
-            }
-            if let Err(e) = l.pump() {
-                link_error = Some(e.to_string());
-            }
-        }
-        let stopped: Vec<usize> = (self.stopped.iter().enumerate())
-            .filter(|(_, s)| **s)
-            .map(|(i, _)| i)
-            .collect();
-        let marker = serde_json::json!({"tick": self.report.ticks, "t": t, "step": step, "stopped": stopped, "commands": self.core.packets().len()});
-        record(self.log(), Topic::Ticks, marker.to_string().as_bytes());
-        if let Some(e) = link_error {
-            self.stopper.stop(&StopReason::LinkError(e));
-        }
-        if let Ok(mut l) = self.log().lock()
-            && let Some(r) = l.as_mut()
-        {
-            let _ = r.flush();
-        }
-        Ok(())
     }
 
     fn write_trajectory(&mut self) -> Result<()> {
