@@ -230,8 +230,8 @@ pub fn render(
     with_renderer(|r| r.render(pheromones, screen, width, height))
 }
 
-/// [`render`] into an existing image, at its size: no allocation once the calling thread has drawn
-/// at that size (each thread keeps a [`ScreenRenderer`] with its tables and buffers).
+/// [`render`] into an existing image, at its size: no new image (at 4K a fresh one costs more than
+/// drawing it, in page faults), and the calling thread's [`ScreenRenderer`] keeps its tables.
 pub fn render_into(pheromones: &[Pheromone], screen: &ScreenSpec, img: &mut image::RgbImage) {
     with_renderer(|r| r.render_into(pheromones, screen, img))
 }

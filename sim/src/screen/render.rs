@@ -20,8 +20,8 @@ const BAND_ROWS: usize = 48;
 /// Images with fewer pixels than this render on the calling thread.
 const PARALLEL_MIN_PIXELS: usize = 1 << 16;
 
-/// Renders eq. (1) into images, keeping its lookup tables (per image size and grid geometry) and its
-/// per-frame buffers between calls: the live loop's renderer, one per thread that draws.
+/// Renders eq. (1) into images, keeping its lookup tables (per image size and grid geometry) between
+/// calls; a band's scratch rows (a few hundred KB at 4K) are made per frame.
 #[derive(Default)]
 pub struct ScreenRenderer {
     layout: Option<Layout>,
