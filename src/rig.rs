@@ -51,7 +51,8 @@ pub struct BridgeArgs {
     /// Stop after this many seconds (default: until Ctrl-C).
     #[arg(long)]
     pub duration: Option<f64>,
-    /// Output directory: rig.mcap (everything that crossed a wire), trajectory.csv, summary.json.
+    /// Output directory: rig.mcap (everything that crossed a wire), trajectory.csv, run.gif,
+    /// summary.json.
     #[arg(long, default_value = "runs/bridge")]
     pub out: PathBuf,
     /// No status line.
@@ -138,6 +139,7 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
         },
         log: Some(log.clone()),
         trajectory: Some(args.out.join("trajectory.csv")),
+        gif: Some(args.out.join("run.gif")),
         status: !args.quiet,
         ..LiveOptions::default()
     };
@@ -172,6 +174,10 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
         args.out.join("trajectory.csv").display()
     )?;
     writeln!(text, "  wrote {}", summary.display())?;
+    let gif = args.out.join("run.gif");
+    if gif.exists() {
+        writeln!(text, "  wrote {}", gif.display())?;
+    }
     Ok(())
 }
 

@@ -64,6 +64,7 @@ fn run_rig(
         stream_hz: 25.0,
         log: Some(log_path.clone()),
         trajectory: Some(dir.path().join("trajectory.csv")),
+        gif: Some(dir.path().join("run.gif")),
         ..LiveOptions::default()
     };
     let stop = Arc::new(AtomicBool::new(false));
@@ -86,6 +87,16 @@ fn run_rig(
         Some(colcos_sim::output::trajectory::header().as_str())
     );
     assert_eq!(lines.count() as u64, 5 * report.ticks);
+    // The run's GIF, complete when the loop returns: a frame per `gif_interval`.
+    let gif = std::fs::read(dir.path().join("run.gif")).unwrap();
+    let frames = gif.windows(3).filter(|w| *w == [0x21, 0xF9, 0x04]).count();
+    let interval = sc.spec.output.gif_interval as f64;
+    assert!(gif.ends_with(&[0x3B]), "the GIF has no trailer");
+    assert!(
+        frames as f64 >= (report.seconds / interval).floor() - 1.0,
+        "{frames} GIF frames in {} s",
+        report.seconds
+    );
     Rig {
         twin,
         faults,

@@ -7,6 +7,7 @@
 //! tracker, link, screen and logs; [`replay`] gives it a recorded run's inputs instead.
 
 mod core;
+mod gif_thread;
 mod options;
 pub mod replay;
 mod session;

@@ -28,6 +28,9 @@ pub struct LiveOptions {
     pub log: Option<PathBuf>,
     /// Where the trajectory CSV goes (the simulator's columns, the tracked poses as used); None: none.
     pub trajectory: Option<PathBuf>,
+    /// Where the run's GIF goes (the screen with the robots at their tracked poses, one frame per
+    /// `[output] gif_interval`, `gif_width` px wide, as `colcos run` draws it); None: none.
+    pub gif: Option<PathBuf>,
     /// Print a status line every second.
     pub status: bool,
     /// How wheel speeds become motion commands for old firmware (`[rig] firmware = "motion"`).
@@ -53,4 +56,6 @@ pub struct LiveReport {
     pub silent_robots: Vec<u8>,
     /// Tracker blocks taken.
     pub pose_blocks: u64,
+    /// GIF frames dropped because the encoder was busy.
+    pub gif_frames_dropped: u64,
 }

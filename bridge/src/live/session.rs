@@ -2,6 +2,7 @@
 //! the screen's sinks, the logs, and the frames out; [`LoopCore`] in the middle. [`super::run`] ticks
 //! it at the screen's rate; the Python plants tick it from a policy's `step`.
 use super::core::{LoopCore, PoseIn, TickInput};
+use super::gif_thread::GifThread;
 use super::options::{LiveOptions, LiveReport};
 use super::stopper::{SharedLog, StopOnDrop, Stopper, record};
 use crate::clock::{ClockOffset, epoch_s};
@@ -27,6 +28,8 @@ pub struct LiveSession {
     frames: Option<FrameServer>,
     opts: LiveOptions,
     trajectory: Option<TrajectoryLog>,
+    gif: Option<GifThread>,
+    next_gif: f64,
     scenario: Scenario,
     groups: Vec<usize>,
     clock: ClockOffset,
@@ -73,6 +76,16 @@ impl LiveSession {
             Some(path) => Some(TrajectoryLog::create(path)?),
             None => None,
         };
+        let out = &scenario.spec.output;
+        let gif = match &opts.gif {
+            Some(path) if out.gif_interval > 0.0 => Some(GifThread::start(
+                path,
+                &scenario.spec.screen,
+                out.gif_width,
+                out.gif_interval as f64,
+            )?),
+            _ => None,
+        };
         let start = Instant::now();
         let stopper = Stopper {
             link: Arc::new(Mutex::new(link)),
@@ -116,6 +129,8 @@ impl LiveSession {
             frames,
             opts,
             trajectory,
+            gif,
+            next_gif: 0.0,
             scenario: scenario.clone(),
             clock: ClockOffset::default(),
             dt,
@@ -184,6 +199,19 @@ impl LiveSession {
             record(self.log(), Topic::Events, e.as_bytes());
         }
         self.show_screen(t);
+        if let Some(gif) = self.gif.as_mut()
+            && t >= self.next_gif
+        {
+            self.next_gif = t + gif.interval;
+            let (w, h) = gif.size;
+            let host = self.core.host();
+            gif.push(colcos_sim::output::gif::arena_image(
+                host,
+                &self.scenario.spec.robots,
+                w,
+                h,
+            ));
+        }
         self.write_trajectory()?;
         if let Ok(mut l) = self.log().lock()
             && let Some(r) = l.as_mut()
@@ -399,6 +427,7 @@ impl LiveSession {
         report.telemetry_received = c.telemetry_received;
         report.silent_robots = c.silent_robots.clone();
         report.stops = self.stops.lock().map(|s| s.clone()).unwrap_or_default();
+        report.gif_frames_dropped = self.gif.as_ref().map_or(0, |g| g.dropped);
         report
     }
 }

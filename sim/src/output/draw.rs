@@ -1,8 +1,9 @@
 //! Robots drawn over a screen image (for GIFs and figures): each robot group in its own colour, and a
 //! legend naming the groups.
 use crate::robot::Pose;
+use crate::scenario::RobotGroupSpec;
 use crate::screen::ScreenSpec;
-use crate::world::World;
+use crate::world::{ArenaView, World};
 use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
 use glam::Vec2;
 use image::{Rgb, RgbImage};
@@ -30,7 +31,7 @@ pub fn group_colour(g: usize) -> Rgb<u8> {
 }
 
 /// Every robot's colour: its group's.
-pub fn robot_colours(world: &World) -> Vec<Rgb<u8>> {
+pub fn robot_colours(world: &dyn ArenaView) -> Vec<Rgb<u8>> {
     world
         .robots()
         .iter()
@@ -41,10 +42,12 @@ pub fn robot_colours(world: &World) -> Vec<Rgb<u8>> {
 /// A legend line per robot group of the world's scenario: `role: count behaviour` (`group k` where
 /// the group has no role), with its colour.
 pub fn group_legend(world: &World) -> Vec<(String, Rgb<u8>)> {
-    world
-        .scenario()
-        .spec
-        .robots
+    groups_legend(&world.scenario().spec.robots)
+}
+
+/// [`group_legend`] of the robot groups `groups`.
+pub fn groups_legend(groups: &[RobotGroupSpec]) -> Vec<(String, Rgb<u8>)> {
+    groups
         .iter()
         .enumerate()
         .map(|(g, spec)| {

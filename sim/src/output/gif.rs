@@ -69,9 +69,19 @@ impl GifRecorder {
     /// A GIF `width` pixels wide (height from the screen's aspect ratio, [`frame_height`]) with one
     /// frame per `interval` seconds of simulated time, played back in real time.
     pub fn create(path: &Path, world: &World, width: u32, interval: f32) -> Result<Self> {
+        Self::for_screen(path, world.screen(), width, interval)
+    }
+
+    /// [`GifRecorder::create`] for a screen of `screen`'s aspect ratio.
+    pub fn for_screen(
+        path: &Path,
+        screen: &crate::screen::ScreenSpec,
+        width: u32,
+        interval: f32,
+    ) -> Result<Self> {
         let file = File::create(path)
             .map_err(|e| SimError::io(format!("creating {}", path.display()), e))?;
-        let height = frame_height(world.screen(), width);
+        let height = frame_height(screen, width);
         let mut encoder = GifEncoder::new_with_speed(BufWriter::new(file), 20);
         encoder
             .set_repeat(Repeat::Infinite)
@@ -90,7 +100,16 @@ impl GifRecorder {
 
     /// Adds the world as it is now.
     pub fn frame(&mut self, world: &World) -> Result<()> {
-        let img = frame_image(world, self.width, self.height);
+        self.image(frame_image(world, self.width, self.height))
+    }
+
+    /// The frame's size, pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Adds `img` (of [`GifRecorder::size`]) as the next frame.
+    pub fn image(&mut self, img: image::RgbImage) -> Result<()> {
         let rgba = image::DynamicImage::ImageRgb8(img).into_rgba8();
         let frame = Frame::from_parts(rgba, 0, 0, Delay::from_numer_denom_ms(self.delay_ms, 1));
         self.encoder
@@ -105,15 +124,26 @@ impl GifRecorder {
 /// The screen at `width x height` with every robot drawn on it in its group's colour, and a legend
 /// naming the groups.
 pub fn frame_image(world: &World, width: u32, height: u32) -> image::RgbImage {
-    let mut img = screen::render(world.pheromones(), world.screen(), width, height);
+    arena_image(world, &world.scenario().spec.robots, width, height)
+}
+
+/// [`frame_image`] of any arena (a rig's host: the robots at their tracked poses), its robots from
+/// `groups`.
+pub fn arena_image(
+    view: &dyn crate::world::ArenaView,
+    groups: &[crate::scenario::RobotGroupSpec],
+    width: u32,
+    height: u32,
+) -> image::RgbImage {
+    let mut img = screen::render(view.pheromones(), view.screen(), width, height);
     super::draw::robots(
         &mut img,
-        world.screen(),
-        world.poses(),
-        world.robot_params().radius,
-        &super::draw::robot_colours(world),
+        view.screen(),
+        view.poses(),
+        view.robot_params().radius,
+        &super::draw::robot_colours(view),
     );
-    super::draw::legend(&mut img, &super::draw::group_legend(world));
+    super::draw::legend(&mut img, &super::draw::groups_legend(groups));
     img
 }
 
