@@ -49,6 +49,10 @@ fn mutated_scenarios_validate_and_run_under_time_and_memory_limits() {
             "--test-threads=1",
         ])
         .env(CHILD_ENV, "1")
+        // Address space, not memory, is limited: on a many-core machine each thread's stack and
+        // malloc arena would count against it.
+        .env("RAYON_NUM_THREADS", "2")
+        .env("MALLOC_ARENA_MAX", "2")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
