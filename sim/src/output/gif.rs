@@ -10,8 +10,9 @@ use std::path::Path;
 
 /// Most frames in a run's GIF.
 pub const MAX_GIF_FRAMES: u64 = 1_000;
-/// Most pixels in a run's GIF, all frames together (about 300 MB of frames before compression).
-pub const MAX_GIF_PIXELS: u64 = 300_000_000;
+/// Most pixels in a run's GIF, all frames together: a GIF file takes about half a byte a pixel
+/// (a 20-minute `three_trails` run, 858 frames of 480 x 270: 56 MB), so at most about 75 MB.
+pub const MAX_GIF_PIXELS: u64 = 150_000_000;
 
 /// Which ticks a run's GIF shows. One frame per `gif_interval`, unless that makes more than
 /// [`MAX_GIF_FRAMES`] frames or more than [`MAX_GIF_PIXELS`] pixels in all: then a frame every
