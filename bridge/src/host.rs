@@ -240,6 +240,11 @@ impl Host {
         }
     }
 
+    /// The screen image, eq. (1), drawn into `img` at its size (reusing its buffer).
+    pub fn render_into(&self, img: &mut RgbImage) {
+        colcos_sim::screen::render_into(self.parts.fields.pheromones(), &self.screen, img)
+    }
+
     /// The screen image, eq. (1), at `width x height` (the panel's resolution for the LCD).
     pub fn render(&self, width: u32, height: u32) -> RgbImage {
         colcos_sim::screen::render(self.parts.fields.pheromones(), &self.screen, width, height)

@@ -13,7 +13,8 @@ pub trait FrameSink: Send {
 #[derive(Default)]
 pub struct LiveOptions {
     /// The LCD's window, shown `display_width` px wide at `display_hz` (the window scales it to the
-    /// panel). The CPU renders a 4K frame in ~90 ms, so the default is a smaller frame.
+    /// panel). The CPU draws a 4K frame of three grid pheromones in ~3 ms; Gaussian fields cost an
+    /// `exp` per source and pixel, so the default is a smaller frame.
     pub display: Option<std::sync::Mutex<Box<dyn FrameSink>>>,
     pub display_width: u32,
     pub display_hz: f64,
