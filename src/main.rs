@@ -177,8 +177,9 @@ fn run_command(command: Command, text: &mut String) -> Result<()> {
                 report.robots,
                 report.steps,
                 report.sim_seconds,
-                report.wall_seconds,
-                report.real_time_factor()
+                // The whole run (world build, log, GIF, files): what the user waited for.
+                report.total_wall_seconds,
+                report.overall_real_time_factor()
             )?;
             for f in &report.files {
                 writeln!(text, "  wrote {}", f.display())?;
