@@ -3,12 +3,10 @@
 //! unchanged. The GIL is released around every call that waits on the arena (reset, step).
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
+use crate::vec_env::{Ptrs, view};
 use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions};
 use colcos_env::Space;
-use numpy::ndarray::{ArrayView, IxDyn};
-use numpy::{
-    Element, PyArray, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods,
-};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
@@ -29,25 +27,6 @@ fn plant_err(e: PlantError) -> PyErr {
         PlantError::Source(_) | PlantError::Link(_) | PlantError::Io(_) => Kind::State.err(msg),
         PlantError::Replay(_) | PlantError::State(_) => Kind::State.err(msg),
     }
-}
-
-/// Raw buffer pointers carried out of a `detach` closure.
-struct Ptrs<T>(T);
-// SAFETY: plain addresses of buffers owned by the plant, only dereferenced with the GIL held while
-// the plant is alive (see `views`).
-unsafe impl<T> Send for Ptrs<T> {}
-
-/// A numpy view of the elements at `ptr` shaped `shape`, keeping `owner` alive.
-///
-/// # Safety
-/// `ptr..ptr + product(shape)` must stay valid for as long as `owner` lives.
-unsafe fn view<'py, T: Element>(
-    owner: &Bound<'py, PyAny>,
-    ptr: *mut T,
-    shape: Vec<usize>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let a = unsafe { ArrayView::from_shape_ptr(IxDyn(&shape), ptr as *const T) };
-    Ok(unsafe { PyArray::borrow_from_array(&a, owner.clone()) }.into_any())
 }
 
 impl PyPlant {

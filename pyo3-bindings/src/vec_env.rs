@@ -46,7 +46,7 @@ impl PyVecEnv {
 }
 
 /// Raw buffer pointers carried out of a `detach` closure.
-struct Ptrs<T>(T);
+pub(crate) struct Ptrs<T>(pub T);
 // SAFETY: plain addresses of buffers owned by the env, only dereferenced with the GIL held while the
 // env is alive (see `views`).
 unsafe impl<T> Send for Ptrs<T> {}
@@ -55,7 +55,7 @@ unsafe impl<T> Send for Ptrs<T> {}
 ///
 /// # Safety
 /// `ptr..ptr + product(shape)` must stay valid for as long as `owner` lives.
-unsafe fn view<'py, T: Element>(
+pub(crate) unsafe fn view<'py, T: Element>(
     owner: &Bound<'py, PyAny>,
     ptr: *mut T,
     shape: Vec<usize>,
