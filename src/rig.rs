@@ -155,9 +155,11 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
     )?;
     writeln!(
         text,
-        "{} pose blocks, {} commands, {} telemetry frames; shield capped {} and walled {} commands; safety stops: {}",
+        "{} pose blocks, {} commands ({} on air, {} replaced by newer ones while waiting), {} telemetry frames; shield capped {} and walled {} commands; safety stops: {}",
         report.pose_blocks,
         report.commands_sent,
+        report.frames_on_air,
+        report.frames_superseded,
         report.telemetry_received,
         report.shield.capped,
         report.shield.walled,

@@ -51,7 +51,12 @@ pub struct LiveReport {
     pub shield: ShieldCounts,
     /// Safety stops the watchdog sent, by kind, in order.
     pub stops: Vec<String>,
+    /// Command frames the loop handed to the link.
     pub commands_sent: u64,
+    /// Of those, frames that went on air, and frames a newer one for the same robot replaced while
+    /// they waited for airtime (the link is newest-wins, never a growing queue).
+    pub frames_on_air: u64,
+    pub frames_superseded: u64,
     pub telemetry_received: u64,
     /// Robots (radio addresses) that stopped answering data requests, in the order they fell silent.
     pub silent_robots: Vec<u8>,

@@ -438,6 +438,10 @@ impl LiveSession {
         report.silent_robots = c.silent_robots.clone();
         report.stops = self.stops.lock().map(|s| s.clone()).unwrap_or_default();
         report.gif_frames_dropped = self.gif.as_ref().map_or(0, |g| g.dropped);
+        if let Ok(l) = self.stopper.link.lock() {
+            let c = l.counters().scheduler;
+            (report.frames_on_air, report.frames_superseded) = (c.sent, c.superseded);
+        }
         report
     }
 }
