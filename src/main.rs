@@ -63,6 +63,11 @@ enum Command {
     /// Put a rig log (`rig.mcap`) through the live loop again and check that the same inputs give
     /// the same command bytes.
     Replay(colcos::replay::ReplayArgs),
+    /// The rig's pre-flight: `colcos rig check SCENARIO` runs the behaviours on a digital twin first.
+    Rig {
+        #[command(subcommand)]
+        command: colcos::preflight::RigCommand,
+    },
     /// Run a batch of scenarios over axes of parameters and seeds (a sweep file), in parallel and
     /// resumable: results.csv, plots/ and summary.md (docs/sweeps.md).
     Sweep(colcos::sweep::SweepArgs),
@@ -126,6 +131,7 @@ fn run_command(command: Command, text: &mut String) -> Result<()> {
         Command::Twin(args) => colcos::rig::twin(args, text),
         Command::Calibrate(args) => colcos::calibrate::main(args, text),
         Command::Replay(args) => colcos::replay::run(args, text),
+        Command::Rig { command } => colcos::preflight::run(command, text),
         Command::Run {
             scenario,
             out,

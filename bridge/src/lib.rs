@@ -15,6 +15,7 @@ pub mod host;
 pub mod link;
 pub mod live;
 pub mod plant;
+pub mod preflight;
 pub mod recorder;
 pub mod source;
 pub mod swarmcon;

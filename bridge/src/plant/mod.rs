@@ -10,7 +10,7 @@
 //! `step` is paced to the screen's 20 ms on the twin and the rig; `reset` drives the robots to the
 //! episode's start poses with a tracker-guided [`GoTo`], bounded in time, unless asked not to.
 mod calibration_gate;
-mod driver;
+pub(crate) mod driver;
 mod goto;
 
 pub use goto::GoTo;

@@ -1,0 +1,129 @@
+//! Pre-flight check of a scenario's behaviours: a few episodes on a digital twin started here (with
+//! the scenario's calibration and tracker model), measured as the rig would be, before the behaviours
+//! may drive the real robots. Refused, with every limit broken named, when the shield had to turn or
+//! cap commands too often, a robot reached the arena's edge, robots ran into each other, or the loop
+//! overran its ticks. `colcos.preflight` does the same for a Python policy.
+use crate::calibrate::RigCalibration;
+use crate::live::{LiveOptions, LiveSession};
+use crate::plant::PlantError;
+use crate::plant::driver::TwinThread;
+use crate::{SourceOptions, open_pose_source, open_robot_link};
+use colcos_sim::scenario::Scenario;
+use colcos_sim::world::ArenaView;
+use std::time::Instant;
+
+/// What the behaviours may do on the twin and still be let onto the rig.
+#[derive(Clone, Copy, Debug)]
+pub struct PreflightLimits {
+    /// Robot-ticks the shield turned from a virtual wall, fraction.
+    pub walled: f64,
+    /// Robot-ticks whose wheel speeds the shield capped, fraction.
+    pub capped: f64,
+    /// Ticks with a robot's body past the arena's edge (tracked poses), count.
+    pub boundary: u64,
+    /// Ticks with two robots overlapping by more than 5 mm (tracked poses), fraction.
+    pub collisions: f64,
+    /// Ticks that overran their slot, fraction.
+    pub overruns: f64,
+}
+
+impl Default for PreflightLimits {
+    fn default() -> Self {
+        PreflightLimits {
+            walled: 0.05,
+            capped: 0.05,
+            boundary: 0,
+            collisions: 0.02,
+            overruns: 0.02,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct PreflightReport {
+    pub episodes: usize,
+    pub ticks: u64,
+    pub robot_ticks: u64,
+    pub walled: u64,
+    pub capped: u64,
+    pub boundary: u64,
+    pub collisions: u64,
+    pub overruns: u64,
+    pub stops: Vec<String>,
+    /// Each limit broken, with its value.
+    pub broken: Vec<String>,
+}
+
+/// Runs `episodes` episodes of `seconds` s (seeds `seed, seed + 1, ...`) and checks `limits`.
+pub fn check(
+    scenario: &Scenario,
+    episodes: usize,
+    seconds: f64,
+    limits: &PreflightLimits,
+) -> Result<PreflightReport, PlantError> {
+    let mut r = PreflightReport::default();
+    let radius = scenario.spec.robot.radius;
+    let arena = scenario.arena_size();
+    for k in 0..episodes {
+        let mut sc = scenario.clone();
+        sc.spec.seed = scenario.spec.seed.wrapping_add(k as u64);
+        let twin = TwinThread::start(&sc)?;
+        let calibration = RigCalibration::load(&sc)
+            .map_err(|e| PlantError::Io(format!("rig.screen_calibration: {e}")))?;
+        let source = open_pose_source(
+            &twin.tracker_url,
+            &SourceOptions::new(calibration.frame_transform(&sc)),
+        )?;
+        let link = open_robot_link(&twin.robots_url)?;
+        let mut session = LiveSession::new(&sc, source, link, None, LiveOptions::default())?;
+        let start = Instant::now();
+        while start.elapsed().as_secs_f64() < seconds {
+            session.tick(&[])?;
+            let core = session.core();
+            let host = core.host();
+            let seen: Vec<_> = (host.tracked().iter())
+                .zip(ArenaView::poses(host))
+                .filter(|(t, _)| t.seen)
+                .map(|(_, p)| p.pos)
+                .collect();
+            r.ticks += 1;
+            r.robot_ticks += seen.len() as u64;
+            for i in core.interventions() {
+                r.walled += i.walled as u64;
+                r.capped += i.capped as u64;
+            }
+            let past = |p: &glam::Vec2| {
+                p.x < radius || p.y < radius || p.x > arena.x - radius || p.y > arena.y - radius
+            };
+            r.boundary += seen.iter().any(past) as u64;
+            let touching = seen.iter().enumerate().any(|(i, a)| {
+                seen[..i]
+                    .iter()
+                    .any(|b| a.distance(*b) < 2.0 * radius - 0.005)
+            });
+            r.collisions += touching as u64;
+            session.wait_next();
+        }
+        let report = session.report();
+        r.overruns += report.overruns;
+        r.stops.extend(report.stops);
+        r.episodes += 1;
+        drop(session);
+        drop(twin);
+    }
+    let frac = |n: u64, d: u64| n as f64 / d.max(1) as f64;
+    let checks = [
+        ("walled", frac(r.walled, r.robot_ticks), limits.walled),
+        ("capped", frac(r.capped, r.robot_ticks), limits.capped),
+        ("boundary", r.boundary as f64, limits.boundary as f64),
+        ("collisions", frac(r.collisions, r.ticks), limits.collisions),
+        ("overruns", frac(r.overruns, r.ticks), limits.overruns),
+    ];
+    for (name, value, limit) in checks {
+        if value > limit {
+            r.broken
+                .push(format!("{name} = {value:.4} over the limit {limit}"));
+        }
+    }
+    Ok(r)
+}
