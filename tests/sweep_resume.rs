@@ -61,7 +61,8 @@ fn run_and_kill_after(file: &Path, out: &Path, k: usize) {
         if child.try_wait().unwrap().is_some() {
             return;
         }
-        let header = out.join("results.csv").exists();
+        // The header line complete (the file exists a moment before it is written).
+        let header = std::fs::read(out.join("results.csv")).is_ok_and(|b| b.contains(&b'\n'));
         if header && complete_rows(out) >= k {
             child.kill().unwrap();
             child.wait().unwrap();

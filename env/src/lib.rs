@@ -21,6 +21,7 @@ pub mod task;
 mod vec_env;
 pub mod world_output;
 mod world_slot;
+mod world_step;
 
 pub use backend::EnvBackend;
 pub use config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource};

@@ -13,8 +13,10 @@ use crate::task::{Task, registry};
 pub use crate::world_output::render_world;
 use crate::world_output::{write_obs, write_patch, write_state};
 use crate::world_slot::WorldSlot;
+pub use crate::world_step::shield_bits;
+use crate::world_step::{Ctx, Out, step_world};
 use colcos_sim::scenario::Scenario;
-use colcos_sim::shield::{Intervention, Shield};
+use colcos_sim::shield::Shield;
 use colcos_sim::world::World;
 use rayon::prelude::*;
 
@@ -25,32 +27,6 @@ pub enum Actions<'a> {
     Continuous(&'a [f32]),
     /// Indices into [`encoding::DISCRETE_ACTIONS`], `[E, N]`.
     Discrete(&'a [i64]),
-}
-
-/// Per-world output slices.
-struct Out<'a> {
-    obs: &'a mut [f32],
-    rewards: &'a mut [f32],
-    terminated: &'a mut [bool],
-    truncated: &'a mut [bool],
-    state: &'a mut [f32],
-    patch: &'a mut [u8],
-    final_obs: &'a mut [f32],
-    final_mask: &'a mut bool,
-    shield: &'a mut [u8],
-}
-
-/// Everything a world's step needs besides its own slot and buffers.
-struct Ctx<'a> {
-    task: &'a dyn Task,
-    scenario: &'a Scenario,
-    backend: &'a EnvBackend,
-    mode: AutoresetMode,
-    max_cycles: u64,
-    max_speed: f32,
-    state_dim: usize,
-    patch: Option<PatchConfig>,
-    shield: Option<Shield>,
 }
 
 pub struct VecEnv {
@@ -545,87 +521,4 @@ pub struct BufferPtrs {
     pub final_obs: *mut f32,
     pub final_mask: *mut bool,
     pub shield: *mut u8,
-}
-
-fn step_world(
-    ctx: &Ctx,
-    w: usize,
-    slot: &mut WorldSlot,
-    cmds: &[colcos_sim::behaviour::WheelCommand],
-    out: &mut Out,
-) -> Result<()> {
-    let agents = ctx.task.agents();
-    *out.final_mask = false;
-    out.shield.fill(0);
-    if slot.done {
-        // Next-step autoreset: this step only resets the world.
-        *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
-        out.rewards.fill(0.0);
-        out.terminated.fill(false);
-        out.truncated.fill(false);
-        write_world(ctx, slot, out);
-        return Ok(());
-    }
-    slot.decide_scripted();
-    let poses = slot.world.poses();
-    for (((&i, cmd), &term), flags) in agents
-        .iter()
-        .zip(cmds)
-        .zip(&slot.terminated)
-        .zip(out.shield.iter_mut())
-    {
-        slot.commands[i] = if term {
-            colcos_sim::behaviour::WheelCommand::STOP
-        } else if let Some(shield) = &ctx.shield {
-            let (cmd, intervention) = shield.apply(&poses[i], *cmd);
-            *flags = shield_bits(intervention);
-            cmd
-        } else {
-            *cmd
-        };
-    }
-    slot.world.step_with_commands(&slot.commands);
-    slot.steps += 1;
-    slot.prev_terminated.copy_from_slice(&slot.terminated);
-    ctx.task
-        .evaluate(&slot.world, out.rewards, &mut slot.terminated);
-    for (r, &was) in out.rewards.iter_mut().zip(&slot.prev_terminated) {
-        if was {
-            *r = 0.0;
-        }
-    }
-    let truncate = slot.steps >= ctx.max_cycles;
-    let mut done = true;
-    for k in 0..agents.len() {
-        out.terminated[k] = slot.terminated[k];
-        out.truncated[k] = truncate && !slot.terminated[k];
-        done &= out.terminated[k] || out.truncated[k];
-    }
-    write_world(ctx, slot, out);
-    if done {
-        slot.done = true;
-        if ctx.mode == AutoresetMode::SameStep {
-            out.final_obs.copy_from_slice(out.obs);
-            *out.final_mask = true;
-            *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
-            write_world(ctx, slot, out);
-        }
-    }
-    Ok(())
-}
-
-fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut Out) {
-    let agents = ctx.task.agents();
-    write_obs(&slot.world, agents, ctx.max_speed, out.obs);
-    if ctx.state_dim > 0 {
-        write_state(&slot.world, slot.steps, ctx.max_cycles, out.state);
-    }
-    if let Some(p) = &ctx.patch {
-        write_patch(&slot.world, agents, p, out.patch);
-    }
-}
-
-/// A shield intervention as the bits of [`VecEnv::shield_flags`].
-pub fn shield_bits(i: Intervention) -> u8 {
-    i.capped as u8 | (i.walled as u8) << 1
 }

@@ -1,0 +1,119 @@
+//! One world's step of the batch: the scripted robots decide, the agents' commands pass the safety
+//! shield, the world steps, the task hands out rewards and ends episodes, and the outputs are written.
+use crate::backend::EnvBackend;
+use crate::config::{AutoresetMode, PatchConfig};
+use crate::error::Result;
+use crate::task::Task;
+use crate::world_output::{write_obs, write_patch, write_state};
+use crate::world_slot::WorldSlot;
+use colcos_sim::scenario::Scenario;
+use colcos_sim::shield::{Intervention, Shield};
+
+/// Per-world output slices.
+pub(crate) struct Out<'a> {
+    pub(crate) obs: &'a mut [f32],
+    pub(crate) rewards: &'a mut [f32],
+    pub(crate) terminated: &'a mut [bool],
+    pub(crate) truncated: &'a mut [bool],
+    pub(crate) state: &'a mut [f32],
+    pub(crate) patch: &'a mut [u8],
+    pub(crate) final_obs: &'a mut [f32],
+    pub(crate) final_mask: &'a mut bool,
+    pub(crate) shield: &'a mut [u8],
+}
+
+/// Everything a world's step needs besides its own slot and buffers.
+pub(crate) struct Ctx<'a> {
+    pub(crate) task: &'a dyn Task,
+    pub(crate) scenario: &'a Scenario,
+    pub(crate) backend: &'a EnvBackend,
+    pub(crate) mode: AutoresetMode,
+    pub(crate) max_cycles: u64,
+    pub(crate) max_speed: f32,
+    pub(crate) state_dim: usize,
+    pub(crate) patch: Option<PatchConfig>,
+    pub(crate) shield: Option<Shield>,
+}
+
+pub(crate) fn step_world(
+    ctx: &Ctx,
+    w: usize,
+    slot: &mut WorldSlot,
+    cmds: &[colcos_sim::behaviour::WheelCommand],
+    out: &mut Out,
+) -> Result<()> {
+    let agents = ctx.task.agents();
+    *out.final_mask = false;
+    out.shield.fill(0);
+    if slot.done {
+        // Next-step autoreset: this step only resets the world.
+        *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
+        out.rewards.fill(0.0);
+        out.terminated.fill(false);
+        out.truncated.fill(false);
+        write_world(ctx, slot, out);
+        return Ok(());
+    }
+    slot.decide_scripted();
+    let poses = slot.world.poses();
+    for (((&i, cmd), &term), flags) in agents
+        .iter()
+        .zip(cmds)
+        .zip(&slot.terminated)
+        .zip(out.shield.iter_mut())
+    {
+        slot.commands[i] = if term {
+            colcos_sim::behaviour::WheelCommand::STOP
+        } else if let Some(shield) = &ctx.shield {
+            let (cmd, intervention) = shield.apply(&poses[i], *cmd);
+            *flags = shield_bits(intervention);
+            cmd
+        } else {
+            *cmd
+        };
+    }
+    slot.world.step_with_commands(&slot.commands);
+    slot.steps += 1;
+    slot.prev_terminated.copy_from_slice(&slot.terminated);
+    ctx.task
+        .evaluate(&slot.world, out.rewards, &mut slot.terminated);
+    for (r, &was) in out.rewards.iter_mut().zip(&slot.prev_terminated) {
+        if was {
+            *r = 0.0;
+        }
+    }
+    let truncate = slot.steps >= ctx.max_cycles;
+    let mut done = true;
+    for k in 0..agents.len() {
+        out.terminated[k] = slot.terminated[k];
+        out.truncated[k] = truncate && !slot.terminated[k];
+        done &= out.terminated[k] || out.truncated[k];
+    }
+    write_world(ctx, slot, out);
+    if done {
+        slot.done = true;
+        if ctx.mode == AutoresetMode::SameStep {
+            out.final_obs.copy_from_slice(out.obs);
+            *out.final_mask = true;
+            *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
+            write_world(ctx, slot, out);
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut Out) {
+    let agents = ctx.task.agents();
+    write_obs(&slot.world, agents, ctx.max_speed, out.obs);
+    if ctx.state_dim > 0 {
+        write_state(&slot.world, slot.steps, ctx.max_cycles, out.state);
+    }
+    if let Some(p) = &ctx.patch {
+        write_patch(&slot.world, agents, p, out.patch);
+    }
+}
+
+/// A shield intervention as the bits of [`VecEnv::shield_flags`].
+pub fn shield_bits(i: Intervention) -> u8 {
+    i.capped as u8 | (i.walled as u8) << 1
+}
