@@ -65,7 +65,7 @@ fn progress_bar(steps: u64) -> indicatif::ProgressBar {
 /// absolute path. GPU drivers' EGL probes for a Wayland compositor on every GPU run, and libwayland
 /// then prints "XDG_RUNTIME_DIR is invalid or not set in the environment" (ssh sessions, containers)
 /// although no window is wanted; in an empty directory the probe finds no socket and stays silent.
-/// A session's own valid value is kept. Call it first in `main`, before any thread starts: it sets an
+/// A valid value (set by the user's login) is kept. Call it first in `main`, before any thread starts: it sets an
 /// environment variable.
 pub fn quiet_wayland_probe() {
     let valid = std::env::var_os("XDG_RUNTIME_DIR")

@@ -3,10 +3,10 @@
 //! unchanged. The GIL is released around every call that waits on the arena (reset, step).
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
-use crate::vec_env::{Ptrs, view};
+use crate::vec_env::{Owned, Ptrs, owned_actions, view};
 use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions};
 use colcos_env::Space;
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
@@ -193,40 +193,12 @@ impl PyPlant {
     /// `[1, N]`.
     fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
         guard(|| {
-            let n = self.num_agents;
-            if self.discrete {
-                let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
-                    Kind::ActionType.err(format!(
-                        "discrete actions must be an int64 numpy array of shape (1, {n}), got {}",
-                        args::show(actions)
-                    ))
-                })?;
-                if a.shape() != [1, n] {
-                    return Err(Kind::Action.err(format!(
-                        "actions have shape {:?}, expected (1, {n})",
-                        a.shape()
-                    )));
-                }
-                let v: Vec<i64> = a.as_array().iter().copied().collect();
-                py.detach(|| self.lock().step(None, Some(&v)))
-                    .map_err(plant_err)
-            } else {
-                let a: PyReadonlyArrayDyn<'_, f32> = actions.extract().map_err(|_| {
-                    Kind::ActionType.err(format!(
-                        "continuous actions must be a float32 numpy array of shape (1, {n}, 2), got {}",
-                        args::show(actions)
-                    ))
-                })?;
-                if a.shape() != [1, n, 2] {
-                    return Err(Kind::Action.err(format!(
-                        "actions have shape {:?}, expected (1, {n}, 2)",
-                        a.shape()
-                    )));
-                }
-                let v: Vec<f32> = a.as_array().iter().copied().collect();
-                py.detach(|| self.lock().step(Some(&v), None))
-                    .map_err(plant_err)
-            }
+            let acts = owned_actions(actions, 1, self.num_agents, self.discrete)?;
+            py.detach(|| match &acts {
+                Owned::Discrete(a) => self.lock().step(None, Some(a)),
+                Owned::Continuous(a) => self.lock().step(Some(a), None),
+            })
+            .map_err(plant_err)
         })
     }
 

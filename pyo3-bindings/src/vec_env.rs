@@ -295,40 +295,7 @@ impl PyVecEnv {
     fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
         guard(|| {
             let (e, n) = (self.num_envs, self.num_agents);
-            let acts = if self.discrete {
-                let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
-                    Kind::ActionType.err(format!(
-                        "discrete actions must be an int64 numpy array of shape ({e}, {n}) = \
-                         (num_envs, num_agents), got {}",
-                        args::show(actions)
-                    ))
-                })?;
-                if a.shape() != [e, n] {
-                    return Err(Kind::Action.err(format!(
-                        "actions have shape {:?}, expected ({e}, {n}) = (num_envs, num_agents)",
-                        a.shape()
-                    )));
-                }
-                Owned::Discrete(a.as_array().iter().copied().collect())
-            } else {
-                let a: PyReadonlyArrayDyn<'_, f32> = actions.extract().map_err(|_| {
-                    Kind::ActionType.err(format!(
-                        "continuous actions must be a float32 numpy array of shape ({e}, {n}, 2) = \
-                         (num_envs, num_agents, wheels), got {}",
-                        args::show(actions)
-                    ))
-                })?;
-                if a.shape() != [e, n, 2] {
-                    return Err(Kind::Action.err(format!(
-                        "actions have shape {:?}, expected ({e}, {n}, 2) = (num_envs, num_agents, wheels)",
-                        a.shape()
-                    )));
-                }
-                Owned::Continuous(match a.as_slice() {
-                    Ok(src) => src.to_vec(),
-                    Err(_) => a.as_array().iter().copied().collect(),
-                })
-            };
+            let acts = owned_actions(actions, e, n, self.discrete)?;
             py.detach(|| {
                 let mut g = self.lock();
                 match &acts {
@@ -462,9 +429,54 @@ impl PyVecEnv {
 }
 
 /// Actions copied out of Python's array, so that the env's lock is taken without the GIL.
-enum Owned {
+/// Actions copied out of numpy (before the env's lock is taken, with the GIL held).
+pub(crate) enum Owned {
     Continuous(Vec<f32>),
     Discrete(Vec<i64>),
+}
+
+/// `actions` checked and copied: int64 `[e, n]` (discrete) or float32 `[e, n, 2]`, C-contiguous or
+/// not.
+pub(crate) fn owned_actions(
+    actions: &Bound<'_, PyAny>,
+    e: usize,
+    n: usize,
+    discrete: bool,
+) -> PyResult<Owned> {
+    Ok(if discrete {
+        let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
+            Kind::ActionType.err(format!(
+                "discrete actions must be an int64 numpy array of shape ({e}, {n}) = \
+                 (num_envs, num_agents), got {}",
+                args::show(actions)
+            ))
+        })?;
+        if a.shape() != [e, n] {
+            return Err(Kind::Action.err(format!(
+                "actions have shape {:?}, expected ({e}, {n}) = (num_envs, num_agents)",
+                a.shape()
+            )));
+        }
+        Owned::Discrete(a.as_array().iter().copied().collect())
+    } else {
+        let a: PyReadonlyArrayDyn<'_, f32> = actions.extract().map_err(|_| {
+            Kind::ActionType.err(format!(
+                "continuous actions must be a float32 numpy array of shape ({e}, {n}, 2) = \
+                 (num_envs, num_agents, wheels), got {}",
+                args::show(actions)
+            ))
+        })?;
+        if a.shape() != [e, n, 2] {
+            return Err(Kind::Action.err(format!(
+                "actions have shape {:?}, expected ({e}, {n}, 2) = (num_envs, num_agents, wheels)",
+                a.shape()
+            )));
+        }
+        Owned::Continuous(match a.as_slice() {
+            Ok(src) => src.to_vec(),
+            Err(_) => a.as_array().iter().copied().collect(),
+        })
+    })
 }
 
 impl PyVecEnv {
