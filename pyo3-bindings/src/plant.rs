@@ -3,7 +3,7 @@
 //! unchanged. The GIL is released around every call that waits on the arena (reset, step).
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
-use crate::vec_env::{Owned, Ptrs, owned_actions, view};
+use crate::vec_env::{AgentBuffers, Owned, Ptrs, agent_views, owned_actions};
 use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions};
 use colcos_env::Space;
 use numpy::{PyArray1, PyArrayMethods};
@@ -141,29 +141,19 @@ impl PyPlant {
                 (Ptrs(g.buffer_ptrs()), g.spec().clone())
             });
             let p = ptrs.0;
-            let n = spec.num_agents;
             let d = PyDict::new(py);
+            let bufs = AgentBuffers {
+                obs: p.obs,
+                rewards: p.rewards,
+                terminated: p.terminated,
+                truncated: p.truncated,
+                shield: p.shield,
+                state: p.state,
+                patch: p.patch,
+            };
             // SAFETY: the buffers are allocated once in LiveEnv::new and never reallocated; each view
             // keeps `owner` (and so the plant) alive.
-            unsafe {
-                d.set_item(
-                    "obs",
-                    view(&owner, p.obs, vec![1, n, spec.observation.flat_len()])?,
-                )?;
-                d.set_item("rewards", view(&owner, p.rewards, vec![1, n])?)?;
-                d.set_item("terminated", view(&owner, p.terminated, vec![1, n])?)?;
-                d.set_item("truncated", view(&owner, p.truncated, vec![1, n])?)?;
-                d.set_item("shield", view(&owner, p.shield, vec![1, n])?)?;
-                if let Some(s) = &spec.state {
-                    d.set_item("state", view(&owner, p.state, vec![1, s.flat_len()])?)?;
-                }
-                if let Some(Space::Box { shape, .. }) = &spec.patch {
-                    d.set_item(
-                        "patch",
-                        view(&owner, p.patch, vec![1, n, shape[0], shape[1], shape[2]])?,
-                    )?;
-                }
-            }
+            unsafe { agent_views(&d, &owner, &bufs, &spec, 1)? };
             Ok(d)
         })
     }

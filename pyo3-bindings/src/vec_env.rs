@@ -243,25 +243,21 @@ impl PyVecEnv {
             // SAFETY: the buffers are allocated once in VecEnv::new and never reallocated; each view
             // keeps `owner` (and so the VecEnv) alive.
             unsafe {
-                d.set_item("obs", view(&owner, ptrs.obs, vec![e, n, d_obs])?)?;
-                d.set_item("rewards", view(&owner, ptrs.rewards, vec![e, n])?)?;
-                d.set_item("terminated", view(&owner, ptrs.terminated, vec![e, n])?)?;
-                d.set_item("truncated", view(&owner, ptrs.truncated, vec![e, n])?)?;
+                let agents = AgentBuffers {
+                    obs: ptrs.obs,
+                    rewards: ptrs.rewards,
+                    terminated: ptrs.terminated,
+                    truncated: ptrs.truncated,
+                    shield: ptrs.shield,
+                    state: ptrs.state,
+                    patch: ptrs.patch,
+                };
+                agent_views(&d, &owner, &agents, &spec, e)?;
                 d.set_item(
                     "final_obs",
                     view(&owner, ptrs.final_obs, vec![e, n, d_obs])?,
                 )?;
                 d.set_item("final_mask", view(&owner, ptrs.final_mask, vec![e])?)?;
-                d.set_item("shield", view(&owner, ptrs.shield, vec![e, n])?)?;
-                if let Some(s) = &spec.state {
-                    d.set_item("state", view(&owner, ptrs.state, vec![e, s.flat_len()])?)?;
-                }
-                if let Some(Space::Box { shape, .. }) = &spec.patch {
-                    d.set_item(
-                        "patch",
-                        view(&owner, ptrs.patch, vec![e, n, shape[0], shape[1], shape[2]])?,
-                    )?;
-                }
             }
             Ok(d)
         })
@@ -429,6 +425,48 @@ impl PyVecEnv {
 }
 
 /// Actions copied out of Python's array, so that the env's lock is taken without the GIL.
+/// The per-agent output buffers of `E` worlds, as raw pointers (see [`agent_views`]).
+pub(crate) struct AgentBuffers {
+    pub obs: *mut f32,
+    pub rewards: *mut f32,
+    pub terminated: *mut bool,
+    pub truncated: *mut bool,
+    pub shield: *mut u8,
+    pub state: *mut f32,
+    pub patch: *mut u8,
+}
+
+/// Puts numpy views of `bufs` for `e` worlds into `d`: `obs [E,N,D]`, `rewards`, `terminated`,
+/// `truncated`, `shield [E,N]`, and `state [E,S]` and `patch [E,N,P,P,3]` where `spec` has them.
+///
+/// # Safety
+/// Every buffer must hold `e` worlds' worth of elements and stay valid for as long as `owner` lives.
+pub(crate) unsafe fn agent_views<'py>(
+    d: &Bound<'py, PyDict>,
+    owner: &Bound<'py, PyAny>,
+    bufs: &AgentBuffers,
+    spec: &colcos_env::EnvSpec,
+    e: usize,
+) -> PyResult<()> {
+    let n = spec.num_agents;
+    unsafe {
+        let obs = vec![e, n, spec.observation.flat_len()];
+        d.set_item("obs", view(owner, bufs.obs, obs)?)?;
+        d.set_item("rewards", view(owner, bufs.rewards, vec![e, n])?)?;
+        d.set_item("terminated", view(owner, bufs.terminated, vec![e, n])?)?;
+        d.set_item("truncated", view(owner, bufs.truncated, vec![e, n])?)?;
+        d.set_item("shield", view(owner, bufs.shield, vec![e, n])?)?;
+        if let Some(s) = &spec.state {
+            d.set_item("state", view(owner, bufs.state, vec![e, s.flat_len()])?)?;
+        }
+        if let Some(Space::Box { shape, .. }) = &spec.patch {
+            let patch = vec![e, n, shape[0], shape[1], shape[2]];
+            d.set_item("patch", view(owner, bufs.patch, patch)?)?;
+        }
+    }
+    Ok(())
+}
+
 /// Actions copied out of numpy (before the env's lock is taken, with the GIL held).
 pub(crate) enum Owned {
     Continuous(Vec<f32>),
