@@ -63,6 +63,10 @@ pub enum What {
         /// Robot (scenario order) started from rest for command to motion; needs --robots.
         #[arg(long)]
         robot: Option<usize>,
+        /// Write the measured `[tracker] latency` and `[rig] latency` into the scenario file (in
+        /// place, its comments kept).
+        #[arg(long)]
+        write_scenario: bool,
     },
     /// Colour sensors: ramps of red, green and blue under the parked robots, each sensor's transfer
     /// curve, crosstalk, gain and dark counts fitted from telemetry; needs --robots.
@@ -207,6 +211,7 @@ pub fn main(args: CalibrateArgs, text: &mut String) -> Result<()> {
             listen,
             marker_speed,
             robot,
+            write_scenario,
         } => {
             if robot.is_some() && common.robots.is_none() {
                 bail!("--robot: starting a robot needs --robots");
@@ -239,11 +244,28 @@ pub fn main(args: CalibrateArgs, text: &mut String) -> Result<()> {
             writeln!(text, "render to receipt:  {}", ms(report.render_to_receipt))?;
             writeln!(text, "render to photon:   {}", ms(report.render_to_photon))?;
             writeln!(text, "command to motion:  {}", ms(report.command_to_motion))?;
-            if let (Some(t), Some(r)) = (report.tracker_latency, report.rig_latency) {
-                writeln!(
+            match (report.tracker_latency, report.rig_latency) {
+                (Some(t), Some(r)) if write_scenario => {
+                    crate::scenario_write::set_numbers(
+                        &common.scenario,
+                        &[("tracker", "latency", t), ("rig", "latency", r)],
+                    )?;
+                    writeln!(
+                        text,
+                        "  wrote [tracker] latency = {t:.3} (the simulator's model) and [rig] latency = {r:.3} (the compensation) into {}",
+                        common.scenario.display()
+                    )?;
+                }
+                (Some(t), Some(r)) => writeln!(
                     text,
-                    "  set [tracker] latency = {t:.3} (the simulator's model) and [rig] latency = {r:.3} (the compensation)"
-                )?;
+                    "  set [tracker] latency = {t:.3} (the simulator's model) and [rig] latency = {r:.3} (the compensation), or rerun with --write-scenario"
+                )?,
+                _ if write_scenario => {
+                    bail!(
+                        "--write-scenario: the tracker's latency was not measured (no pose blocks with frame times)"
+                    )
+                }
+                _ => {}
             }
             writeln!(text, "  wrote {}", common.out.display())?;
         }

@@ -13,4 +13,5 @@ pub mod replay;
 pub mod report;
 pub mod rig;
 pub mod run;
+pub mod scenario_write;
 pub mod sweep;
