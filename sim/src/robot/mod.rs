@@ -2,6 +2,7 @@
 
 mod colias;
 mod drive;
+mod obstacle_contacts;
 mod physics;
 
 pub use colias::ColiasParams;

@@ -13,7 +13,8 @@
 //!   guarantees (inside the arena, small overlaps) but no momentum exchange.
 //!
 //! Both are single-threaded and deterministic: the same inputs give bit-identical poses.
-use super::{ColiasParams, Pose};
+use super::{ColiasParams, Pose, obstacle_contacts};
+use crate::arena::Obstacles;
 use crate::sensors::NeighbourIndex;
 use glam::Vec2;
 use rapier2d::prelude::{
@@ -21,6 +22,7 @@ use rapier2d::prelude::{
     Rotation, SpringCoefficients, Vector,
 };
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// Half-thickness of the wall boxes, m: thick enough that nothing can tunnel through.
 const WALL_HALF_THICKNESS: f32 = 0.5;
@@ -79,6 +81,8 @@ pub struct ArenaPhysics {
     poses: Vec<Pose>,
     size: Vec2,
     radius: f32,
+    /// Static obstacles (none unless [`ArenaPhysics::set_obstacles`] gave some).
+    obstacles: Arc<Obstacles>,
 }
 
 impl ArenaPhysics {
@@ -101,6 +105,7 @@ impl ArenaPhysics {
             poses: Vec::with_capacity(poses.len()),
             size,
             radius,
+            obstacles: Arc::default(),
         };
         for pose in poses {
             let p = physics.clamp_position(pose.pos);
@@ -118,6 +123,15 @@ impl ArenaPhysics {
             )));
         }
         physics
+    }
+
+    /// Adds the arena's static obstacles: robots collide with them (fixed rapier colliders, or the
+    /// disc solver's push-out). Call once, before the first step.
+    pub fn set_obstacles(&mut self, obstacles: Arc<Obstacles>) {
+        if let Solver::Rapier(state) = &mut self.solver {
+            obstacle_contacts::add_colliders(&mut state.world, &obstacles, FRICTION);
+        }
+        self.obstacles = obstacles;
     }
 
     /// The solver in use.
@@ -155,6 +169,7 @@ impl ArenaPhysics {
                     self.radius,
                     self.size,
                 );
+                obstacle_contacts::push_out(&mut self.poses, self.radius, &self.obstacles, lo, hi);
             }
         }
     }

@@ -2,6 +2,7 @@
 //! world that places and for the validation that must refuse what would not place.
 use super::Scenario;
 use super::spec::Placement;
+use crate::arena::Obstacles;
 use crate::error::{Result, SimError};
 use crate::rng::SimRng;
 use crate::robot::Pose;
@@ -45,6 +46,22 @@ impl Placed {
 /// world 0, the world builds with it, so a scenario that validates also places.
 pub(crate) fn place(sc: &Scenario, rng: &mut SimRng) -> Result<Vec<Pose>> {
     let s = &sc.spec;
+    // Robots start clear of the obstacles: explicit and grid poses inside one are errors, random
+    // placement draws again.
+    let obstacles = Obstacles::of_scenario(sc)?;
+    let inside = |key: String, p: Vec2| -> Result<()> {
+        match obstacles.overlapping(p, s.robot.radius, 0.0) {
+            Some(o) => Err(SimError::invalid(
+                key,
+                format!("[{}, {}]", p.x, p.y),
+                format!(
+                    "a robot of radius {} m there overlaps obstacles[{o}] ({:?})",
+                    s.robot.radius, s.obstacles[o].shape
+                ),
+            )),
+            None => Ok(()),
+        }
+    };
     let arena = sc.arena_size();
     let radius = s.robot.radius;
     let gap = 0.002;
@@ -87,6 +104,7 @@ pub(crate) fn place(sc: &Scenario, rng: &mut SimRng) -> Result<Vec<Pose>> {
                     if let Some(q) = placed.closer(pos, diameter2) {
                         return Err(overlap(format!("robots[{g}].poses[{n}]"), pos, q));
                     }
+                    inside(format!("robots[{g}].poses[{n}]"), pos)?;
                     placed.push(pos, g);
                     poses.push(Pose::new(p[0], p[1], p[2].to_radians()));
                 }
@@ -115,6 +133,7 @@ pub(crate) fn place(sc: &Scenario, rng: &mut SimRng) -> Result<Vec<Pose>> {
                     if let Some(q) = placed.closer(pos, diameter2) {
                         return Err(overlap(key, pos, q));
                     }
+                    inside(key.clone(), pos)?;
                     new.push(Pose { pos, heading });
                 }
                 new.iter().for_each(|p| placed.push(p.pos, g));
@@ -135,7 +154,9 @@ pub(crate) fn place(sc: &Scenario, rng: &mut SimRng) -> Result<Vec<Pose>> {
                     for _ in 0..10_000 {
                         let p =
                             Vec2::new(rng.random_range(lo.x..=hi.x), rng.random_range(lo.y..=hi.y));
-                        if placed.closer(p, min_d2).is_none() {
+                        if placed.closer(p, min_d2).is_none()
+                            && obstacles.overlapping(p, radius + gap, 0.0).is_none()
+                        {
                             let heading = heading(rng);
                             placed.push(p, g);
                             poses.push(Pose { pos: p, heading });

@@ -46,6 +46,9 @@ pub struct ScenarioSpec {
     pub pheromones: Vec<PheromoneSpec>,
     #[serde(default)]
     pub robots: Vec<RobotGroupSpec>,
+    /// Static obstacles (`[[obstacles]]`: boxes, discs, polygons, walls, image masks).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<crate::arena::ObstacleSpec>,
     /// How the scenario runs on the lab's hardware (`colcos bridge`) and its twin.
     #[serde(default, skip_serializing_if = "super::rig::RigSpec::is_default")]
     pub rig: super::rig::RigSpec,

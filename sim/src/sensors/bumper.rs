@@ -1,4 +1,5 @@
 //! Three IR bumpers (front-left, front, front-right).
+use crate::arena::Obstacles;
 use crate::robot::Pose;
 use crate::spatial::NeighbourIndex;
 use glam::Vec2;
@@ -113,6 +114,20 @@ impl NeighbourIndex {
         arena: Vec2,
         rays: &BumperRays,
     ) -> [f32; 3] {
+        self.bumpers_with(index, poses, radius, arena, rays, &Obstacles::default())
+    }
+
+    /// [`Self::bumpers`] in an arena with `obstacles`: each ray also stops at the first obstacle
+    /// (parry2d ray casts against the parts near the robot, found in the obstacles' grid).
+    pub fn bumpers_with(
+        &self,
+        index: usize,
+        poses: &[Pose],
+        radius: f32,
+        arena: Vec2,
+        rays: &BumperRays,
+        obstacles: &Obstacles,
+    ) -> [f32; 3] {
         let Some(me) = poses.get(index) else {
             return [0.0; 3];
         };
@@ -130,6 +145,11 @@ impl NeighbourIndex {
             dirs[s] = d;
             origins[s] = me.pos + radius * d;
             dists[s] = dists[s].min(ray_walls(origins[s], d, arena));
+        }
+        if !obstacles.is_empty() {
+            for s in 0..3 {
+                dists[s] = obstacles.ray(origins[s], dirs[s], dists[s]);
+            }
         }
         let reach = 2.0 * radius + range;
         let reach2 = reach * reach;

@@ -50,7 +50,9 @@ impl World {
         let spec = &scenario.spec;
         let arena = scenario.arena_size();
         let parts = WorldParts::build(scenario, world_index)?;
-        let physics = ArenaPhysics::with_backend(arena, &spec.robot, &parts.poses, spec.physics);
+        let mut physics =
+            ArenaPhysics::with_backend(arena, &spec.robot, &parts.poses, spec.physics);
+        physics.set_obstacles(parts.sensing.obstacles().clone());
         let tracking = Tracking::new(
             Tracker::new(spec.tracker, parts.poses.len()),
             rng::stream_of(spec.seed, world_index, Stream::Tracker),
@@ -150,17 +152,21 @@ impl WorldParts {
             }
         }
         let count = slots.len();
+        let mut sensing = Sensing::new(
+            ColourSensor::new(spec.sensor),
+            spec.bumper,
+            spec.robot.radius,
+            arena,
+            count,
+        );
+        sensing.set_obstacles(std::sync::Arc::new(crate::arena::Obstacles::of_scenario(
+            scenario,
+        )?));
         Ok(WorldParts {
             fields: FieldSet::new(pheromones),
             slots,
             injection: Injection::new(spec.field.inject_at, deposits, emitters, count),
-            sensing: Sensing::new(
-                ColourSensor::new(spec.sensor),
-                spec.bumper,
-                spec.robot.radius,
-                arena,
-                count,
-            ),
+            sensing,
             poses,
         })
     }

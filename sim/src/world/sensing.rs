@@ -1,6 +1,7 @@
 //! The sensing state: the colour sensor model, the bumper rays, the neighbour index of the current
 //! poses, every robot's sensor positions and its latest observation. Stages `index` and `sense`.
 use super::{FieldSet, PARALLEL_ROBOTS, RobotSlot};
+use crate::arena::Obstacles;
 use crate::behaviour::Observation;
 use crate::field::GridPrefetcher;
 use crate::robot::Pose;
@@ -10,6 +11,7 @@ use crate::sensors::{
 };
 use glam::Vec2;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 pub struct Sensing {
     sensor: ColourSensor,
@@ -20,6 +22,8 @@ pub struct Sensing {
     /// Arena size, m (bumpers see its walls).
     arena: Vec2,
     neighbours: NeighbourIndex,
+    /// Static obstacles the bumpers see (none by default).
+    obstacles: Arc<Obstacles>,
     /// Scratch: robot positions for the neighbour index.
     positions: Vec<Vec2>,
     /// The four sensor positions of every robot at the indexed poses.
@@ -42,6 +46,7 @@ impl Sensing {
             radius,
             arena,
             neighbours: NeighbourIndex::default(),
+            obstacles: Arc::default(),
             positions: Vec::new(),
             sensor_points: Vec::new(),
             observations: vec![Observation::default(); robots],
@@ -50,6 +55,13 @@ impl Sensing {
     /// The colour sensor model shared by all robots.
     pub fn sensor(&self) -> &ColourSensor {
         &self.sensor
+    }
+    /// The arena's static obstacles (what the bumpers see besides walls and robots).
+    pub fn obstacles(&self) -> &Arc<Obstacles> {
+        &self.obstacles
+    }
+    pub fn set_obstacles(&mut self, obstacles: Arc<Obstacles>) {
+        self.obstacles = obstacles;
     }
     /// The neighbour index of the last indexed poses.
     pub fn neighbours(&self) -> &NeighbourIndex {
@@ -100,6 +112,7 @@ pub fn sense(
     let (pheromones, frozen) = (fields.pheromones(), fields.frozen());
     let (sensor, neighbours, bumper) = (&sensing.sensor, &sensing.neighbours, &sensing.bumper_rays);
     let (radius, arena) = (sensing.radius, sensing.arena);
+    let obstacles = &*sensing.obstacles;
     let prefetcher = GridPrefetcher::new(pheromones);
     let sense = |(i, (slot, obs)): (usize, (&mut RobotSlot, &mut Observation))| {
         // The grid cells under the next robot's sensors are scattered over large fields: ask for
@@ -114,7 +127,7 @@ pub fn sense(
         };
         o.counts = sensor.read_all(pheromones, frozen, screen, &sensor_points[i], &mut slot.rng);
         o.intensity = sensor.intensities(&o.counts);
-        o.bumpers = neighbours.bumpers(i, poses, radius, arena, bumper);
+        o.bumpers = neighbours.bumpers_with(i, poses, radius, arena, bumper, obstacles);
         *obs = o;
     };
     if slots.len() >= PARALLEL_ROBOTS {
