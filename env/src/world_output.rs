@@ -40,6 +40,7 @@ pub fn render_world(world: &dyn ArenaView, agents: &[usize], width: u32) -> imag
     let width = width.max(16);
     let height = ((width as f32 * screen.size[1] / screen.size[0]).round() as u32).max(1);
     let mut img = colcos_sim::screen::render(world.pheromones(), screen, width, height);
+    colcos_sim::output::draw::obstacles(&mut img, screen, world.obstacles());
     const OTHERS: [[u8; 3]; 4] = [[255, 200, 0], [255, 0, 255], [0, 200, 255], [150, 150, 150]];
     let mut roles: Vec<&str> = Vec::new();
     let colours: Vec<image::Rgb<u8>> = (0..world.robot_count())

@@ -223,6 +223,24 @@ pub fn robots(
     }
 }
 
+/// Outline colour of physical obstacles: amber, apart from every pheromone and group colour's grey rim.
+pub const OBSTACLE_OUTLINE: Rgb<u8> = Rgb([255, 176, 0]);
+
+/// Every physical obstacle as its outline, as the overhead camera sees an object on the screen (the
+/// LCD under it draws nothing): a closed line two pixels wide.
+pub fn obstacles(img: &mut RgbImage, screen: &ScreenSpec, obstacles: &crate::arena::Obstacles) {
+    let (w, h) = (img.width(), img.height());
+    for (_, ring) in obstacles.outlines() {
+        for k in 0..ring.len() {
+            let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+            let (pa, pb) = (to_pixel(screen, w, h, a), to_pixel(screen, w, h, b));
+            line(img, pa, pb, OBSTACLE_OUTLINE);
+            line(img, (pa.0 + 1.0, pa.1), (pb.0 + 1.0, pb.1), OBSTACLE_OUTLINE);
+            line(img, (pa.0, pa.1 + 1.0), (pb.0, pb.1 + 1.0), OBSTACLE_OUTLINE);
+        }
+    }
+}
+
 /// A polyline of arena points.
 pub fn path(img: &mut RgbImage, screen: &ScreenSpec, points: &[Vec2], c: Rgb<u8>) {
     let (w, h) = (img.width(), img.height());

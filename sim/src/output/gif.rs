@@ -137,6 +137,8 @@ pub fn arena_image(
     height: u32,
 ) -> image::RgbImage {
     let mut img = screen::render(view.pheromones(), view.screen(), width, height);
+    // Physical obstacles as the overhead camera sees them: outlines, under the robots.
+    super::draw::obstacles(&mut img, view.screen(), view.obstacles());
     super::draw::robots(
         &mut img,
         view.screen(),

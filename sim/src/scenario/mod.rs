@@ -119,6 +119,10 @@ impl Scenario {
             .flat_map(|ph| ph.maps.iter_mut())
             .filter_map(|m| m.image.as_mut())
             .for_each(absolute);
+        spec.obstacles
+            .iter_mut()
+            .filter_map(|o| o.image.as_mut())
+            .for_each(absolute);
         spec.rig.screen_calibration.iter_mut().for_each(absolute);
         spec.rig.colour_calibration.iter_mut().for_each(absolute);
         toml::to_string_pretty(&spec).unwrap_or_default()

@@ -50,6 +50,10 @@ impl World {
     pub fn poses(&self) -> &[Pose] {
         self.robots.poses()
     }
+    /// The arena's static obstacles (empty when the scenario has none).
+    pub fn obstacles(&self) -> &crate::arena::Obstacles {
+        self.sensing.obstacles()
+    }
     /// Poses as the tracker last delivered them.
     pub fn tracked(&self) -> &[TrackedPose] {
         self.tracking.tracked()

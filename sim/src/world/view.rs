@@ -32,9 +32,18 @@ pub trait ArenaView {
     fn robot_count(&self) -> usize {
         self.poses().len()
     }
+    /// The arena's static obstacles (none unless the view has some).
+    fn obstacles(&self) -> &crate::arena::Obstacles {
+        static NONE: std::sync::LazyLock<crate::arena::Obstacles> =
+            std::sync::LazyLock::new(Default::default);
+        &NONE
+    }
 }
 
 impl ArenaView for World {
+    fn obstacles(&self) -> &crate::arena::Obstacles {
+        World::obstacles(self)
+    }
     fn arena(&self) -> Vec2 {
         World::arena(self)
     }
