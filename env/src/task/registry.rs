@@ -45,6 +45,12 @@ pub fn build(
     params: &serde_json::Value,
 ) -> Result<(Box<dyn Task>, Scenario)> {
     let (_, _, default, builder) = find(name)?;
+    // A task option may pick another built-in scenario (`trail`'s `maze`).
+    let default = if name == "trail" {
+        trail::default_scenario(params)
+    } else {
+        default
+    };
     let scenario = source.load(default)?;
     let task = builder(&scenario, params)?;
     if task.agents().is_empty() {

@@ -3,6 +3,9 @@
 //!
 //! Reward per agent and step: `forward speed / max speed * strength of channel` (its own sensors'
 //! mean intensity), minus `bump_penalty * strongest bumper`. No termination.
+//!
+//! `maze = true` runs the loop as a walled corridor (the built-in `trail_maze` scenario: an island and
+//! an outer wall, `[[obstacles]]`); the bumper penalty then also counts the walls.
 use super::{Task, check_non_negative, parse_params, require_role};
 use crate::error::{EnvError, Result};
 use colcos_sim::behaviour::channel_index;
@@ -14,6 +17,17 @@ use serde::Deserialize;
 pub const DESCRIPTION: &str =
     "follow a colour trail forward while laying one (static loop plus the robots' own trails)";
 pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/trail.toml");
+/// The built-in scenario with `maze = true`.
+pub const MAZE_SCENARIO: &str = include_str!("../../scenarios/trail_maze.toml");
+
+/// The built-in scenario `params` ask for (`maze = true`: the walled corridor); a malformed `maze`
+/// falls back to the plain loop and [`build`] reports it.
+pub fn default_scenario(params: &serde_json::Value) -> &'static str {
+    match params.get("maze") {
+        Some(serde_json::Value::Bool(true)) => MAZE_SCENARIO,
+        _ => DEFAULT_SCENARIO,
+    }
+}
 
 #[derive(Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -22,6 +36,9 @@ struct Params {
     /// Channel of the trail to follow: "r", "g" or "b".
     channel: String,
     bump_penalty: f32,
+    /// The walled corridor: the built-in `trail_maze` scenario, or a scenario of one's own that
+    /// lists `[[obstacles]]`.
+    maze: bool,
 }
 
 impl Default for Params {
@@ -30,6 +47,7 @@ impl Default for Params {
             agent_role: "agent".into(),
             channel: "b".into(),
             bump_penalty: 0.1,
+            maze: false,
         }
     }
 }
@@ -43,6 +61,15 @@ pub struct Trail {
 
 pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn Task>> {
     let p: Params = parse_params("trail", params)?;
+    if p.maze && scenario.spec.obstacles.is_empty() {
+        return Err(EnvError::param(
+            "trail.maze",
+            format!(
+                "true, but scenario {:?} lists no [[obstacles]] (use the built-in scenario or add walls)",
+                scenario.spec.name
+            ),
+        ));
+    }
     let agents = require_role(scenario, &p.agent_role, "trail.agent_role")?;
     let channel = channel_index(&p.channel).ok_or_else(|| {
         EnvError::param(
