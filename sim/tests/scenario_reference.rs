@@ -20,6 +20,20 @@ physics = "discs"
 [arena]
 size = [1.0, 0.8]
 
+[[obstacles]]
+shape = "box"
+kind = "physical"
+centre = [0.5, 0.4]
+size = [0.1, 0.05]
+angle = 30.0
+radius = 0.05
+points = [[0.1, 0.1], [0.2, 0.1], [0.2, 0.2]]
+thickness = 0.01
+image = "mask.png"
+channel = "a"
+threshold = 128
+pixels = [64, 48]
+
 [screen]
 resolution = [1920, 1080]
 size = [1.2, 0.7]
