@@ -295,3 +295,63 @@ fn robots_are_placed_off_obstacles_or_refused() {
         }
     }
 }
+
+#[test]
+fn the_grid_finds_what_a_scan_of_every_part_finds() {
+    use parry2d::query::{Ray, RayCast};
+    // 60 small obstacles of every shape scattered over the arena; 2,000 random rays.
+    let mut text = String::new();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    for k in 0..60 {
+        let c = Vec2::new(rng.random_range(0.1..0.9), rng.random_range(0.1..0.9));
+        text += &match k % 4 {
+            0 => format!(
+                "[[obstacles]]\nshape = \"box\"\ncentre = [{}, {}]\nsize = [0.05, 0.02]\nangle = {}\n",
+                c.x,
+                c.y,
+                k * 13
+            ),
+            1 => format!(
+                "[[obstacles]]\nshape = \"disc\"\ncentre = [{}, {}]\nradius = 0.03\n",
+                c.x, c.y
+            ),
+            2 => format!(
+                "[[obstacles]]\nshape = \"wall\"\npoints = [[{}, {}], [{}, {}]]\nthickness = 0.005\n",
+                c.x - 0.05,
+                c.y,
+                c.x + 0.05,
+                c.y + 0.02
+            ),
+            _ => format!(
+                "[[obstacles]]\nshape = \"polygon\"\npoints = [[{}, {}], [{}, {}], [{}, {}], [{}, {}]]\n",
+                c.x - 0.04,
+                c.y - 0.04,
+                c.x + 0.04,
+                c.y - 0.04,
+                c.x,
+                c.y - 0.01,
+                c.x - 0.04,
+                c.y + 0.04
+            ),
+        };
+    }
+    let obs = obstacles(&text);
+    for _ in 0..2000 {
+        let o = Vec2::new(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+        let d = Vec2::from_angle(rng.random_range(-3.2..3.2));
+        let max = rng.random_range(0.0..0.1);
+        let scan = obs
+            .parts()
+            .iter()
+            .filter_map(|p| p.shape.cast_ray(&p.pose, &Ray::new(o, d), max, true))
+            .fold(max, f32::min);
+        let grid = obs.ray(o, d, max);
+        assert!(
+            close(grid, scan, 1e-6),
+            "ray {o:?} {d:?} {max}: grid {grid}, scan {scan}"
+        );
+        let mut three = [max; 3];
+        obs.rays(o, max, &[o; 3], &[d; 3], &mut three);
+        assert!(close(three[0], scan, 1e-6), "rays: {three:?} vs {scan}");
+    }
+}

@@ -193,6 +193,32 @@ impl Obstacles {
         best
     }
 
+    /// [`Self::ray`] for several rays starting within `reach` of `centre` and no longer than
+    /// `reach` from it: one grid query for all of them (a robot's three bumper rays). `dists` holds
+    /// each ray's length on entry and its distance to the first obstacle within it on return.
+    pub fn rays<const N: usize>(
+        &self,
+        centre: Vec2,
+        reach: f32,
+        origins: &[Vec2; N],
+        dirs: &[Vec2; N],
+        dists: &mut [f32; N],
+    ) {
+        let r = Vec2::splat(reach);
+        self.for_each_near(centre - r, centre + r, |part| {
+            for s in 0..N {
+                // Most rays near a part miss its bounds: a slab test spares the shape's ray cast.
+                if !ray_meets_box(origins[s], dirs[s], dists[s], part.lo, part.hi) {
+                    continue;
+                }
+                let ray = Ray::new(origins[s], dirs[s]);
+                if let Some(t) = part.shape.cast_ray(&part.pose, &ray, dists[s], true) {
+                    dists[s] = dists[s].min(t);
+                }
+            }
+        });
+    }
+
     /// The obstacle (index in `[[obstacles]]`) that a disc of `radius` at `p` overlaps by more than
     /// `slack` m, if any.
     pub fn overlapping(&self, p: Vec2, radius: f32, slack: f32) -> Option<usize> {
@@ -254,4 +280,16 @@ impl Obstacles {
         }
         p
     }
+}
+
+/// Whether the segment `o + t d`, `t` in `[0, len]`, meets the box `lo..hi` (slab test).
+#[inline]
+fn ray_meets_box(o: Vec2, d: Vec2, len: f32, lo: Vec2, hi: Vec2) -> bool {
+    let inv = d.recip();
+    let (t1, t2) = ((lo - o) * inv, (hi - o) * inv);
+    let (near, far) = (t1.min(t2), t1.max(t2));
+    // A ray running exactly along a box edge (0 * inf = NaN, ignored by min/max) counts as a miss.
+    let enter = near.x.max(near.y).max(0.0);
+    let exit = far.x.min(far.y).min(len);
+    !(enter > exit)
 }

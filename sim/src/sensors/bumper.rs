@@ -147,9 +147,7 @@ impl NeighbourIndex {
             dists[s] = dists[s].min(ray_walls(origins[s], d, arena));
         }
         if !obstacles.is_empty() {
-            for s in 0..3 {
-                dists[s] = obstacles.ray(origins[s], dirs[s], dists[s]);
-            }
+            obstacles.rays(me.pos, radius + range, &origins, &dirs, &mut dists);
         }
         let reach = 2.0 * radius + range;
         let reach2 = reach * reach;
