@@ -1,7 +1,7 @@
 //! The RL plants over loopback: the digital twin started in-process and a recorded run replayed, with
 //! the spaces and outputs of the simulated environment, and the shield keeping a policy that drives at
 //! the walls inside the arena.
-use colcos_bridge::plant::{LiveEnv, PlantKind, PlantOptions};
+use colcos_bridge::plant::{LiveEnv, PlantKind, PlantOptions, TwinScenario};
 use colcos_env::{EnvConfig, VecEnv};
 use colcos_sim::world::ArenaView;
 
@@ -109,4 +109,65 @@ fn a_plant_without_what_it_needs_names_it() {
     replay.log = Some("/nonexistent/rig.mcap".into());
     assert!(err(replay).contains("/nonexistent/rig.mcap"));
     assert!("simulator".parse::<PlantKind>().is_err());
+}
+
+/// Steps (20 ms) from the first full-ahead command until the tracker shows the host any robot moved
+/// 8 mm (the tracker's noise is 1 mm), on a twin playing `twin` (none: the host's scenario).
+fn steps_until_seen_moving(twin: Option<TwinScenario>) -> usize {
+    let cfg = config();
+    let mut opts = PlantOptions::new(PlantKind::Twin);
+    opts.goto = false;
+    opts.twin_scenario = twin;
+    let mut env = LiveEnv::new(&cfg, &opts).unwrap();
+    env.reset(Some(5)).unwrap();
+    let n = env.spec().num_agents;
+    // Still for half a second: every pose the host holds is of robots at rest.
+    for _ in 0..25 {
+        env.step(Some(&vec![0.0; 2 * n]), None).unwrap();
+    }
+    let start: Vec<_> = env.host().tracked().to_vec();
+    for k in 1..=60 {
+        env.step(Some(&full_ahead(n)), None).unwrap();
+        let moved = env
+            .host()
+            .tracked()
+            .iter()
+            .zip(&start)
+            .any(|(p, s)| (p.pose.pos - s.pose.pos).length() > 0.008);
+        if moved {
+            return k;
+        }
+    }
+    panic!("no robot seen moving within 60 steps");
+}
+
+#[test]
+fn a_twin_with_its_own_tracker_latency_is_seen_later_by_the_host() {
+    let own = steps_until_seen_moving(None);
+    let late = steps_until_seen_moving(Some(TwinScenario::Overrides(vec![(
+        "tracker.latency".into(),
+        serde_json::json!(0.2),
+    )])));
+    // The host's scenario says 40 ms; the twin's tracker holds poses back 200 ms: ~8 ticks later.
+    assert!(
+        late >= own + 5,
+        "seen moving after {own} steps on the host's twin, {late} on the late one"
+    );
+}
+
+#[test]
+fn a_twin_scenario_of_another_arena_or_with_urls_is_refused() {
+    let cfg = config();
+    let mut opts = PlantOptions::new(PlantKind::Twin);
+    opts.twin_scenario = Some(TwinScenario::Overrides(vec![(
+        "dt".into(),
+        serde_json::json!(0.04),
+    )]));
+    let err = LiveEnv::new(&cfg, &opts).err().unwrap().to_string();
+    assert!(err.contains("`twin_scenario.dt`"), "{err}");
+    opts.twin_scenario = Some(TwinScenario::Overrides(vec![]));
+    opts.tracker = Some("swarmcon://127.0.0.1:1".into());
+    opts.robots = Some("udp://127.0.0.1:1".into());
+    let err = LiveEnv::new(&cfg, &opts).err().unwrap().to_string();
+    assert!(err.contains("`twin_scenario`"), "{err}");
 }

@@ -114,6 +114,14 @@ pub(crate) struct TwinThread {
 
 impl TwinThread {
     pub fn start(scenario: &Scenario) -> Result<TwinThread, PlantError> {
+        Self::start_seeing(scenario, None)
+    }
+
+    /// A twin of `scenario`; colour readings from the frame stream at `frames` when given.
+    pub fn start_seeing(
+        scenario: &Scenario,
+        frames: Option<std::net::SocketAddr>,
+    ) -> Result<TwinThread, PlantError> {
         let io = |what: &str, e: std::io::Error| {
             PlantError::Io(format!("starting the twin's {what}: {e}"))
         };
@@ -125,7 +133,7 @@ impl TwinThread {
             "udp://{}",
             channel.local_addr().map_err(|e| io("robot link", e))?
         );
-        let mut twin = Twin::new(scenario, tracker, Box::new(channel), None)?;
+        let mut twin = Twin::new(scenario, tracker, Box::new(channel), frames)?;
         let stop = Arc::new(AtomicBool::new(false));
         let s = stop.clone();
         let handle = std::thread::Builder::new()

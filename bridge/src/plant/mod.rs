@@ -12,11 +12,14 @@
 mod calibration_gate;
 pub(crate) mod driver;
 mod goto;
+mod twin_scenario;
 
 pub use goto::GoTo;
+pub use twin_scenario::TwinScenario;
 
 use crate::calibrate::RigCalibration;
 use crate::colias::LegacyDrive;
+use crate::frames::FrameServer;
 use crate::host::Host;
 use crate::live::{LiveOptions, LiveSession, LoopCore, replay};
 use crate::{SourceOptions, open_pose_source, open_robot_link};
@@ -26,11 +29,16 @@ use colcos_env::world_output::{render_world, write_obs, write_patch, write_state
 use colcos_env::{EnvConfig, EnvError, EnvSpec, Space, Task, VecEnv, shield_bits};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Pose;
-use colcos_sim::scenario::Scenario;
+use colcos_sim::scenario::{Scenario, SensorSource};
 use colcos_sim::world::WorldParts;
 use driver::{Driver, TwinThread};
 use std::path::PathBuf;
 use std::time::Instant;
+
+/// The frames the host streams to a twin started here whose robots read their own sensors: wide
+/// enough for a sensor's footprint to cover a few pixels, at twice the default telemetry rate.
+const TWIN_FRAME_WIDTH: u32 = 480;
+const TWIN_FRAME_HZ: f64 = 10.0;
 
 /// Where a plant's arena is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,6 +81,9 @@ pub struct PlantOptions {
     pub calibration_max_age: f64,
     /// ... and its RMS reprojection error at most this, mm.
     pub calibration_max_error_mm: f64,
+    /// `twin` started here: the scenario the twin plays (its true tracker latency, sensors, robot
+    /// body) where it differs from the host's; None: the host's own.
+    pub twin_scenario: Option<TwinScenario>,
 }
 
 impl PlantOptions {
@@ -86,6 +97,7 @@ impl PlantOptions {
             goto_timeout: 30.0,
             calibration_max_age: 7.0 * 86400.0,
             calibration_max_error_mm: 3.0,
+            twin_scenario: None,
         }
     }
 }
@@ -225,8 +237,32 @@ impl LiveEnv {
                 next: 0,
             });
         }
+        let local =
+            plant.kind == PlantKind::Twin && plant.tracker.is_none() && plant.robots.is_none();
+        if plant.twin_scenario.is_some() && !local {
+            return Err(PlantError::option(
+                "twin_scenario",
+                "only a twin started here (plant twin, no `tracker`/`robots` URLs) plays its own \
+                 scenario; a twin elsewhere takes its scenario where it is started (`colcos twin`)",
+            ));
+        }
+        // Robots reading their own sensors: the twin's readings come from the frames the host
+        // shows, as on the rig's LCD, so the host streams them to it.
+        let frames = (local && scenario.spec.rig.sensors == SensorSource::Robot)
+            .then(|| FrameServer::bind("127.0.0.1:0"))
+            .transpose()
+            .map_err(|e| PlantError::Io(format!("starting the frame stream for the twin: {e}")))?;
         let twin = match (plant.kind, &plant.tracker, &plant.robots) {
-            (PlantKind::Twin, None, None) => Some(TwinThread::start(scenario)?),
+            (PlantKind::Twin, None, None) => {
+                let own = match &plant.twin_scenario {
+                    Some(t) => t.resolve(scenario)?,
+                    None => scenario.clone(),
+                };
+                Some(TwinThread::start_seeing(
+                    &own,
+                    frames.as_ref().map(|f| f.local_addr()),
+                )?)
+            }
             (_, Some(_), Some(_)) => None,
             (kind, _, _) => {
                 let which = if kind == PlantKind::Rig {
@@ -264,9 +300,11 @@ impl LiveEnv {
         let link = open_robot_link(&robots)?;
         let live = LiveOptions {
             log: plant.log.clone(),
+            stream_width: TWIN_FRAME_WIDTH,
+            stream_hz: TWIN_FRAME_HZ,
             ..LiveOptions::default()
         };
-        let session = LiveSession::new(scenario, source, link, None, live)?;
+        let session = LiveSession::new(scenario, source, link, frames, live)?;
         Ok(Driver::Live {
             session: Box::new(session),
             _twin: twin,
