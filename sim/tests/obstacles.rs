@@ -355,3 +355,80 @@ fn the_grid_finds_what_a_scan_of_every_part_finds() {
         assert!(close(three[0], scan, 1e-6), "rays: {three:?} vs {scan}");
     }
 }
+
+const DISC_ARENA: &str = r#"
+duration = 1.0
+[screen]
+size = [1.0, 1.0]
+resolution = [200, 200]
+[arena]
+shape = { disc = { centre = [0.5, 0.5], radius = 0.45 } }
+"#;
+
+#[test]
+fn a_disc_arena_holds_its_robots() {
+    let text = format!("{DISC_ARENA}[[robots]]\ncount = 40\nbehaviour = \"avoid\"\n");
+    let sc = Scenario::from_toml_str(&text, ".").unwrap();
+    let obs = Arc::new(Obstacles::of_scenario(&sc).unwrap());
+    // Bumper: facing the wall 1 cm from the rim (the wall's inner face is the disc's edge).
+    let r = bumpers(&obs, Pose::new(0.5 + 0.45 - R - 0.01, 0.5, 0.0));
+    assert!(close(r[1], 0.5, 1e-2), "{r:?}");
+    for backend in BACKENDS {
+        let world = World::new(&sc).unwrap();
+        let poses = world.poses().to_vec();
+        for p in &poses {
+            assert!(obs.holds(p.pos, R), "{backend:?}: placed at {:?}", p.pos);
+        }
+        let mut phys = ArenaPhysics::with_backend(ARENA, &ColiasParams::default(), &poses, backend);
+        phys.set_obstacles(obs.clone());
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        let mut v = vec![(0.0, 0.0); poses.len()];
+        for step in 0..3000 {
+            if step % 25 == 0 {
+                for x in v.iter_mut() {
+                    *x = (rng.random_range(0.0..0.35), rng.random_range(-3.0..3.0));
+                }
+            }
+            phys.step(&v, 0.02);
+            for p in phys.poses() {
+                // Within the disc, up to 2 mm into its wall.
+                assert!(
+                    p.pos.distance(Vec2::splat(0.5)) <= 0.45 - R + 0.002,
+                    "{backend:?} step {step}: {:?} left the disc",
+                    p.pos
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn arena_shapes_are_checked() {
+    let e = err(&format!(
+        "[arena]\nshape = {{ disc = {{ centre = [0.5, 0.5], radius = 0.6 }} }}\n"
+    ));
+    assert!(
+        e.contains("arena.shape") && e.contains("outside the arena"),
+        "{e}"
+    );
+    let e = err("[arena]\nshape = { polygon = [[0.1, 0.1], [0.9, 0.1], [0.5, 0.1]] }\n");
+    assert!(e.contains("arena.shape") && e.contains("no area"), "{e}");
+    let text = DISC_ARENA.to_string()
+        + "[[robots]]\ncount = 1\nbehaviour = \"avoid\"\nplacement = \"explicit\"\nposes = [[0.05, 0.05, 0]]\n";
+    let e = Scenario::from_toml_str(&text, ".").unwrap_err().to_string();
+    assert!(
+        e.contains("robots[0].poses[0]") && e.contains("outside the arena's shape"),
+        "{e}"
+    );
+    // A concave (L-shaped) arena: random placement keeps to the L.
+    let l = "[arena]\nshape = { polygon = [[0.05, 0.05], [0.95, 0.05], [0.95, 0.4], [0.4, 0.4], [0.4, 0.95], [0.05, 0.95]] }\n";
+    let sc = Scenario::from_toml_str(&format!("{BASE}{l}"), ".").unwrap();
+    let world = World::new(&sc).unwrap();
+    for p in world.poses() {
+        assert!(
+            p.pos.x <= 0.4 || p.pos.y <= 0.4,
+            "placed at {:?} in the L's notch",
+            p.pos
+        );
+    }
+}

@@ -5,12 +5,14 @@
 //! bucketed into a grid over the arena, so the queries of the bumpers (three short rays per robot),
 //! of the disc solver (push a robot out) and of placement (is this spot free?) look at the parts near
 //! the robot only, never at all of them.
+mod boundary;
 mod mask;
 mod shapes;
 mod spec;
 
+pub use boundary::{BOUNDARY, BOUNDARY_THICKNESS, Inside};
 pub use mask::{MaskRect, merge_runs, solid_rects};
-pub use spec::{ObstacleKind, ObstacleShape, ObstacleSpec};
+pub use spec::{ArenaShape, ObstacleKind, ObstacleShape, ObstacleSpec};
 
 use crate::error::Result;
 use glam::Vec2;
@@ -49,13 +51,28 @@ pub struct Obstacles {
     /// `starts[k]..starts[k + 1]` indexes `items` for cell `k`.
     starts: Vec<u32>,
     items: Vec<u32>,
+    /// Where robots may be, for an arena of another shape than its rectangle.
+    inside: Option<Inside>,
 }
 
 impl Obstacles {
     /// The obstacles of `specs` in an arena of `arena` size (m), image masks read relative to
     /// `base_dir`. Errors name the key (`obstacles[2].size`) and why.
     pub fn build(specs: &[ObstacleSpec], arena: Vec2, base_dir: &Path) -> Result<Obstacles> {
+        Self::build_in(specs, None, arena, base_dir)
+    }
+
+    /// [`Self::build`] in an arena bounded by `shape` (a disc or polygon wall within the rectangle).
+    pub fn build_in(
+        specs: &[ObstacleSpec],
+        shape: Option<&ArenaShape>,
+        arena: Vec2,
+        base_dir: &Path,
+    ) -> Result<Obstacles> {
         let mut out = Obstacles::default();
+        if let Some(shape) = shape {
+            boundary::add(&mut out, shape, arena)?;
+        }
         for (i, spec) in specs.iter().enumerate() {
             shapes::add(&mut out, i, spec, arena, base_dir)?;
         }
@@ -65,12 +82,22 @@ impl Obstacles {
 
     /// The obstacles of a scenario (none when it lists none).
     pub fn of_scenario(sc: &crate::scenario::Scenario) -> Result<Obstacles> {
-        Self::build(&sc.spec.obstacles, sc.arena_size(), &sc.base_dir)
+        Self::build_in(
+            &sc.spec.obstacles,
+            sc.spec.arena.shape.as_ref(),
+            sc.arena_size(),
+            &sc.base_dir,
+        )
     }
 
     /// True when there are no obstacles.
     pub fn is_empty(&self) -> bool {
         self.parts.is_empty()
+    }
+
+    /// Whether a disc of `radius` at `p` lies within the arena's shape (always, for a rectangle).
+    pub fn holds(&self, p: Vec2, radius: f32) -> bool {
+        self.inside.as_ref().is_none_or(|i| i.holds(p, radius))
     }
 
     /// The parry2d parts (for rapier colliders).

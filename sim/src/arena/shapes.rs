@@ -240,7 +240,7 @@ pub(super) fn add(
 }
 
 /// Twice the signed area (positive counter-clockwise).
-fn signed_area(v: &[Vec2]) -> f32 {
+pub(super) fn signed_area(v: &[Vec2]) -> f32 {
     let n = v.len();
     (0..n).map(|k| v[k].perp_dot(v[(k + 1) % n])).sum::<f32>()
 }
@@ -253,15 +253,12 @@ fn is_convex(v: &[Vec2]) -> bool {
     })
 }
 
-/// At least 3 distinct points, a non-zero area and no two edges crossing.
-fn polygon_checks(key: &str, shown: &str, v: &[Vec2]) -> Result<()> {
+/// At least 3 distinct points, no two edges crossing and a non-zero area.
+pub(super) fn polygon_checks(key: &str, shown: &str, v: &[Vec2]) -> Result<()> {
     let bad = |reason: String| Err(SimError::invalid(key, shown, reason));
     let n = v.len();
     if n < 3 {
         return bad(format!("a polygon needs at least 3 points, not {n}"));
-    }
-    if signed_area(v).abs() < 1e-9 {
-        return bad("the polygon has no area (its points are on a line)".into());
     }
     for k in 0..n {
         if v[k].distance(v[(k + 1) % n]) < 1e-6 {
@@ -285,6 +282,10 @@ fn polygon_checks(key: &str, shown: &str, v: &[Vec2]) -> Result<()> {
                 ));
             }
         }
+    }
+    // Below a square of 0.1 mm (rounding of collinear points leaves ~1e-9).
+    if signed_area(v).abs() < 1e-8 {
+        return bad("the polygon has no area (its points are on a line)".into());
     }
     Ok(())
 }

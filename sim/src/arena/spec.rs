@@ -66,3 +66,14 @@ pub struct ObstacleSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pixels: Option<[u32; 2]>,
 }
+
+/// `[arena] shape`: an arena bounded by a disc or a polygon inside the `[0, w] x [0, h]` rectangle
+/// (by default the rectangle itself). The boundary is a wall robots collide with and bumpers see.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ArenaShape {
+    /// `shape = { disc = { centre = [x, y], radius = r } }`.
+    Disc { centre: [f32; 2], radius: f32 },
+    /// `shape = { polygon = [[x, y], ...] }`: the vertices in order, convex or concave.
+    Polygon(Vec<[f32; 2]>),
+}

@@ -50,17 +50,21 @@ pub(crate) fn place(sc: &Scenario, rng: &mut SimRng) -> Result<Vec<Pose>> {
     // placement draws again.
     let obstacles = Obstacles::of_scenario(sc)?;
     let inside = |key: String, p: Vec2| -> Result<()> {
-        match obstacles.overlapping(p, s.robot.radius, 0.0) {
-            Some(o) => Err(SimError::invalid(
-                key,
-                format!("[{}, {}]", p.x, p.y),
-                format!(
-                    "a robot of radius {} m there overlaps obstacles[{o}] ({:?})",
-                    s.robot.radius, s.obstacles[o].shape
-                ),
-            )),
-            None => Ok(()),
-        }
+        let what = match obstacles.overlapping(p, s.robot.radius, 0.0) {
+            Some(o) => match s.obstacles.get(o) {
+                Some(ob) => format!("overlaps obstacles[{o}] ({:?})", ob.shape),
+                None => "overlaps the arena's boundary (arena.shape)".to_string(),
+            },
+            None if !obstacles.holds(p, s.robot.radius) => {
+                "lies outside the arena's shape (arena.shape)".to_string()
+            }
+            None => return Ok(()),
+        };
+        Err(SimError::invalid(
+            key,
+            format!("[{}, {}]", p.x, p.y),
+            format!("a robot of radius {} m there {what}", s.robot.radius),
+        ))
     };
     let arena = sc.arena_size();
     let radius = s.robot.radius;
@@ -156,6 +160,7 @@ pub(crate) fn place(sc: &Scenario, rng: &mut SimRng) -> Result<Vec<Pose>> {
                             Vec2::new(rng.random_range(lo.x..=hi.x), rng.random_range(lo.y..=hi.y));
                         if placed.closer(p, min_d2).is_none()
                             && obstacles.overlapping(p, radius + gap, 0.0).is_none()
+                            && obstacles.holds(p, radius + gap)
                         {
                             let heading = heading(rng);
                             placed.push(p, g);

@@ -70,6 +70,9 @@ fn default_dt() -> f32 {
 pub struct ArenaSpec {
     /// Width and height, m (default: the screen's size).
     pub size: Option<[f32; 2]>,
+    /// A disc or polygon boundary inside that rectangle (default: the rectangle).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<crate::arena::ArenaShape>,
 }
 
 /// Where pheromone is injected: at the tracker's poses (as in the real rig) or the true ones.
