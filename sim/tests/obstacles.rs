@@ -298,7 +298,7 @@ fn robots_are_placed_off_obstacles_or_refused() {
 
 #[test]
 fn the_grid_finds_what_a_scan_of_every_part_finds() {
-    use parry2d::query::{Ray, RayCast};
+    use parry2d::query::Ray;
     // 60 small obstacles of every shape scattered over the arena; 2,000 random rays.
     let mut text = String::new();
     let mut rng = rand::rngs::StdRng::seed_from_u64(11);
@@ -404,9 +404,7 @@ fn a_disc_arena_holds_its_robots() {
 
 #[test]
 fn arena_shapes_are_checked() {
-    let e = err(&format!(
-        "[arena]\nshape = {{ disc = {{ centre = [0.5, 0.5], radius = 0.6 }} }}\n"
-    ));
+    let e = err("[arena]\nshape = { disc = { centre = [0.5, 0.5], radius = 0.6 } }\n");
     assert!(
         e.contains("arena.shape") && e.contains("outside the arena"),
         "{e}"

@@ -318,5 +318,6 @@ fn ray_meets_box(o: Vec2, d: Vec2, len: f32, lo: Vec2, hi: Vec2) -> bool {
     // A ray running exactly along a box edge (0 * inf = NaN, ignored by min/max) counts as a miss.
     let enter = near.x.max(near.y).max(0.0);
     let exit = far.x.min(far.y).min(len);
-    !(enter > exit)
+    // Neither is NaN: `f32::max` and `min` return the other operand.
+    enter <= exit
 }

@@ -235,8 +235,18 @@ pub fn obstacles(img: &mut RgbImage, screen: &ScreenSpec, obstacles: &crate::are
             let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
             let (pa, pb) = (to_pixel(screen, w, h, a), to_pixel(screen, w, h, b));
             line(img, pa, pb, OBSTACLE_OUTLINE);
-            line(img, (pa.0 + 1.0, pa.1), (pb.0 + 1.0, pb.1), OBSTACLE_OUTLINE);
-            line(img, (pa.0, pa.1 + 1.0), (pb.0, pb.1 + 1.0), OBSTACLE_OUTLINE);
+            line(
+                img,
+                (pa.0 + 1.0, pa.1),
+                (pb.0 + 1.0, pb.1),
+                OBSTACLE_OUTLINE,
+            );
+            line(
+                img,
+                (pa.0, pa.1 + 1.0),
+                (pb.0, pb.1 + 1.0),
+                OBSTACLE_OUTLINE,
+            );
         }
     }
 }
