@@ -297,7 +297,7 @@ pub fn main(args: CalibrateArgs, text: &mut String) -> Result<()> {
             )?;
             writeln!(
                 text,
-                "  wrote {}: name it in the scenario as [rig] colour_calibration",
+                "  wrote {}: name it in the scenario as [rig] colour_calibration (and set [sensor] per_robot = true to simulate these sensors)",
                 common.out.display()
             )?;
         }

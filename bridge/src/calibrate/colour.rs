@@ -5,11 +5,11 @@
 //! Model, per sensor: `counts_c = dark_c + sum_k matrix[c][k] * (level_k / 255) ^ gamma`, where
 //! `matrix = gain * integration_ms * crosstalk`. Gain and crosstalk only show up as their product,
 //! so the file keeps the matrix and reports the gain as its mean diagonal per ms.
-use super::{CalibrationError, utc_now};
-use colcos_sim::sensors::{ColourSensor, ColourSensorParams, invert3};
+use super::CalibrationError;
+/// The file format and the fitted model live in the simulator, which reads the screen through them.
+pub use colcos_sim::sensors::{ColourCalibration, RobotColour, SensorFit};
 use nalgebra::{Matrix4, Vector4};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// Counts a channel saturates at; saturated readings are left out of the fit.
 const SATURATED: f64 = 65_535.0;
@@ -19,60 +19,6 @@ const SATURATED: f64 = 65_535.0;
 pub struct ColourSample {
     pub levels: [f64; 3],
     pub counts: [f64; 3],
-}
-
-/// One sensor's fitted model.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SensorFit {
-    pub gamma: f64,
-    pub dark: [f64; 3],
-    /// counts_c per unit light of primary k (gain x integration time x crosstalk).
-    pub matrix: [[f64; 3]; 3],
-    /// Counts per unit light per ms (the mean of the matrix's diagonal over the integration time).
-    pub gain: f64,
-    /// The matrix over gain x integration time.
-    pub crosstalk: [[f64; 3]; 3],
-    /// Root mean square residual of the samples fitted, counts.
-    pub rms_counts: f64,
-}
-
-impl SensorFit {
-    /// The counts the model predicts for `levels` (without noise or saturation).
-    pub fn predict(&self, levels: [f64; 3]) -> [f64; 3] {
-        let light = levels.map(|l| (l / 255.0).clamp(0.0, 1.0).powf(self.gamma));
-        std::array::from_fn(|c| {
-            self.dark[c] + (0..3).map(|k| self.matrix[c][k] * light[k]).sum::<f64>()
-        })
-    }
-
-    /// Screen intensity (level / 255) per primary from raw counts: the calibrated inverse.
-    pub fn intensity(&self, counts: [u16; 3]) -> [f64; 3] {
-        let m = self.matrix.map(|r| r.map(|v| v as f32));
-        let Some(inv) = invert3(&m) else {
-            return [0.0; 3];
-        };
-        let signal: [f64; 3] = std::array::from_fn(|c| counts[c] as f64 - self.dark[c]);
-        std::array::from_fn(|k| {
-            let light: f64 = (0..3).map(|c| inv[k][c] as f64 * signal[c]).sum();
-            if counts[k] as f64 >= SATURATED {
-                1.0
-            } else {
-                light.clamp(0.0, 1.0).powf(1.0 / self.gamma)
-            }
-        })
-    }
-
-    /// The simulator's sensor parameters for this sensor (the rest from `base`).
-    pub fn params(&self, base: &ColourSensorParams) -> ColourSensorParams {
-        ColourSensorParams {
-            gamma: self.gamma as f32,
-            crosstalk: self.crosstalk.map(|r| r.map(|v| v as f32)),
-            gain: self.gain as f32,
-            dark_counts: (self.dark.iter().sum::<f64>() / 3.0) as f32,
-            ..*base
-        }
-    }
 }
 
 /// Least squares of one channel at one gamma: (dark, m_r, m_g, m_b) and the sum of squares.
@@ -162,97 +108,6 @@ pub fn fit_sensor(
     })
 }
 
-/// One robot's four sensors, in the simulator's order (right, front, left, back).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RobotColour {
-    pub radio_id: u8,
-    pub sensors: [SensorFit; 4],
-}
-
-/// What a colour calibration file holds (JSON).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ColourCalibration {
-    pub date: String,
-    /// The sensors' integration time the counts were taken at, ms.
-    pub integration_ms: f64,
-    pub robots: Vec<RobotColour>,
-    /// Root mean square residual over every sensor's fitted samples, counts.
-    pub rms_counts: f64,
-    /// The same over samples held out of the fit (other colours than the ramps), counts.
-    pub held_out_rms_counts: f64,
-}
-
-impl ColourCalibration {
-    pub fn new(integration_ms: f64, robots: Vec<RobotColour>, held_out_rms_counts: f64) -> Self {
-        let fits: Vec<_> = robots.iter().flat_map(|r| r.sensors.iter()).collect();
-        let ms = fits.iter().map(|f| f.rms_counts.powi(2)).sum::<f64>() / fits.len().max(1) as f64;
-        ColourCalibration {
-            date: utc_now(),
-            integration_ms,
-            robots,
-            rms_counts: ms.sqrt(),
-            held_out_rms_counts,
-        }
-    }
-
-    pub fn robot(&self, radio_id: u8) -> Option<&RobotColour> {
-        self.robots.iter().find(|r| r.radio_id == radio_id)
-    }
-
-    pub fn save(&self, path: &Path) -> Result<(), CalibrationError> {
-        let text =
-            serde_json::to_string_pretty(self).map_err(|e| CalibrationError::file(path, e))?;
-        std::fs::write(path, text + "\n").map_err(|e| CalibrationError::file(path, e))
-    }
-
-    pub fn load(path: &Path) -> Result<ColourCalibration, CalibrationError> {
-        let text = std::fs::read_to_string(path).map_err(|e| CalibrationError::file(path, e))?;
-        let cal: ColourCalibration =
-            serde_json::from_str(&text).map_err(|e| CalibrationError::file(path, e))?;
-        for (i, r) in cal.robots.iter().enumerate() {
-            for (k, s) in r.sensors.iter().enumerate() {
-                let m = s.matrix.map(|r| r.map(|v| v as f32));
-                if !(s.gamma.is_finite() && s.gamma > 0.0) || invert3(&m).is_none() {
-                    return Err(CalibrationError::Invalid {
-                        path: path.display().to_string(),
-                        key: format!("robots[{i}].sensors[{k}]"),
-                        value: format!("gamma {}, matrix {:?}", s.gamma, s.matrix),
-                        reason: "needs a gamma > 0 and an invertible matrix".into(),
-                    });
-                }
-            }
-        }
-        Ok(cal)
-    }
-
-    /// Robot `radio_id`'s raw counts (simulator order) as the `nominal` sensor model would read the
-    /// same screen: through this robot's calibrated inverse, then the nominal model without noise.
-    /// A robot not in the file keeps its counts.
-    pub fn to_nominal(
-        &self,
-        radio_id: u8,
-        counts: [[u16; 3]; 4],
-        nominal: &ColourSensor,
-    ) -> [[u16; 3]; 4] {
-        let Some(robot) = self.robot(radio_id) else {
-            return counts;
-        };
-        let p = nominal.params();
-        std::array::from_fn(|s| {
-            let intensity = robot.sensors[s].intensity(counts[s]);
-            let light = nominal.light(intensity.map(|v| (v * 255.0) as f32));
-            std::array::from_fn(|c| {
-                let signal: f32 = (0..3).map(|k| p.crosstalk[c][k] * light[k]).sum();
-                (p.dark_counts + p.gain * p.integration_ms * signal)
-                    .round()
-                    .clamp(0.0, 65_535.0) as u16
-            })
-        })
-    }
-}
-
 /// The screen levels shown for a colour calibration: black, then ramps of red, green and blue in
 /// `steps` steps each (these are fitted), then mixed colours (held out, to check the fit).
 pub fn ramp_levels(steps: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
@@ -279,6 +134,7 @@ pub fn ramp_levels(steps: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
 mod tests {
     use super::*;
     use colcos_sim::rng::{Stream, stream_of};
+    use colcos_sim::sensors::{ColourSensor, ColourSensorParams};
 
     #[test]
     fn the_model_comes_back_from_noisy_ramps() {

@@ -72,7 +72,10 @@ impl RigCalibration {
             None => None,
         };
         let colour = match &rig.colour_calibration {
-            Some(p) => Some(ColourCalibration::load(&resolve(p))?),
+            Some(p) => {
+                let path = resolve(p);
+                Some(ColourCalibration::load(&path).map_err(|e| CalibrationError::file(&path, e))?)
+            }
             None => None,
         };
         Ok(RigCalibration { screen, colour })

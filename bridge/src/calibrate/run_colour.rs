@@ -164,6 +164,7 @@ pub fn calibrate_colour(
         });
     }
     Ok(ColourCalibration::new(
+        super::utc_now(),
         integration_ms,
         robots,
         (ss / count.max(1) as f64).sqrt(),

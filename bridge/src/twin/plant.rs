@@ -117,11 +117,16 @@ impl TwinPlant {
             Some(frame) => {
                 let size = Vec2::from(self.world.screen().size);
                 let points = sensor_positions(&pose, SENSOR_RADIUS);
-                let sensor = match self.sensors.get(i) {
-                    Some(Some(own)) => own,
-                    _ => self.world.sensor(),
-                };
-                sensor.read_frame(frame, size, &points, &mut self.telemetry_rng[i])
+                let rng = &mut self.telemetry_rng[i];
+                match (self.sensors.get(i), self.world.robot_sensors(i)) {
+                    (Some(Some(own)), _) => own.read_frame(frame, size, &points, rng),
+                    // The scenario's per-robot sensors (`[sensor] per_robot`): each of the four
+                    // its own model, read in order.
+                    (_, Some(own)) => std::array::from_fn(|k| {
+                        own.truth[k].read_frame(frame, size, &[points[k]], rng)[0]
+                    }),
+                    _ => self.world.sensor().read_frame(frame, size, &points, rng),
+                }
             }
             None => self.world.observations()[i].counts,
         }

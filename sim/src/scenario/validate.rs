@@ -145,6 +145,13 @@ fn validate_robot_params(sc: &Scenario) -> Result<()> {
     positive("sensor.integration_ms", c.integration_ms)?;
     non_negative("sensor.dark_counts", c.dark_counts)?;
     non_negative("sensor.noise", c.noise)?;
+    if c.per_robot && s.rig.colour_calibration.is_none() {
+        return Err(SimError::invalid(
+            "sensor.per_robot",
+            true,
+            "needs the file of the robots' fitted sensors (colcos calibrate colour) in [rig] colour_calibration",
+        ));
+    }
     for (i, row) in c.crosstalk.iter().enumerate() {
         for (j, v) in row.iter().enumerate() {
             non_negative(&format!("sensor.crosstalk[{i}][{j}]"), *v)?;

@@ -33,6 +33,11 @@ pub struct ColourSensorParams {
     pub dark_counts: f32,
     /// Standard deviation of the count noise (counts).
     pub noise: f32,
+    /// Each robot reads the screen through its own fitted sensors: the file `[rig]
+    /// colour_calibration` names, robot i matched by its radio address (the rig's sensors in the
+    /// simulator). The file's models replace gamma, crosstalk, gain and dark counts.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub per_robot: bool,
 }
 
 impl Default for ColourSensorParams {
@@ -45,6 +50,7 @@ impl Default for ColourSensorParams {
             integration_ms: 24.0,
             dark_counts: 30.0,
             noise: 8.0,
+            per_robot: false,
         }
     }
 }
@@ -69,6 +75,8 @@ pub struct ColourSensor {
     /// `params.crosstalk` and its inverse (identity if singular) as lanes ([`matrix_lanes`]).
     crosstalk_lanes: [[f32; LANES]; 3],
     inverse_lanes: [[f32; LANES]; 3],
+    /// Dark counts per channel (each `params.dark_counts` unless fitted per channel).
+    dark: [f32; 3],
 }
 
 /// The table of [`ColourSensor::light`] by footprint level sum for `gamma`, built once per process and
@@ -115,6 +123,12 @@ pub fn invert3(m: &[[f32; 3]; 3]) -> Option<[[f32; 3]; 3]> {
 
 impl ColourSensor {
     pub fn new(params: ColourSensorParams) -> Self {
+        Self::with_dark(params, [params.dark_counts; 3])
+    }
+
+    /// A sensor whose dark counts differ by channel (a fitted sensor: `dark` replaces
+    /// `params.dark_counts`).
+    pub fn with_dark(params: ColourSensorParams, dark: [f32; 3]) -> Self {
         const IDENTITY: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         let inverse = invert3(&params.crosstalk).unwrap_or(IDENTITY);
         let mut offsets = [Vec2::ZERO; RING_POINTS + 1];
@@ -128,6 +142,7 @@ impl ColourSensor {
             light_by_sum: shared_light_table(params.gamma),
             crosstalk_lanes: matrix_lanes(&params.crosstalk),
             inverse_lanes: matrix_lanes(&inverse),
+            dark,
         }
     }
 
@@ -275,7 +290,8 @@ impl ColourSensor {
             let mut counts = [0u16; LANES];
             for i in 0..LANES {
                 let signal = m[0][i] * r[i] + m[1][i] * g[i] + m[2][i] * b[i];
-                counts[i] = round_count(p.dark_counts + scale * signal + noise[i]);
+                let dark = self.dark[i / LANE_SENSORS];
+                counts[i] = round_count(dark + scale * signal + noise[i]);
             }
             for (s, out) in out.iter_mut().enumerate() {
                 *out = std::array::from_fn(|c| counts[lane(s, c)]);
@@ -307,7 +323,7 @@ impl ColourSensor {
             let mut signal = [[0.0f32; 3]; LANE_SENSORS];
             if scale > 0.0 {
                 for (signal, counts) in signal.iter_mut().zip(counts) {
-                    *signal = counts.map(|n| (n as f32 - p.dark_counts) / scale);
+                    *signal = std::array::from_fn(|c| (counts[c] as f32 - self.dark[c]) / scale);
                 }
             }
             let [r, g, b] = spread(&signal);

@@ -90,6 +90,11 @@ impl World {
     pub fn sensor(&self) -> &ColourSensor {
         self.sensing.sensor()
     }
+    /// Robot `i`'s own four sensors with `[sensor] per_robot` (`None` without: every robot reads
+    /// through [`World::sensor`]).
+    pub fn robot_sensors(&self, i: usize) -> Option<&super::RobotSensors> {
+        self.sensing.robot_sensors(i)
+    }
     /// The neighbour index of the current poses (tests probe bumpers through it).
     pub fn neighbour_index(&self) -> &NeighbourIndex {
         self.sensing.neighbours()

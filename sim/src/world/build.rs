@@ -37,6 +37,7 @@ impl World {
     /// batch differ, and none depends on how many threads step them.
     pub fn with_index(scenario: &Scenario, world_index: u64) -> Result<World> {
         // Domain randomisation: this world's own draw of the `[randomize]` ranges.
+        let base_sensor = scenario.spec.sensor;
         let drawn;
         let scenario = if scenario.spec.randomize.is_default() {
             scenario
@@ -49,7 +50,11 @@ impl World {
         };
         let spec = &scenario.spec;
         let arena = scenario.arena_size();
-        let parts = WorldParts::build(scenario, world_index)?;
+        let mut parts = WorldParts::build(scenario, world_index)?;
+        if spec.sensor.per_robot {
+            let sensors = robot_sensors(scenario, &base_sensor, parts.poses.len())?;
+            parts.sensing.set_robot_sensors(sensors);
+        }
         let mut physics =
             ArenaPhysics::with_backend(arena, &spec.robot, &parts.poses, spec.physics);
         physics.set_obstacles(parts.sensing.obstacles().clone());
@@ -254,4 +259,28 @@ fn build_map(scenario: &Scenario, _key: &str, map: &MapSpec, grid: &GridSpec) ->
         _ => None,
     };
     image_map(grid, &path, channel, map.rate)
+}
+
+/// `[sensor] per_robot`: every robot's own sensors from the file `[rig] colour_calibration` names
+/// (relative to the scenario's directory), with the world's `[randomize]` draws (`scenario`'s
+/// `[sensor]` against `base`) on top.
+fn robot_sensors(
+    scenario: &Scenario,
+    base: &crate::sensors::ColourSensorParams,
+    robots: usize,
+) -> Result<Vec<super::RobotSensors>> {
+    let spec = &scenario.spec;
+    let Some(file) = &spec.rig.colour_calibration else {
+        return Err(crate::error::SimError::invalid(
+            "sensor.per_robot",
+            true,
+            "needs the file of the robots' fitted sensors in [rig] colour_calibration",
+        ));
+    };
+    let calibration = crate::sensors::ColourCalibration::load(&scenario.base_dir.join(file))
+        .map_err(|e| {
+            crate::error::SimError::invalid("rig.colour_calibration", format!("{file:?}"), e.to_string())
+        })?;
+    let radio = spec.rig.radio_addresses(robots)?;
+    super::sensing::per_robot_sensors(&calibration, &radio, &spec.sensor, base, file)
 }

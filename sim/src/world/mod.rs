@@ -24,7 +24,7 @@ pub use build::WorldParts;
 pub use fields::FieldSet;
 pub use inject::Injection;
 pub use robots::{RobotSet, RobotSlot};
-pub use sensing::Sensing;
+pub use sensing::{RobotSensors, Sensing};
 pub use tracking::Tracking;
 pub use view::ArenaView;
 

@@ -7,7 +7,8 @@ use crate::field::GridPrefetcher;
 use crate::robot::Pose;
 use crate::screen::ScreenSpec;
 use crate::sensors::{
-    BumperParams, BumperRays, ColourSensor, NeighbourIndex, SENSOR_RADIUS, sensor_positions,
+    BumperParams, BumperRays, ColourCalibration, ColourSensor, ColourSensorParams, NeighbourIndex,
+    SENSOR_RADIUS, sensor_positions,
 };
 use glam::Vec2;
 use rayon::prelude::*;
@@ -15,6 +16,9 @@ use std::sync::Arc;
 
 pub struct Sensing {
     sensor: ColourSensor,
+    /// Each robot's own four sensors (`[sensor] per_robot`), or none: every robot reads through
+    /// `sensor`.
+    robot_sensors: Vec<RobotSensors>,
     bumper_params: BumperParams,
     bumper_rays: BumperRays,
     /// Robot radius, m (bumper rays start at the rim).
@@ -41,6 +45,7 @@ impl Sensing {
     ) -> Self {
         Sensing {
             sensor,
+            robot_sensors: Vec::new(),
             bumper_rays: BumperRays::new(&bumper_params),
             bumper_params,
             radius,
@@ -55,6 +60,14 @@ impl Sensing {
     /// The colour sensor model shared by all robots.
     pub fn sensor(&self) -> &ColourSensor {
         &self.sensor
+    }
+    /// Robot `i`'s own sensors, if the robots have their own ([`Sensing::set_robot_sensors`]).
+    pub fn robot_sensors(&self, i: usize) -> Option<&RobotSensors> {
+        self.robot_sensors.get(i)
+    }
+    /// Gives each robot its own four sensors (one entry per robot, in order).
+    pub fn set_robot_sensors(&mut self, sensors: Vec<RobotSensors>) {
+        self.robot_sensors = sensors;
     }
     /// The arena's static obstacles (what the bumpers see besides walls and robots).
     pub fn obstacles(&self) -> &Arc<Obstacles> {
@@ -111,6 +124,7 @@ pub fn sense(
     let sensor_points = &sensing.sensor_points;
     let (pheromones, frozen) = (fields.pheromones(), fields.frozen());
     let (sensor, neighbours, bumper) = (&sensing.sensor, &sensing.neighbours, &sensing.bumper_rays);
+    let robot_sensors = &sensing.robot_sensors;
     let (radius, arena) = (sensing.radius, sensing.arena);
     let obstacles = &*sensing.obstacles;
     let prefetcher = GridPrefetcher::new(pheromones);
@@ -125,8 +139,21 @@ pub fn sense(
             last_command: slot.command,
             ..Observation::default()
         };
-        o.counts = sensor.read_all(pheromones, frozen, screen, &sensor_points[i], &mut slot.rng);
-        o.intensity = sensor.intensities(&o.counts);
+        match robot_sensors.get(i) {
+            Some(own) => {
+                // One sensor at a time, in order: the same draws as `read_all`'s.
+                for (k, p) in sensor_points[i].iter().enumerate() {
+                    let c = own.truth[k].read(pheromones, frozen, screen, *p, &mut slot.rng);
+                    o.counts[k] = c;
+                    o.intensity[k] = own.inverse[k].intensity(c);
+                }
+            }
+            None => {
+                o.counts =
+                    sensor.read_all(pheromones, frozen, screen, &sensor_points[i], &mut slot.rng);
+                o.intensity = sensor.intensities(&o.counts);
+            }
+        }
         o.bumpers = neighbours.bumpers_with(i, poses, radius, arena, bumper, obstacles);
         *obs = o;
     };
@@ -143,4 +170,57 @@ pub fn sense(
             .enumerate()
             .for_each(sense);
     }
+}
+
+/// One robot's own four colour sensors (simulator order): the model its counts are drawn from, and
+/// the calibrated inverse its intensities are read through (the calibration file's, as on the rig;
+/// they differ only by a world's `[randomize]` draws).
+#[derive(Clone, Debug)]
+pub struct RobotSensors {
+    pub truth: [ColourSensor; 4],
+    pub inverse: [ColourSensor; 4],
+}
+
+/// Every robot's own sensors from `calibration` (robot i is the file's robot with radio address
+/// `radio[i]`). `drawn` is the world's `[sensor]` section after its `[randomize]` draws, `base` the
+/// scenario's: their gain ratio and crosstalk difference go on top of every fitted sensor. `file`
+/// names the file in errors.
+pub fn per_robot_sensors(
+    calibration: &ColourCalibration,
+    radio: &[u8],
+    drawn: &ColourSensorParams,
+    base: &ColourSensorParams,
+    file: &str,
+) -> crate::error::Result<Vec<RobotSensors>> {
+    let gain_factor = if base.gain > 0.0 {
+        drawn.gain / base.gain
+    } else {
+        1.0
+    };
+    let offset: [[f32; 3]; 3] = std::array::from_fn(|c| {
+        std::array::from_fn(|k| drawn.crosstalk[c][k] - base.crosstalk[c][k])
+    });
+    let ids: Vec<u8> = calibration.robots.iter().map(|r| r.radio_id).collect();
+    radio
+        .iter()
+        .enumerate()
+        .map(|(i, id)| {
+            let robot = calibration.robot(*id).ok_or_else(|| {
+                crate::error::SimError::invalid(
+                    "rig.colour_calibration",
+                    format!("{file:?}"),
+                    format!(
+                        "[sensor] per_robot: robot {i} (radio address {id}) is not in the file, \
+                         which holds radio addresses {ids:?} ({} robots for the scenario's {})",
+                        ids.len(),
+                        radio.len()
+                    ),
+                )
+            })?;
+            Ok(RobotSensors {
+                truth: robot.sensors.map(|f| f.sensor(drawn, gain_factor, &offset)),
+                inverse: robot.sensors.map(|f| f.sensor(base, 1.0, &[[0.0; 3]; 3])),
+            })
+        })
+        .collect()
 }
