@@ -108,3 +108,27 @@ def _arena(env) -> tuple[float, float]:
     text = colcos.parallel_env(task="aggregation")._core.scenario_toml()
     size = tomllib.loads(text)["screen"]["size"]
     return float(size[0]), float(size[1])
+
+
+def test_a_twin_playing_its_own_scenario_runs_and_one_of_another_arena_is_refused(tmp_path):
+    # The twin's tracker 150 ms late and its colour sensors at 70 % gain: the host still runs.
+    with colcos.parallel_env(
+        task="aggregation", plant="twin", goto=False, max_cycles=10,
+        twin_scenario={"tracker.latency": 0.15, "sensor.gain": 0.7},
+    ) as env:
+        env.reset(seed=0)
+        while env.agents:
+            env.step({a: np.zeros(2, np.float32) for a in env.agents})
+    with pytest.raises(colcos.TaskError, match=r"`twin_scenario\.dt`"):
+        colcos.parallel_env(task="aggregation", plant="twin", twin_scenario={"dt": 0.04})
+    with pytest.raises(colcos.TaskError, match=r"`twin_scenario\.tracker\.latncy`"):
+        colcos.parallel_env(task="aggregation", plant="twin", twin_scenario={"tracker.latncy": 0.1})
+    text = colcos.parallel_env(task="aggregation")._core.scenario_toml()
+    other = tmp_path / "other.toml"
+    other.write_text(text.replace('count = 1\nrole = "leader"', 'count = 2\nrole = "leader"', 1))
+    with pytest.raises(colcos.TaskError, match=r"`twin_scenario\.robots`: 6 robots on the twin but 5"):
+        colcos.parallel_env(task="aggregation", plant="twin", twin_scenario=str(other))
+    with pytest.raises(colcos.TaskError, match="twin_scenario"):
+        colcos.parallel_env(task="aggregation", twin_scenario={"tracker.latency": 0.1})
+    with pytest.raises(colcos.ArgumentTypeError, match="twin_scenario"):
+        colcos.parallel_env(task="aggregation", plant="twin", twin_scenario=3)

@@ -4,8 +4,9 @@
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
 use crate::vec_env::{AgentBuffers, Owned, Ptrs, agent_views, owned_actions};
-use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions};
+use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions, TwinScenario};
 use colcos_env::Space;
+use colcos_sim::scenario::Scenario;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -29,6 +30,38 @@ fn plant_err(e: PlantError) -> PyErr {
     }
 }
 
+/// The twin's own scenario from at most one of a file, TOML text and JSON overrides.
+fn twin_choice(
+    file: Option<String>,
+    text: Option<String>,
+    overrides: Option<String>,
+) -> PyResult<Option<TwinScenario>> {
+    let scenario_err =
+        |e: colcos_sim::error::SimError| Kind::Scenario.err(format!("twin_scenario: {e}"));
+    Ok(match (file, text, overrides) {
+        (None, None, None) => None,
+        (Some(f), None, None) => Some(TwinScenario::Full(
+            Scenario::from_file(std::path::Path::new(&f)).map_err(scenario_err)?,
+        )),
+        (None, Some(t), None) => Some(TwinScenario::Full(
+            Scenario::from_toml_str(&t, ".").map_err(scenario_err)?,
+        )),
+        (None, None, Some(j)) => {
+            let map: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&j)
+                .map_err(|e| {
+                    Kind::Task.err(format!(
+                        "twin_scenario: overrides must be a JSON object: {e}"
+                    ))
+                })?;
+            Some(TwinScenario::Overrides(map.into_iter().collect()))
+        }
+        _ => {
+            return Err(Kind::Task
+                .err("twin_scenario: give one of a scenario file, scenario text or overrides"));
+        }
+    })
+}
+
 impl PyPlant {
     /// The lock. Call only with the GIL released (inside `py.detach`).
     fn lock(&self) -> MutexGuard<'_, LiveEnv> {
@@ -41,9 +74,11 @@ impl PyPlant {
     /// `plant`: "twin", "rig" or "replay"; `tracker`/`robots`: the URLs (a twin without them starts
     /// in this process on loopback); `log`: the rig log to replay, or to write (twin, rig);
     /// `goto`: reset drives the robots to the episode's start poses, for at most `goto_timeout` s.
+    /// `twin_scenario` (a file) / `twin_scenario_text` (TOML) / `twin_overrides_json` (a JSON object
+    /// of key paths and values over the host's scenario): what a twin started here plays instead.
     /// The other arguments are `VecEnv`'s (one world).
     #[new]
-    #[pyo3(signature = (plant, task, tracker=None, robots=None, log=None, goto=None, goto_timeout=None, seed=None, scenario=None, scenario_text=None, max_cycles=None, action=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None))]
+    #[pyo3(signature = (plant, task, tracker=None, robots=None, log=None, goto=None, goto_timeout=None, twin_scenario=None, twin_scenario_text=None, twin_overrides_json=None, seed=None, scenario=None, scenario_text=None, max_cycles=None, action=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -54,6 +89,9 @@ impl PyPlant {
         log: Option<&Bound<'_, PyAny>>,
         goto: Option<&Bound<'_, PyAny>>,
         goto_timeout: Option<&Bound<'_, PyAny>>,
+        twin_scenario: Option<&Bound<'_, PyAny>>,
+        twin_scenario_text: Option<&Bound<'_, PyAny>>,
+        twin_overrides_json: Option<&Bound<'_, PyAny>>,
         seed: Option<&Bound<'_, PyAny>>,
         scenario: Option<&Bound<'_, PyAny>>,
         scenario_text: Option<&Bound<'_, PyAny>>,
@@ -92,6 +130,11 @@ impl PyPlant {
                 );
             }
             opts.goto_timeout = timeout;
+            opts.twin_scenario = twin_choice(
+                args::opt_text(twin_scenario, "twin_scenario")?,
+                args::opt_text(twin_scenario_text, "twin_scenario_text")?,
+                args::opt_text(twin_overrides_json, "twin_overrides_json")?,
+            )?;
             let one = Some(1u64.into_pyobject(py)?.into_any());
             let cfg = crate::vec_env::config(
                 task,

@@ -14,7 +14,15 @@ from pettingzoo.utils.conversions import parallel_to_aec_wrapper
 
 from colcos import _actions, _checks, _core
 from colcos._core import ActionError, StateError, TaskError, UnknownAgentError
-from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_space, share_signature
+from colcos._options import (
+    BackendInfo,
+    HumanWindow,
+    core_kwargs,
+    log_backend,
+    make_space,
+    share_signature,
+    twin_kwargs,
+)
 
 RENDER_WIDTH = 640
 _F32 = np.dtype(np.float32)
@@ -55,6 +63,12 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         goto: on the twin and the rig, `reset` first drives the robots to the episode's start poses
             (tracker-guided, collision-aware), for at most `goto_timeout` s; False leaves them where
             they are.
+        twin_scenario: `"twin"` started here: what the twin plays where it differs from this
+            scenario (its true tracker latency, sensor gain and crosstalk, robot body): a scenario
+            file, scenario TOML text, or a dict of key paths over this scenario
+            (`{"tracker.latency": 0.15, "sensor.gain": 0.8}`). Its robots, arena, screen and tick
+            must be this scenario's. The robots' own sensors are read only with `[rig] sensors =
+            "robot"` in this scenario. See docs/bridge.md ("Sim-to-real").
         **params: task parameters (see the task's docs); unknown ones raise `colcos.TaskError`.
 
     Actions (`step`): a dict with an action for every agent in `agents`; see docs/python.md
@@ -87,12 +101,14 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         log: str | os.PathLike[str] | None = None,
         goto: bool = True,
         goto_timeout: float = 30.0,
+        twin_scenario: str | os.PathLike[str] | dict[str, Any] | None = None,
         **params: Any,
     ) -> None:
         self._init_kwargs = dict(
             task=task, scenario=scenario, max_cycles=max_cycles, render_mode=render_mode, continuous=continuous,
             global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, backend=backend,
-            plant=plant, tracker=tracker, robots=robots, log=log, goto=goto, goto_timeout=goto_timeout, **params,
+            plant=plant, tracker=tracker, robots=robots, log=log, goto=goto, goto_timeout=goto_timeout,
+            twin_scenario=twin_scenario, **params,
         )
         _checks.choice(render_mode, "render_mode", [None, "human", "rgb_array"])
         kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend)
@@ -100,7 +116,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self.plant = plant
         self._core: _core.VecEnv | _core.Plant
         if plant == "sim":
-            for name, value in (("tracker", tracker), ("robots", robots), ("log", log)):
+            for name, value in (("tracker", tracker), ("robots", robots), ("log", log), ("twin_scenario", twin_scenario)):
                 if value is not None:
                     raise TaskError(f"{name}={value!r} is for plant='twin', 'rig' or 'replay', not 'sim'")
             self._core = _core.VecEnv(
@@ -109,7 +125,8 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         else:
             self._core = _core.Plant(
                 plant=plant, tracker=tracker, robots=robots, log=None if log is None else os.fspath(log),
-                goto=_checks.flag(goto, "goto"), goto_timeout=goto_timeout, seed=_checks.seed(seed), **kw,
+                goto=_checks.flag(goto, "goto"), goto_timeout=goto_timeout, seed=_checks.seed(seed),
+                **twin_kwargs(twin_scenario), **kw,
             )
         log_backend(self._core, backend)
         spec = self._core.spec()
