@@ -430,3 +430,54 @@ fn arena_shapes_are_checked() {
         );
     }
 }
+
+#[test]
+fn the_same_seed_gives_the_same_run_whatever_the_thread_count() {
+    // 100 robots (the sense stage runs in parallel from 64) among obstacles of every shape.
+    let obstacles = r#"
+[[obstacles]]
+shape = "box"
+centre = [0.3, 0.3]
+size = [0.15, 0.1]
+angle = 30
+[[obstacles]]
+shape = "disc"
+centre = [0.7, 0.3]
+radius = 0.08
+[[obstacles]]
+shape = "polygon"
+points = [[0.2, 0.6], [0.45, 0.6], [0.45, 0.85], [0.35, 0.85], [0.35, 0.7], [0.2, 0.7]]
+[[obstacles]]
+shape = "wall"
+points = [[0.6, 0.55], [0.8, 0.75], [0.9, 0.6]]
+thickness = 0.01
+"#;
+    for physics in ["rapier", "discs"] {
+        let text = format!(
+            "physics = \"{physics}\"\n{}{obstacles}",
+            BASE.replace("count = 20", "count = 100")
+        );
+        let sc = Scenario::from_toml_str(&text, ".").unwrap();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut world = World::new(&sc).unwrap();
+                for _ in 0..150 {
+                    world.step();
+                }
+                let bumpers: Vec<[f32; 3]> =
+                    world.observations().iter().map(|o| o.bumpers).collect();
+                (world.poses().to_vec(), bumpers)
+            })
+        };
+        let (one, two) = (run(1), run(2));
+        assert!(
+            one.1.iter().any(|b| b.iter().any(|&x| x > 0.0)),
+            "{physics}: no bumper fired"
+        );
+        assert_eq!(one, two, "{physics}: 1 and 2 threads differ");
+    }
+}
