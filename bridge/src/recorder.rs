@@ -115,6 +115,19 @@ impl Recorder {
         Ok(())
     }
 
+    /// Writes a metadata record `name` of key-value strings (what the run ran with).
+    pub fn write_metadata(
+        &mut self,
+        name: &str,
+        values: BTreeMap<String, String>,
+    ) -> Result<(), RecorderError> {
+        self.writer.write_metadata(&mcap::records::Metadata {
+            name: name.into(),
+            metadata: values,
+        })?;
+        Ok(())
+    }
+
     /// Pushes everything recorded so far to the file.
     pub fn flush(&mut self) -> Result<(), RecorderError> {
         self.writer.flush()?;
@@ -157,6 +170,22 @@ pub fn read_log(bytes: &[u8]) -> Vec<Recorded> {
     out
 }
 
+/// The metadata records of the log `bytes` (name, key-value strings), in file order; a log cut short
+/// yields those before the cut.
+pub fn read_metadata(bytes: &[u8]) -> Vec<(String, BTreeMap<String, String>)> {
+    let options = mcap::read::Options::IgnoreEndMagic.into();
+    let Ok(reader) = mcap::read::LinearReader::new_with_options(bytes, options) else {
+        return Vec::new();
+    };
+    reader
+        .map_while(|r| r.ok())
+        .filter_map(|r| match r {
+            mcap::records::Record::Metadata(m) => Some((m.name, m.metadata)),
+            _ => None,
+        })
+        .collect()
+}
+
 /// FNV-1a (64-bit) of a frame's bytes, for the log.
 pub fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
@@ -191,5 +220,21 @@ mod tests {
             assert_eq!(log[5].topic, Topic::Poses);
             assert_eq!(log[5].t_ns, 2001);
         }
+    }
+
+    #[test]
+    fn metadata_comes_back_beside_the_messages() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("rig.mcap");
+        let mut rec = Recorder::create(&path).unwrap();
+        let values: BTreeMap<String, String> = [("rig_latency".to_string(), "0.031".to_string())]
+            .into_iter()
+            .collect();
+        rec.write_metadata("rig", values.clone()).unwrap();
+        rec.record(Topic::Poses, 5, b"{}").unwrap();
+        rec.finish().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(read_metadata(&bytes), vec![("rig".to_string(), values)]);
+        assert_eq!(read_log(&bytes).len(), 1);
     }
 }

@@ -79,6 +79,19 @@ fn run_rig(
     let report = bridge.join().unwrap();
     let bridge_stopped_at = Instant::now();
     let log = read_log(&std::fs::read(&log_path).unwrap());
+    // The log and the report record the latencies the run ran with.
+    let meta = colcos_bridge::recorder::read_metadata(&std::fs::read(&log_path).unwrap());
+    let rig_meta = &meta
+        .iter()
+        .find(|(name, _)| name == "rig")
+        .expect("rig metadata")
+        .1;
+    assert_eq!(rig_meta["rig_latency"], sc.spec.rig.latency.to_string());
+    assert_eq!(
+        rig_meta["tracker_latency"],
+        sc.spec.tracker.latency.to_string()
+    );
+    assert_eq!(report.tracker_latency, sc.spec.tracker.latency);
     // The trajectory has the simulator's columns and one row per robot and tick.
     let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).unwrap();
     let mut lines = csv.lines();

@@ -64,4 +64,9 @@ pub struct LiveReport {
     pub pose_blocks: u64,
     /// GIF frames dropped because the encoder was busy.
     pub gif_frames_dropped: u64,
+    /// The latencies the run ran with, s: the scenario's `[rig] latency` (the compensation) and
+    /// `[tracker] latency` (the simulator's model of the tracker), as `colcos calibrate latency`
+    /// measures them.
+    pub rig_latency: f32,
+    pub tracker_latency: f32,
 }

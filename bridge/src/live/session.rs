@@ -71,10 +71,15 @@ impl LiveSession {
         let rig = &scenario.spec.rig;
         let n = core.robot_count();
         let recorder = match &opts.log {
-            Some(path) => Some(
-                Recorder::create(path)
-                    .map_err(|e| SimError::invalid("--log", path.display(), e.to_string()))?,
-            ),
+            Some(path) => {
+                let bad = |e: crate::recorder::RecorderError| {
+                    SimError::invalid("--log", path.display(), e.to_string())
+                };
+                let mut rec = Recorder::create(path).map_err(bad)?;
+                rec.write_metadata("rig", run_metadata(scenario))
+                    .map_err(bad)?;
+                Some(rec)
+            }
             None => None,
         };
         let trajectory = match &opts.trajectory {
@@ -150,7 +155,11 @@ impl LiveSession {
             next_frame: 0.0,
             next_display: 0.0,
             display_gone: false,
-            report: LiveReport::default(),
+            report: LiveReport {
+                rig_latency: rig.latency,
+                tracker_latency: scenario.spec.tracker.latency,
+                ..LiveReport::default()
+            },
             tick_ms: Vec::new(),
             poses: Vec::with_capacity(n),
             telemetry: Vec::new(),
@@ -452,4 +461,25 @@ fn kept(img: &mut RgbImage, width: u32, height: u32) -> &mut RgbImage {
         *img = RgbImage::new(width, height);
     }
     img
+}
+
+/// What a rig log records the run ran with (metadata `rig`): the latencies (s) and calibrations.
+fn run_metadata(scenario: &Scenario) -> std::collections::BTreeMap<String, String> {
+    let rig = &scenario.spec.rig;
+    let none = || "none".to_string();
+    [
+        ("rig_latency", rig.latency.to_string()),
+        ("tracker_latency", scenario.spec.tracker.latency.to_string()),
+        (
+            "screen_calibration",
+            rig.screen_calibration.clone().unwrap_or_else(none),
+        ),
+        (
+            "colour_calibration",
+            rig.colour_calibration.clone().unwrap_or_else(none),
+        ),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect()
 }
