@@ -216,6 +216,8 @@ pub fn main(args: CalibrateArgs, text: &mut String) -> Result<()> {
             if robot.is_some() && common.robots.is_none() {
                 bail!("--robot: starting a robot needs --robots");
             }
+            // The scenario as the calibration found it: the write-back is refused if it changes.
+            let before = std::fs::read_to_string(&common.scenario).ok();
             let (sc, mut rig) = open_rig(&common)?;
             let transform = RigCalibration::load(&sc)?.frame_transform(&sc);
             let opts = LatencyRunOptions {
@@ -246,8 +248,9 @@ pub fn main(args: CalibrateArgs, text: &mut String) -> Result<()> {
             writeln!(text, "command to motion:  {}", ms(report.command_to_motion))?;
             match (report.tracker_latency, report.rig_latency) {
                 (Some(t), Some(r)) if write_scenario => {
-                    crate::scenario_write::set_numbers(
+                    crate::scenario_write::set_numbers_unless_changed(
                         &common.scenario,
+                        before.as_deref(),
                         &[("tracker", "latency", t), ("rig", "latency", r)],
                     )?;
                     writeln!(

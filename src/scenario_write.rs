@@ -8,8 +8,24 @@ use toml_edit::{DocumentMut, Item, Table, value};
 
 /// Sets `[section] key = v` for each `(section, key, v)` in the scenario file at `path`.
 pub fn set_numbers(path: &Path, values: &[(&str, &str, f64)]) -> Result<()> {
+    set_numbers_unless_changed(path, None, values)
+}
+
+/// [`set_numbers`], refused when `expected` is given and the file no longer holds it (edited while
+/// a calibration ran: the measured values may no longer be meant for it).
+pub fn set_numbers_unless_changed(
+    path: &Path,
+    expected: Option<&str>,
+    values: &[(&str, &str, f64)],
+) -> Result<()> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("reading the scenario {}", path.display()))?;
+    if expected.is_some_and(|e| e != text) {
+        bail!(
+            "{}: the scenario changed while the calibration ran; nothing written (the measured values are in the calibration file)",
+            path.display()
+        );
+    }
     let new = with_numbers(&text, values).with_context(|| format!("{}", path.display()))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     Scenario::from_toml_str(&new, base).with_context(|| {
@@ -104,6 +120,17 @@ mod tests {
         let before = std::fs::read_to_string(&path).unwrap();
         assert!(set_numbers(&path, &[("tracker", "latency", 50.0)]).is_err());
         assert_eq!(std::fs::read_to_string(&path).unwrap(), before);
+        // A file edited since it was read is left alone.
+        let e =
+            set_numbers_unless_changed(&path, Some("name = \"x\"\n"), &[("rig", "latency", 0.03)])
+                .unwrap_err();
+        assert!(
+            e.to_string().contains("changed while the calibration ran"),
+            "{e}"
+        );
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), before);
+        set_numbers_unless_changed(&path, Some(&before), &[("rig", "latency", 0.03)]).unwrap();
+        assert!((Scenario::from_file(&path).unwrap().spec.rig.latency - 0.03).abs() < 1e-6);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
