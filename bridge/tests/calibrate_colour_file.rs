@@ -84,14 +84,13 @@ fn calibrating_a_twin_built_from_a_file_gives_the_file_back() {
                 }
             }
         }
-        for k in 0..4 {
-            let want = robot.sensors[k].predict(levels);
+        for (k, (mean, sensor)) in mean.iter().zip(&robot.sensors).enumerate() {
+            let want = sensor.predict(levels);
             for c in 0..3 {
                 // Noise of 8 counts over 16 readings: 2 counts; rounding of the model in f32.
                 assert!(
-                    (mean[k][c] - want[c]).abs() < 8.0 + 0.002 * want[c],
-                    "robot {r} sensor {k}: {:?} against the file's {want:?}",
-                    mean[k]
+                    (mean[c] - want[c]).abs() < 8.0 + 0.002 * want[c],
+                    "robot {r} sensor {k}: {mean:?} against the file's {want:?}"
                 );
             }
         }
