@@ -279,7 +279,11 @@ fn robot_sensors(
     };
     let calibration = crate::sensors::ColourCalibration::load(&scenario.base_dir.join(file))
         .map_err(|e| {
-            crate::error::SimError::invalid("rig.colour_calibration", format!("{file:?}"), e.to_string())
+            crate::error::SimError::invalid(
+                "rig.colour_calibration",
+                format!("{file:?}"),
+                e.to_string(),
+            )
         })?;
     let radio = spec.rig.radio_addresses(robots)?;
     super::sensing::per_robot_sensors(&calibration, &radio, &spec.sensor, base, file)
