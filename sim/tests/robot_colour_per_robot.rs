@@ -96,7 +96,7 @@ fn each_robot_reads_the_screen_through_its_own_fitted_model() {
     let nominal = World::new(&scenario(&file, "", "")).unwrap();
     let own = World::new(&scenario(&file, "per_robot = true", "")).unwrap();
     let mut red = [0.0f64; 2];
-    for r in 0..2 {
+    for (r, red) in red.iter_mut().enumerate() {
         let fitted = &cal.robots[r].sensors[0];
         for k in 0..4 {
             let levels = nominal.observations()[r].intensity[k].map(|v| v as f64 * 255.0);
@@ -118,7 +118,7 @@ fn each_robot_reads_the_screen_through_its_own_fitted_model() {
                     "robot {r}: {back:?} vs {levels:?}"
                 );
             }
-            red[r] = got[0] as f64;
+            *red = got[0] as f64;
         }
     }
     // The same orange, very different counts: the bright sensor counts well over twice the dim one.
@@ -213,8 +213,7 @@ fn a_file_that_cannot_serve_the_scenario_is_refused_by_key() {
     // The switch without a file is refused when the scenario is read.
     let text = "duration = 1.0\n[sensor]\nper_robot = true\n[[robots]]\ncount = 1\nbehaviour = \"wander\"\n";
     let err = Scenario::from_toml_str(text, ".")
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(
         err.contains("sensor.per_robot") && err.contains("colour_calibration"),
