@@ -481,3 +481,24 @@ thickness = 0.01
         assert_eq!(one, two, "{physics}: 1 and 2 threads differ");
     }
 }
+
+#[test]
+fn obstacles_and_arena_shapes_survive_the_saved_scenario() {
+    for shape in [
+        "{ disc = { centre = [0.5, 0.5], radius = 0.45 } }",
+        "{ polygon = [[0.05, 0.05], [0.95, 0.05], [0.95, 0.4], [0.4, 0.4], [0.4, 0.95], [0.05, 0.95]] }",
+    ] {
+        let text = format!(
+            "duration = 1.0\n[screen]\nsize = [1.0, 1.0]\nresolution = [200, 200]\n\
+             [arena]\nshape = {shape}\n[[obstacles]]\nshape = \"box\"\ncentre = [0.2, 0.2]\n\
+             size = [0.05, 0.05]\nangle = 10.0\n[[robots]]\ncount = 5\nbehaviour = \"avoid\"\n"
+        );
+        let sc = Scenario::from_toml_str(&text, ".").unwrap();
+        let again = Scenario::from_toml_str(&sc.to_toml_standalone(), ".").unwrap();
+        assert_eq!(again.spec.arena.shape, sc.spec.arena.shape);
+        assert_eq!(again.spec.obstacles.len(), 1);
+        assert_eq!(again.spec.obstacles[0].angle, Some(10.0));
+        let (a, b) = (World::new(&sc).unwrap(), World::new(&again).unwrap());
+        assert_eq!(a.poses(), b.poses());
+    }
+}
