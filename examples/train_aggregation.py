@@ -116,6 +116,7 @@ def main() -> None:
     p.add_argument("--eval-seed", type=int, default=12345)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default="runs/aggregation")
+    p.add_argument("--scenario", default=None, help="scenario file for training and evaluation (e.g. with a [randomize] section)")
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="numeric task parameter for training and evaluation, e.g. progress_weight=0 (repeatable)")
     args = p.parse_args()
@@ -123,6 +124,8 @@ def main() -> None:
     torch.set_num_threads(1)
     os.makedirs(args.out, exist_ok=True)
     task_kwargs = {"task": "aggregation", "num_threads": args.threads}
+    if args.scenario:
+        task_kwargs["scenario"] = args.scenario
     for kv in args.param:
         key, value = kv.split("=", 1)
         task_kwargs[key] = float(value)
@@ -259,7 +262,8 @@ def main() -> None:
         "eval_worlds": worlds,
         "eval_steps": horizon,
         "eval_seed": seed,
-        "task_params": {k: v for k, v in task_kwargs.items() if k not in ("task", "num_threads")},
+        "scenario": args.scenario,
+        "task_params": {k: v for k, v in task_kwargs.items() if k not in ("task", "num_threads", "scenario")},
         "return_learned": round(learned, 2),
         "return_random": round(rand, 2),
         f"return_handwritten_{follower}": round(hand, 2),
