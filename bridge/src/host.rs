@@ -266,6 +266,9 @@ impl ArenaView for Host {
     fn poses(&self) -> &[Pose] {
         &self.poses
     }
+    fn obstacles(&self) -> &colcos_sim::arena::Obstacles {
+        self.parts.sensing.obstacles()
+    }
     fn observations(&self) -> &[Observation] {
         self.parts.sensing.observations()
     }
