@@ -40,12 +40,12 @@ fn twin_choice(
         |e: colcos_sim::error::SimError| Kind::Scenario.err(format!("twin_scenario: {e}"));
     Ok(match (file, text, overrides) {
         (None, None, None) => None,
-        (Some(f), None, None) => Some(TwinScenario::Full(
+        (Some(f), None, None) => Some(TwinScenario::Full(Box::new(
             Scenario::from_file(std::path::Path::new(&f)).map_err(scenario_err)?,
-        )),
-        (None, Some(t), None) => Some(TwinScenario::Full(
+        ))),
+        (None, Some(t), None) => Some(TwinScenario::Full(Box::new(
             Scenario::from_toml_str(&t, ".").map_err(scenario_err)?,
-        )),
+        ))),
         (None, None, Some(j)) => {
             let map: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&j)
                 .map_err(|e| {

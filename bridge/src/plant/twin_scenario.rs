@@ -8,7 +8,7 @@ use colcos_sim::scenario::Scenario;
 #[derive(Clone, Debug)]
 pub enum TwinScenario {
     /// A whole scenario of its own (same robots, arena, screen and tick).
-    Full(Scenario),
+    Full(Box<Scenario>),
     /// The host's scenario with these dotted key paths (`"tracker.latency"`, `"sensor.gain"`) set.
     Overrides(Vec<(String, serde_json::Value)>),
 }
@@ -17,7 +17,7 @@ impl TwinScenario {
     /// The twin's scenario for the host's `host` (seeded as the host).
     pub fn resolve(&self, host: &Scenario) -> Result<Scenario, PlantError> {
         let mut twin = match self {
-            TwinScenario::Full(s) => s.clone(),
+            TwinScenario::Full(s) => (**s).clone(),
             TwinScenario::Overrides(sets) => with_overrides(host, sets)?,
         };
         twin.spec.seed = host.spec.seed;
@@ -43,9 +43,9 @@ fn with_overrides(
                 return Err(PlantError::option(&key, "is not a key of a table"));
             };
             // Optional fields left out of the host's scenario may be set; no other new key may.
-            if !table.contains_key(*part)
-                && !(last && host_allows_new(parts[..k].join(".").as_str()))
-            {
+            let allowed = table.contains_key(*part)
+                || (last && host_allows_new(parts[..k].join(".").as_str()));
+            if !allowed {
                 return Err(PlantError::option(
                     &key,
                     format!("the scenario has no `{part}` there"),
