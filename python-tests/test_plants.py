@@ -132,3 +132,24 @@ def test_a_twin_playing_its_own_scenario_runs_and_one_of_another_arena_is_refuse
         colcos.parallel_env(task="aggregation", twin_scenario={"tracker.latency": 0.1})
     with pytest.raises(colcos.ArgumentTypeError, match="twin_scenario"):
         colcos.parallel_env(task="aggregation", plant="twin", twin_scenario=3)
+
+
+def test_the_twins_own_sensor_gain_reaches_a_host_reading_the_robots_sensors():
+    # `[rig] sensors = "robot"`: the host takes the robots' telemetry, which the twin computes from the
+    # frames the host shows with its own sensor model; a fifth of the gain reads markedly darker.
+    host = colcos.parallel_env(task="aggregation")._core.scenario_toml() + '\n[rig]\nsensors = "robot"\n'
+
+    def late_obs(gain: float) -> np.ndarray:
+        seen = []
+        with colcos.parallel_env(task="aggregation", scenario=host, plant="twin", goto=False, max_cycles=60,
+                                 twin_scenario={"sensor.gain": gain}) as env:
+            obs, _ = env.reset(seed=4)
+            while env.agents:
+                obs, *_ = env.step({a: np.zeros(2, np.float32) for a in env.agents})
+                if obs:
+                    seen.append(np.stack(list(obs.values())))
+        return np.array(seen[-10:])
+
+    bright, dark = late_obs(1500.0), late_obs(300.0)
+    assert bright.max() > 0.05, bright.max(axis=(0, 1))
+    assert dark.sum() < 0.75 * bright.sum(), (dark.mean(axis=(0, 1)), bright.mean(axis=(0, 1)))
