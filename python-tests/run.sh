@@ -3,7 +3,7 @@
 # `pip install ./pyo3-bindings`), installs it into two venvs and runs every Python suite (what CI runs):
 #   main venv  (requirements.txt):       PettingZoo suite, errors, vector env, determinism,
 #                                        SuperSuit -> SB3 PPO, our SB3 adapter, TorchRL
-#   rllib venv (requirements-rllib.txt): RLlib ParallelPettingZooEnv (ray pins gymnasium 1.2.2); sweeps on a local Ray cluster
+#   rllib venv (requirements-rllib.txt): RLlib ParallelPettingZooEnv (ray pins gymnasium 1.2.2); sweeps on a local Ray cluster, the Ray Tune example
 # Both requirement files are complete locks installed with --no-deps (no resolver); the main venv gets
 # PyPI's torch without its CUDA libraries, made loadable by torch_cpu_stubs.py (see requirements.txt).
 # The first run builds the wheel from a cold cargo target and fills both venvs (tens of minutes on
@@ -85,10 +85,10 @@ check_venv venv-rllib
 lap "installed ($(du -sh "$work/venv-rllib" | cut -f1))"
 
 echo "== pytest (main venv)"
-"$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --durations=5 --ignore=test_rllib.py --ignore=test_sweep_ray.py "$@" || status=1
+"$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --durations=5 --ignore=test_rllib.py --ignore=test_sweep_ray.py --ignore=test_tune_example.py "$@" || status=1
 lap "main suites"
 echo "== pytest (rllib venv)"
-"$work/venv-rllib/bin/python" -m pytest -q -p no:cacheprovider test_rllib.py test_sweep_ray.py "$@" || status=1
+"$work/venv-rllib/bin/python" -m pytest -q -p no:cacheprovider test_rllib.py test_sweep_ray.py test_tune_example.py "$@" || status=1
 lap "rllib suite"
 echo "== python part done in $(($(stamp) - t0)) s (status $status)"
 exit $status
