@@ -8,8 +8,14 @@ followers and a predator, 30 s of simulated time each) on all cores, against one
   CPU per run  the parallel sweep's CPU time (user + sys) / 1000: equal to `one run` when running in
                parallel costs nothing extra. On a machine shared with other work the wall-clock
                efficiency falls while this does not, so both are printed, with the load average.
+  floor        the machine's own scaling, measured in the same run: `cores` independent one-thread
+               sweep processes of 1000 / cores runs each, started together. A VM whose cores share
+               one physical core, or a machine busy with other work, caps this below 1; the sweep's
+               efficiency over the floor's is what the runner itself loses.
 
-Usage: python3 benches/sweep_throughput.py [--cores N] [--bin PATH]
+Each measurement is repeated `--repeat` times, interleaved; medians are printed.
+
+Usage: python3 benches/sweep_throughput.py [--cores N] [--repeat K] [--bin PATH]
 (default: all cores, and target/release/colcos built first)
 """
 
@@ -44,9 +50,24 @@ def timed(cmd: list[str]) -> tuple[float, float]:
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+def processes_at_once(cmds: list[list[str]]) -> float:
+    """Wall time of child processes started together, s."""
+    t0 = time.perf_counter()
+    children = [subprocess.Popen(c, stdout=subprocess.DEVNULL) for c in cmds]
+    for child in children:
+        if child.wait() != 0:
+            raise SystemExit(f"{child.args} failed")
+    return time.perf_counter() - t0
+
+
+def median(xs: list[float]) -> float:
+    return sorted(xs)[len(xs) // 2]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cores", type=int, default=os.cpu_count())
+    ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--bin", default=None, help="a colcos binary (default: build target/release/colcos)")
     a = ap.parse_args()
     binary = a.bin
@@ -58,19 +79,28 @@ def main() -> None:
         sweep_file(d / "one.toml", 50)
         sweep_file(d / "many.toml", 1000)
         run = [binary, "sweep", "--quiet", "--out"]
-        one_wall, _ = timed(run + [str(d / "one"), str(d / "one.toml"), "--threads", "1"])
-        load0 = os.getloadavg()[0]
-        wall, cpu = timed(run + [str(d / "many"), str(d / "many.toml"), "--threads", str(a.cores)])
-        load1 = os.getloadavg()[0]
-    one_ms = one_wall / 50 * 1e3
-    cpu_ms = cpu / 1000 * 1e3
+        share = 1000 // a.cores
+        for k in range(a.cores):
+            sweep_file(d / f"part{k}.toml", share)
+        ones, walls, cpus, floors, loads = [], [], [], [], []
+        for r in range(a.repeat):
+            ones.append(timed(run + [str(d / f"one{r}"), str(d / "one.toml"), "--threads", "1"])[0] / 50)
+            loads.append(os.getloadavg()[0])
+            wall, cpu = timed(run + [str(d / f"many{r}"), str(d / "many.toml"), "--threads", str(a.cores)])
+            walls.append(wall)
+            cpus.append(cpu)
+            parts = [run + [str(d / f"part{k}_{r}"), str(d / f"part{k}.toml"), "--threads", "1"] for k in range(a.cores)]
+            floors.append(processes_at_once(parts) / (share * a.cores) * 1000)
+    one_ms, wall, cpu_ms, floor = median(ones) * 1e3, median(walls), median(cpus), median(floors)
     rate = 1000 / wall
+    efficiency = rate * one_ms / 1e3 / a.cores
+    floor_efficiency = 1000 / floor * one_ms / 1e3 / a.cores
     print(
         f"one run alone: {one_ms:.2f} ms; 1,000 runs on {a.cores} threads: {wall:.2f} s, {rate:.1f} runs/s; "
-        f"parallel efficiency {rate * one_ms / 1e3 / a.cores:.2f}; CPU per run {cpu_ms:.2f} ms "
-        f"({one_ms / cpu_ms:.2f} x one run alone); load average {load0:.1f} -> {load1:.1f}"
+        f"parallel efficiency {efficiency:.2f}; floor ({a.cores} independent processes) {floor_efficiency:.2f}; "
+        f"sweep / floor {efficiency / floor_efficiency:.2f}; CPU per run {cpu_ms:.2f} ms "
+        f"({one_ms / cpu_ms:.2f} x one run alone); load average {median(loads):.1f} (medians of {a.repeat})"
     )
-
 
 if __name__ == "__main__":
     main()
