@@ -10,14 +10,7 @@ use colcos_sim::sensors::{ColourCalibration, RobotColour, SensorFit};
 use image::RgbImage;
 
 fn fit(gamma: f64, gain: f64, crosstalk: [[f64; 3]; 3], dark: [f64; 3]) -> SensorFit {
-    SensorFit {
-        gamma,
-        dark,
-        matrix: crosstalk.map(|r| r.map(|v| v * gain * 24.0)),
-        gain,
-        crosstalk,
-        rms_counts: 5.0,
-    }
+    SensorFit::from_parts(gamma, gain, crosstalk, dark, 24.0)
 }
 
 /// Two robots far apart: a dim red-leaning one and a bright one with strong green-blue crosstalk

@@ -8,14 +8,7 @@ use colcos_sim::world::World;
 
 /// A fitted sensor: `gain` counts per unit light per ms at 24 ms, `crosstalk`, `dark` per channel.
 fn fit(gamma: f64, gain: f64, crosstalk: [[f64; 3]; 3], dark: [f64; 3]) -> SensorFit {
-    SensorFit {
-        gamma,
-        dark,
-        matrix: crosstalk.map(|r| r.map(|v| v * gain * 24.0)),
-        gain,
-        crosstalk,
-        rms_counts: 5.0,
-    }
+    SensorFit::from_parts(gamma, gain, crosstalk, dark, 24.0)
 }
 
 /// Radio 1: a dim, red-leaning sensor; radio 2: a bright one with strong green-blue crosstalk.

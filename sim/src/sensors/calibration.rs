@@ -30,6 +30,25 @@ pub struct SensorFit {
 }
 
 impl SensorFit {
+    /// A sensor's model from its parts (a datasheet's or a twin's known values): the matrix is
+    /// `gain x integration_ms x crosstalk`; no fit, so no residual.
+    pub fn from_parts(
+        gamma: f64,
+        gain: f64,
+        crosstalk: [[f64; 3]; 3],
+        dark: [f64; 3],
+        integration_ms: f64,
+    ) -> SensorFit {
+        SensorFit {
+            gamma,
+            dark,
+            matrix: crosstalk.map(|r| r.map(|v| v * gain * integration_ms)),
+            gain,
+            crosstalk,
+            rms_counts: 0.0,
+        }
+    }
+
     /// The counts the model predicts for `levels` (without noise or saturation).
     pub fn predict(&self, levels: [f64; 3]) -> [f64; 3] {
         let light = levels.map(|l| (l / 255.0).clamp(0.0, 1.0).powf(self.gamma));
