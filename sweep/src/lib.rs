@@ -18,6 +18,7 @@ pub mod axis;
 pub mod error;
 pub mod keypath;
 pub mod metrics;
+pub mod parquet_table;
 pub mod plan;
 pub mod runner;
 pub mod spec;

@@ -148,7 +148,10 @@ impl ResultsTable {
         std::fs::write(&tmp, &bytes)
             .map_err(|e| SweepError::io(format!("writing {}", tmp.display()), e))?;
         std::fs::rename(&tmp, &self.path)
-            .map_err(|e| SweepError::io(format!("replacing {}", self.path.display()), e))
+            .map_err(|e| SweepError::io(format!("replacing {}", self.path.display()), e))?;
+        let rows: Vec<&[String]> = self.rows.values().map(Vec::as_slice).collect();
+        let parquet = self.path.with_file_name(crate::parquet_table::PARQUET_FILE);
+        crate::parquet_table::write_parquet(&parquet, &self.columns, &rows)
     }
 }
 

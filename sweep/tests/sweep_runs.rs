@@ -184,3 +184,44 @@ fn traced_runs_give_the_same_row_and_the_poses_at_the_sample_times() {
     assert_eq!(row.fields(&plan)[plan.columns.len() - 2], "");
     assert!(tiny().with_extra_metrics(&["s_mean".to_string()]).is_err());
 }
+
+#[test]
+fn the_finished_table_has_a_typed_parquet_copy_with_the_same_cells() {
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    use parquet::record::Field;
+    let tmp = tempfile::tempdir().unwrap();
+    run(&tiny(), tmp.path(), 2);
+    let mut csv = csv::Reader::from_path(tmp.path().join("results.csv")).unwrap();
+    let header: Vec<String> = csv.headers().unwrap().iter().map(String::from).collect();
+    let rows: Vec<Vec<String>> = csv
+        .records()
+        .map(|r| r.unwrap().iter().map(String::from).collect())
+        .collect();
+    let file = std::fs::File::open(tmp.path().join("results.parquet")).unwrap();
+    let reader = SerializedFileReader::new(file).unwrap();
+    let got: Vec<_> = reader
+        .get_row_iter(None)
+        .unwrap()
+        .map(|r| r.unwrap())
+        .collect();
+    assert_eq!(got.len(), rows.len());
+    for (row, cells) in got.iter().zip(&rows) {
+        let fields: Vec<_> = row.get_column_iter().collect();
+        assert_eq!(fields.len(), header.len());
+        for ((name, field), (column, cell)) in fields.iter().zip(header.iter().zip(cells)) {
+            assert_eq!(*name, column);
+            match field {
+                Field::Long(v) => assert_eq!(v.to_string(), *cell, "{column}"),
+                Field::Double(v) => assert_eq!(*v, cell.parse::<f64>().unwrap(), "{column}"),
+                Field::Str(v) => assert_eq!(v, cell, "{column}"),
+                Field::Null => assert!(cell.is_empty(), "{column}"),
+                other => panic!("{column}: unexpected {other:?}"),
+            }
+        }
+    }
+    // The run ids and seeds are integers, the metrics numbers.
+    let first: Vec<_> = got[0].get_column_iter().collect();
+    assert!(matches!(first[0].1, Field::Long(0)));
+    let s_mean = header.iter().position(|h| h == "s_mean").unwrap();
+    assert!(matches!(first[s_mean].1, Field::Double(_)));
+}
