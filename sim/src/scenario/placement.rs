@@ -43,12 +43,12 @@ impl Placed {
 /// Every robot's start pose, groups in order, drawn from `rng` (the world's placement stream): random
 /// without overlap, on a grid, or explicit. Robots closer than a diameter to an earlier one (explicit
 /// or grid) and groups that cannot be placed are errors naming the key. Validation runs this for
-/// world 0, the world builds with it, so a scenario that validates also places.
-pub(crate) fn place(sc: &Scenario, rng: &mut SimRng) -> Result<Vec<Pose>> {
+/// world 0, the world builds with it, so a scenario that validates also places. `obstacles` are the
+/// scenario's ([`Obstacles::of_scenario`], built once by the caller, who keeps them).
+pub(crate) fn place(sc: &Scenario, obstacles: &Obstacles, rng: &mut SimRng) -> Result<Vec<Pose>> {
     let s = &sc.spec;
     // Robots start clear of the obstacles: explicit and grid poses inside one are errors, random
     // placement draws again.
-    let obstacles = Obstacles::of_scenario(sc)?;
     let inside = |key: String, p: Vec2| -> Result<()> {
         let what = match obstacles.overlapping(p, s.robot.radius, 0.0) {
             Some(o) => match s.obstacles.get(o) {

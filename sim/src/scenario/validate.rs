@@ -518,7 +518,8 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
     limits::check_step_work(sc, &crate::field::GridSpec::covering(arena, s.field.cell))?;
     // The placement the world runs for world 0, from the same stream.
     let mut rng = crate::rng::stream_of(s.seed, 0, crate::rng::Stream::Placement);
-    super::placement::place(sc, &mut rng).map(|_| ())
+    let obstacles = crate::arena::Obstacles::of_scenario(sc)?;
+    super::placement::place(sc, &obstacles, &mut rng).map(|_| ())
 }
 
 fn find_pheromone(sc: &Scenario, key: &str, name: &str) -> Result<usize> {

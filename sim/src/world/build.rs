@@ -102,7 +102,9 @@ impl WorldParts {
             .collect::<Result<Vec<_>>>()?;
 
         let mut placement_rng = rng::stream_of(spec.seed, world_index, Stream::Placement);
-        let poses: Vec<Pose> = placement::place(scenario, &mut placement_rng)?;
+        // Built once: placement keeps robots off them, then the bumpers and physics see them.
+        let obstacles = std::sync::Arc::new(crate::arena::Obstacles::of_scenario(scenario)?);
+        let poses: Vec<Pose> = placement::place(scenario, &obstacles, &mut placement_rng)?;
         let mut slots = Vec::with_capacity(poses.len());
         let mut deposits = Vec::new();
         let mut emitters = Vec::new();
@@ -164,9 +166,7 @@ impl WorldParts {
             arena,
             count,
         );
-        sensing.set_obstacles(std::sync::Arc::new(crate::arena::Obstacles::of_scenario(
-            scenario,
-        )?));
+        sensing.set_obstacles(obstacles);
         Ok(WorldParts {
             fields: FieldSet::new(pheromones),
             slots,
