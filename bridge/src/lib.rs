@@ -14,6 +14,7 @@ pub mod frames;
 pub mod host;
 pub mod link;
 pub mod live;
+pub mod onboard;
 pub mod plant;
 pub mod preflight;
 pub mod recorder;

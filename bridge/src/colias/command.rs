@@ -4,6 +4,11 @@
 //! `MWS` (two `f32` wheel speeds, left then right, m/s) is this bridge's extension for policies that
 //! run on the host. Firmware that predates it does not know the code and ignores the frame, so a
 //! rig must either run firmware with `MWS` or use [`super::LegacyDrive`] to send motion commands.
+//!
+//! `PWP` (a `u16` offset, a `u8` count and five `f32`) and `PRN` (a `u32` policy hash) are the
+//! extensions for a policy that runs on board (`colcos.onboard.export_c`): the first writes into the
+//! policy's runtime parameter block, the second starts the policy the robot was flashed with if its
+//! hash matches. Any motion or wheel-speed command takes the robot back to the host's commands.
 
 use super::COMMAND_LEN;
 use thiserror::Error;
@@ -62,6 +67,16 @@ pub enum HostCommand {
     WheelSpeeds {
         left: f32,
         right: f32,
+    },
+    /// `PWP`: `count` (1..=5) of `values` into the on-board policy's parameters from `offset`.
+    WriteParamsAt {
+        offset: u16,
+        count: u8,
+        values: [f32; 5],
+    },
+    /// `PRN`: run the on-board policy whose hash is `hash`.
+    RunPolicy {
+        hash: u32,
     },
 }
 
@@ -133,6 +148,22 @@ impl CommandPacket {
                 put_f32(&mut p, 8, left);
                 put_f32(&mut p, 12, right);
             }
+            HostCommand::WriteParamsAt {
+                offset,
+                count,
+                values,
+            } => {
+                p[5..8].copy_from_slice(b"PWP");
+                p[8..10].copy_from_slice(&offset.to_le_bytes());
+                p[10] = count;
+                for (k, v) in values.iter().enumerate() {
+                    put_f32(&mut p, 11 + 4 * k, *v);
+                }
+            }
+            HostCommand::RunPolicy { hash } => {
+                p[5..8].copy_from_slice(b"PRN");
+                p[8..12].copy_from_slice(&hash.to_le_bytes());
+            }
         }
         p
     }
@@ -153,6 +184,16 @@ impl CommandPacket {
             HostCommand::WheelSpeeds {
                 left: f32_at(p, 8),
                 right: f32_at(p, 12),
+            }
+        } else if &code == b"PWP" {
+            HostCommand::WriteParamsAt {
+                offset: u16::from_le_bytes([p[8], p[9]]),
+                count: p[10],
+                values: std::array::from_fn(|k| f32_at(p, 11 + 4 * k)),
+            }
+        } else if &code == b"PRN" {
+            HostCommand::RunPolicy {
+                hash: u32::from_le_bytes([p[8], p[9], p[10], p[11]]),
             }
         } else if &code[..2] == b"DR" {
             HostCommand::RequestTelemetry(code[2])
@@ -190,6 +231,28 @@ mod tests {
         assert!(p[12..].iter().all(|&b| b == 0));
         let d = CommandPacket::new(200, 5, HostCommand::RequestTelemetry(3)).encode();
         assert_eq!(&d[..9], &[200, 5, 0, 0, 0, b'D', b'R', 3, 0]);
+        let w = CommandPacket::new(
+            2,
+            1,
+            HostCommand::WriteParamsAt {
+                offset: 0x0102,
+                count: 2,
+                values: [1.0, -2.0, 0.0, 0.0, 0.0],
+            },
+        )
+        .encode();
+        assert_eq!(
+            &w[..19],
+            &[
+                2, 1, 0, 0, 0, b'P', b'W', b'P', 0x02, 0x01, 2, 0, 0, 0x80, 0x3F, 0, 0, 0, 0xC0
+            ]
+        );
+        assert!(w[19..].iter().all(|&b| b == 0));
+        let r = CommandPacket::new(4, 0, HostCommand::RunPolicy { hash: 0xDEAD_BEEF }).encode();
+        assert_eq!(
+            &r[..12],
+            &[4, 0, 0, 0, 0, b'P', b'R', b'N', 0xEF, 0xBE, 0xAD, 0xDE]
+        );
     }
 
     #[test]
@@ -205,6 +268,12 @@ mod tests {
                 left: -0.1,
                 right: 0.3,
             },
+            HostCommand::WriteParamsAt {
+                offset: 58,
+                count: 5,
+                values: [1.0, 2.0, 3.0, 4.0, 5.5],
+            },
+            HostCommand::RunPolicy { hash: 7 },
         ];
         for c in cmds {
             let p = CommandPacket::new(3, 99, c);

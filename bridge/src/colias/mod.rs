@@ -5,11 +5,13 @@
 mod command;
 mod frame;
 mod legacy;
+mod onboard_status;
 mod telemetry;
 
 pub use command::{CommandError, CommandPacket, HostCommand, MotionKind};
 pub use frame::{DecoderCounters, FrameDecoder, encode_frame};
 pub use legacy::{LegacyDrive, TELEMETRY_TO_SIM, colour_from_sim, colour_to_sim};
+pub use onboard_status::{OnboardStatus, PolicyMode};
 pub use telemetry::Telemetry;
 
 /// Frame start marker.

@@ -1,10 +1,16 @@
 //! Shares a slow serial channel between robots: at most what the line can carry is sent, only the
-//! newest command per robot waits (a newer one replaces it), and robots take turns.
+//! newest command per robot waits (a newer one replaces it), and robots take turns. Parameter writes
+//! are the exception: each carries its own values, so they wait in order, ahead of the robot's
+//! newest command (a policy is started only after its parameters are in).
 
 use crate::colias::{
     COMMAND_FRAME_LEN, CommandPacket, HostCommand, TELEMETRY_FRAME_LEN, airtime_s,
 };
+use std::collections::VecDeque;
 use std::time::{Duration, Instant};
+
+/// Parameter writes one robot may have waiting; more are dropped (and counted).
+const MAX_WRITES_WAITING: usize = 64;
 
 /// Running totals of a scheduler.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -13,12 +19,16 @@ pub struct SchedulerCounters {
     pub sent: u64,
     /// Commands replaced by a newer one for the same robot before they could be sent.
     pub superseded: u64,
+    /// Parameter writes dropped because too many were waiting for their robot.
+    pub dropped_writes: u64,
 }
 
 /// Airtime-limited, newest-wins command queue (one slot per robot id, so never more than 256).
 #[derive(Debug)]
 pub struct AirtimeScheduler {
     slots: Box<[Option<CommandPacket>; 256]>,
+    /// Per robot id, parameter writes in order.
+    writes: Vec<VecDeque<CommandPacket>>,
     pending: usize,
     /// The id after the last one sent: where the round-robin scan starts.
     cursor: usize,
@@ -35,6 +45,7 @@ impl AirtimeScheduler {
     pub fn new(baud: u32) -> Self {
         AirtimeScheduler {
             slots: Box::new([None; 256]),
+            writes: vec![VecDeque::new(); 256],
             pending: 0,
             cursor: 0,
             command_airtime: Duration::from_secs_f64(airtime_s(COMMAND_FRAME_LEN, baud)),
@@ -68,12 +79,26 @@ impl AirtimeScheduler {
         for slot in self.slots.iter_mut() {
             *slot = None;
         }
+        self.writes.iter_mut().for_each(VecDeque::clear);
         self.pending = 0;
     }
 
     /// Queues a command, replacing any unsent one for the same robot.
     pub fn submit(&mut self, p: CommandPacket) {
         self.counters.submitted += 1;
+        if matches!(
+            p.command,
+            HostCommand::WriteParamsAt { .. } | HostCommand::WriteParams(_)
+        ) {
+            let queue = &mut self.writes[p.id as usize];
+            if queue.len() >= MAX_WRITES_WAITING {
+                self.counters.dropped_writes += 1;
+                return;
+            }
+            queue.push_back(p);
+            self.pending += 1;
+            return;
+        }
         if self.slots[p.id as usize].replace(p).is_some() {
             self.counters.superseded += 1;
         } else {
@@ -103,8 +128,11 @@ impl AirtimeScheduler {
         }
         let id = (0..256)
             .map(|k| (self.cursor + k) % 256)
-            .find(|&i| self.slots[i].is_some())?;
-        let p = self.slots[id].take()?;
+            .find(|&i| self.slots[i].is_some() || !self.writes[i].is_empty())?;
+        let p = match self.writes[id].pop_front() {
+            Some(w) => w,
+            None => self.slots[id].take()?,
+        };
         self.pending -= 1;
         self.cursor = (id + 1) % 256;
         self.free_at = Some(free_at + self.cost(&p));
@@ -176,6 +204,48 @@ mod tests {
         }
         // One second of line at 3.125 ms a frame is 320 frames, plus the initial burst.
         assert!((310..=330).contains(&sent), "{sent}");
+    }
+
+    #[test]
+    fn parameter_writes_wait_in_order_ahead_of_the_newest_command() {
+        let mut s = AirtimeScheduler::new(115_200).with_burst(Duration::from_secs(1));
+        let write = |id: u8, offset: u16| {
+            CommandPacket::new(
+                id,
+                0,
+                HostCommand::WriteParamsAt {
+                    offset,
+                    count: 5,
+                    values: [offset as f32; 5],
+                },
+            )
+        };
+        s.submit(cmd(1, 0.1));
+        for k in 0..12 {
+            s.submit(write(1, 5 * k));
+        }
+        s.submit(CommandPacket::new(1, 0, HostCommand::RunPolicy { hash: 9 }));
+        s.submit(write(2, 0));
+        let sent = s.drain_due(Instant::now());
+        assert_eq!(s.counters().superseded, 1);
+        let to_one: Vec<_> = sent
+            .iter()
+            .filter(|p| p.id == 1)
+            .map(|p| p.command)
+            .collect();
+        assert_eq!(to_one.len(), 13);
+        for (k, c) in to_one[..12].iter().enumerate() {
+            assert_eq!(*c, write(1, 5 * k as u16).command);
+        }
+        assert_eq!(to_one[12], HostCommand::RunPolicy { hash: 9 });
+        assert!(sent.iter().any(|p| p.id == 2));
+        // A runaway sender cannot grow the queue without bound.
+        for _ in 0..100 {
+            s.submit(write(3, 0));
+        }
+        assert_eq!(s.counters().dropped_writes, 100 - MAX_WRITES_WAITING as u64);
+        s.clear();
+        assert_eq!(s.pending(), 0);
     }
 
     #[test]

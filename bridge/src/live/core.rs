@@ -2,6 +2,7 @@
 //! tick's time, the watchdog's stops and a policy's commands in; command frames out. No clock, socket
 //! or file in here, so a recorded run put through it again gives the same command bytes (a replay),
 //! and the Python plants step it with a policy's actions.
+use super::onboard::OnboardHost;
 use super::stopper::{drive_packet, t_ms};
 use crate::colias::{CommandPacket, HostCommand, LegacyDrive, Telemetry, colour_to_sim};
 use crate::host::Host;
@@ -77,6 +78,9 @@ pub struct LoopCore {
     /// inverse onto the scenario's sensor model).
     calibration: crate::calibrate::RigCalibration,
     nominal: colcos_sim::sensors::ColourSensor,
+    /// The robots run a policy of their own (`[rig] onboard`): the host sends only its parameters,
+    /// starts and stops.
+    onboard: Option<OnboardHost>,
 }
 
 impl LoopCore {
@@ -95,6 +99,9 @@ impl LoopCore {
         let mut host = Host::with_index(scenario, rig.sensors, index)?;
         host.set_latency(rig.latency);
         let n = host.robot_count();
+        let radio = rig.radio_addresses(n)?;
+        let onboard = crate::onboard::OnboardManifest::of_scenario(scenario)?
+            .map(|m| OnboardHost::new(&m, scenario, calibration.colour.as_ref(), &radio));
         let telemetry_every = if rig.telemetry_hz > 0.0 && n > 0 {
             1.0 / (rig.telemetry_hz as f64 * n as f64)
         } else {
@@ -102,7 +109,7 @@ impl LoopCore {
         };
         Ok(LoopCore {
             shield: Shield::new(rig.shield, scenario.arena_size()),
-            radio: rig.radio_addresses(n)?,
+            radio,
             tracker_ids: (0..n).map(|i| rig.tracker_id(i)).collect(),
             firmware: rig.firmware,
             legacy,
@@ -124,6 +131,7 @@ impl LoopCore {
             events: Vec::new(),
             calibration,
             nominal: colcos_sim::sensors::ColourSensor::new(scenario.spec.sensor),
+            onboard,
             host,
         })
     }
@@ -173,6 +181,10 @@ impl LoopCore {
     pub fn interventions(&self) -> &[Intervention] {
         &self.interventions
     }
+    /// The host's side of the robots' on-board policy, when they run one.
+    pub fn onboard(&self) -> Option<&OnboardHost> {
+        self.onboard.as_ref()
+    }
     /// JSON events of the last tick (a robot fell silent), for the log.
     pub fn take_events(&mut self) -> Vec<String> {
         std::mem::take(&mut self.events)
@@ -205,6 +217,9 @@ impl LoopCore {
                     self.calibration
                         .robot_counts(tm.id, colour_to_sim(tm.colour), &self.nominal);
                 self.host.set_readings(i, counts, bumpers);
+                if let Some(event) = self.onboard.as_mut().and_then(|o| o.take_telemetry(i, tm)) {
+                    self.events.push(event);
+                }
             }
         }
         // A robot that has answered before and not for `answer_timeout`: its radio is gone, so it can
@@ -235,6 +250,29 @@ impl LoopCore {
         self.packets.clear();
         let stamp = t_ms(t);
         for i in 0..self.radio.len() {
+            let stopped = input.stopped.get(i).copied().unwrap_or(false);
+            if let Some(onboard) = &mut self.onboard {
+                // The robot drives itself; the shield can only look ahead and stop it.
+                let cmd = onboard.driving(i);
+                let (_, intervention) = self.shield.apply(&self.host.poses()[i], cmd);
+                self.interventions[i] = intervention;
+                self.counters.shield.add(intervention);
+                let hold = stopped
+                    || !self.host.tracked()[i].seen
+                    || self.silent[i]
+                    || intervention.walled;
+                let drives = onboard.frames(
+                    i,
+                    t,
+                    stamp,
+                    hold,
+                    self.keepalive,
+                    self.firmware,
+                    &mut self.packets,
+                );
+                self.sent[i] = if drives { cmd } else { WheelCommand::STOP };
+                continue;
+            }
             let mut cmd = self.host.commands()[i];
             if let Some(Some(o)) = input.overrides.get(i) {
                 cmd = *o;
@@ -242,7 +280,6 @@ impl LoopCore {
             let (cmd, intervention) = self.shield.apply(&self.host.poses()[i], cmd);
             self.interventions[i] = intervention;
             self.counters.shield.add(intervention);
-            let stopped = input.stopped.get(i).copied().unwrap_or(false);
             let cmd = if stopped || !self.host.tracked()[i].seen || self.silent[i] {
                 WheelCommand::STOP
             } else {

@@ -8,12 +8,14 @@
 
 mod core;
 mod gif_thread;
+mod onboard;
 mod options;
 pub mod replay;
 mod session;
 mod stopper;
 
 pub use core::{CoreCounters, LoopCore, PoseIn, TickInput};
+pub use onboard::OnboardHost;
 pub use options::{FrameSink, LiveOptions, LiveReport};
 pub use session::LiveSession;
 pub use stopper::{drive_packet, stop_packet, t_ms};

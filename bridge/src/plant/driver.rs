@@ -157,3 +157,18 @@ impl Drop for TwinThread {
         }
     }
 }
+
+/// A policy from Python drives the robots from the host: a scenario whose robots run their own
+/// (`[rig] onboard`) would ignore its actions, so it is refused.
+pub(super) fn refuse_onboard(scenario: &Scenario) -> Result<(), PlantError> {
+    match &scenario.spec.rig.onboard {
+        Some(path) => Err(colcos_sim::error::SimError::invalid(
+            "rig.onboard",
+            path,
+            "the robots would run their own policy and ignore this environment's actions: \
+             run an on-board policy with `colcos bridge` (and `colcos twin`)",
+        )
+        .into()),
+        None => Ok(()),
+    }
+}

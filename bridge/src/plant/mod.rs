@@ -181,6 +181,7 @@ impl LiveEnv {
         let spec = VecEnv::new(&one)?.spec().clone();
         let (task, mut scenario) = registry::build(&cfg.task, &cfg.scenario, &cfg.params)?;
         scenario.spec.seed = cfg.seed;
+        driver::refuse_onboard(&scenario)?;
         let driver = Self::open(&scenario, plant)?;
         let p = &scenario.spec.robot;
         let goto = (plant.goto && plant.kind != PlantKind::Replay).then(|| {

@@ -17,6 +17,7 @@ pub use robot_end::{
 pub use tracker_server::{TrackerFaults, TrackerServer};
 
 use crate::frames::FrameClient;
+use crate::onboard::{OnboardFirmware, OnboardFleet, OnboardManifest};
 use crate::swarmcon::FrameTransform;
 use colcos_sim::scenario::Scenario;
 use std::net::SocketAddr;
@@ -60,10 +61,15 @@ impl Twin {
         let n = plant.robot_count();
         let radio = rig.radio_addresses(n)?;
         let rate = scenario.spec.tracker.rate_hz.max(1.0) as f64;
+        let mut robots = RobotEnd::new(channel, radio);
+        if let Some(manifest) = OnboardManifest::of_scenario(scenario)? {
+            let firmware = OnboardFirmware::build(&manifest)?;
+            robots.set_onboard(Some(OnboardFleet::new(firmware, n)));
+        }
         Ok(Twin {
             plant,
             tracker,
-            robots: RobotEnd::new(channel, radio),
+            robots,
             frames: frames.map(FrameClient::connect),
             transform: FrameTransform::new(scenario.arena_size().y as f64),
             tracker_ids: (0..n).map(|i| rig.tracker_id(i)).collect(),
@@ -90,6 +96,10 @@ impl Twin {
     }
     pub fn robots(&mut self) -> &mut RobotEnd {
         &mut self.robots
+    }
+    /// The robots' on-board policy, when their firmware carries one (`[rig] onboard`).
+    pub fn onboard(&self) -> Option<&OnboardFleet> {
+        self.robots.onboard()
     }
     /// Commands received so far.
     pub fn received(&self) -> &[Received] {

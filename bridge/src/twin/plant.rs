@@ -79,6 +79,28 @@ impl TwinPlant {
         }
     }
 
+    /// Robot `i` heard a frame for it that is not a drive command (its on-board policy's link
+    /// activity): its timeout starts again, its command stays.
+    pub fn keep_alive(&mut self, i: usize) {
+        let now = self.time();
+        if let Some(h) = self.heard.get_mut(i) {
+            *h = now;
+        }
+    }
+    /// Robot `i` drives with `cmd` of its own choosing (its on-board policy); the link timeout runs on.
+    pub fn drive(&mut self, i: usize, cmd: WheelCommand) {
+        if let Some(c) = self.commands.get_mut(i)
+            && cmd.left.is_finite()
+            && cmd.right.is_finite()
+        {
+            *c = cmd;
+        }
+    }
+    /// Seconds since robot `i` last heard a frame for it.
+    pub fn heard_age(&self, i: usize) -> f64 {
+        self.time() - self.heard.get(i).copied().unwrap_or(f64::NEG_INFINITY)
+    }
+
     /// One step of the scenario's `dt`; robots that have heard nothing for [`FIRMWARE_TIMEOUT`] stop.
     pub fn step(&mut self) {
         let now = self.time();

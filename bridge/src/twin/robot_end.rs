@@ -1,11 +1,12 @@
 //! The robots' end of the serial protocol, for the twin: reads host command frames from a byte
 //! channel (a pseudo-terminal, so the bridge's real serial code runs, or UDP), applies them to the
 //! simulated robots, and answers data requests with 96-byte telemetry frames.
-use super::plant::TwinPlant;
+use super::plant::{FIRMWARE_TIMEOUT, TwinPlant};
 use crate::colias::{
     BROADCAST_ID, COMMAND_LEN, CommandPacket, FrameDecoder, HostCommand, MotionKind, Telemetry,
     colour_from_sim,
 };
+use crate::onboard::OnboardFleet;
 use colcos_sim::behaviour::WheelCommand;
 use image::RgbImage;
 use std::io::{Read, Write};
@@ -137,6 +138,8 @@ pub struct RobotEnd {
     pub log: Vec<Received>,
     /// Payloads that were framed right but did not decode.
     pub rejected: u64,
+    /// The robots' on-board policy, when their firmware carries one.
+    onboard: Option<OnboardFleet>,
 }
 
 impl RobotEnd {
@@ -150,7 +153,16 @@ impl RobotEnd {
             faults: Default::default(),
             log: Vec::new(),
             rejected: 0,
+            onboard: None,
         }
+    }
+
+    /// Flashes the robots with an on-board policy (`None`: firmware without one).
+    pub fn set_onboard(&mut self, fleet: Option<OnboardFleet>) {
+        self.onboard = fleet;
+    }
+    pub fn onboard(&self) -> Option<&OnboardFleet> {
+        self.onboard.as_ref()
     }
 
     pub fn describe(&self) -> String {
@@ -189,6 +201,11 @@ impl RobotEnd {
                 if faults.deaf.contains(&self.radio[i]) {
                     continue;
                 }
+                if let Some(fleet) = &mut self.onboard {
+                    fleet.hear(i, &packet.command);
+                    // Firmware with a policy counts any frame for it as the link being alive.
+                    plant.keep_alive(i);
+                }
                 match packet.command {
                     HostCommand::WheelSpeeds { left, right } => {
                         plant.hear(Some(i), WheelCommand { left, right })
@@ -203,26 +220,53 @@ impl RobotEnd {
                             self.channel.send(&t.to_frame());
                         }
                     }
-                    HostCommand::WriteParams(_) => {}
+                    HostCommand::WriteParams(_)
+                    | HostCommand::WriteParamsAt { .. }
+                    | HostCommand::RunPolicy { .. } => {}
                 }
             }
         }
         self.payloads = payloads;
+        self.run_onboard(plant, frame);
+    }
+
+    /// One control tick of every robot running its on-board policy, on its own readings.
+    fn run_onboard(&mut self, plant: &mut TwinPlant, frame: Option<&RgbImage>) {
+        let Some(fleet) = &mut self.onboard else {
+            return;
+        };
+        for i in 0..self.radio.len() {
+            if !fleet.running(i) {
+                continue;
+            }
+            if plant.heard_age(i) > FIRMWARE_TIMEOUT {
+                fleet.lose_link(i);
+                plant.hear(Some(i), WheelCommand::STOP);
+                continue;
+            }
+            let colour = colour_from_sim(plant.colour_counts(i, frame));
+            let (on, off) = bumper_counts(plant.bumpers(i));
+            let cmd = fleet.control(i, &colour, &on, &off);
+            plant.drive(i, cmd);
+        }
     }
 
     fn telemetry(&self, plant: &mut TwinPlant, i: usize, frame: Option<&RgbImage>) -> Telemetry {
         let colour = colour_from_sim(plant.colour_counts(i, frame));
-        let bumpers = plant.bumpers(i);
-        Telemetry {
+        let (tcrt_on, tcrt_off) = bumper_counts(plant.bumpers(i));
+        let mut t = Telemetry {
             id: self.radio[i],
             sys_t_ms: (plant.time() * 1e3) as u32,
             v_bat: 200,
             colour,
-            tcrt_off: [BUMPER_DARK; 3],
-            tcrt_on: bumpers
-                .map(|b| BUMPER_DARK + (b.clamp(0.0, 1.0) * BUMPER_SPAN as f32).round() as u16),
+            tcrt_off,
+            tcrt_on,
             ..Telemetry::default()
+        };
+        if let Some(fleet) = &self.onboard {
+            t.set_onboard(&fleet.status(i, plant.command(i)));
         }
+        t
     }
 }
 
@@ -230,6 +274,12 @@ impl RobotEnd {
 /// (emitter on minus emitter off is proportional to the reading in [0, 1]).
 pub const BUMPER_DARK: u16 = 100;
 pub const BUMPER_SPAN: u16 = 3000;
+
+/// The twin's IR counts (emitter on, emitter off) for bumper readings in [0, 1].
+fn bumper_counts(bumpers: [f32; 3]) -> ([u16; 3], [u16; 3]) {
+    let on = bumpers.map(|b| BUMPER_DARK + (b.clamp(0.0, 1.0) * BUMPER_SPAN as f32).round() as u16);
+    (on, [BUMPER_DARK; 3])
+}
 
 /// A bumper reading in [0, 1] from the emitter-on and emitter-off counts (the twin's scale).
 pub fn bumper_reading(on: u16, off: u16) -> f32 {

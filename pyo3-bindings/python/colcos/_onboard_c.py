@@ -125,6 +125,36 @@ extern "C" {{
 /* Largest wheel speed, m/s: the action scale and the last command's (robot.max_wheel_speed). */
 #define {U}_MAX_WHEEL_SPEED {c_float(p["max_wheel_speed"])}
 
+/* This policy's identity: a hash of its network (FNV-1a over the layer sizes, activations, weights
+ * and normaliser). The host's `PRN` names it and the robot runs only the policy it was flashed with. */
+#define {U}_HASH {p["hash_hex"]}u
+
+/* Runtime parameters: what the host may rewrite over the radio (`PWP`: an offset and up to five f32)
+ * without reflashing. The firmware keeps one block in RAM ({U}_N_RUNTIME f32), filled by
+ * {P}_default_params at boot. Layout: */
+#define {U}_N_RUNTIME {p["n_runtime"]}
+#define {U}_P_MAX_SPEED 0      /* largest wheel speed, m/s (action scale) */
+#define {U}_P_INV_MAX_SPEED 1  /* its reciprocal (last command's scale) */
+#define {U}_P_BUMPER_SPAN 2    /* IR counts, emitter on minus off, at contact */
+/* Colour sensor w (telemetry order: 0 front, 1 back, 2 left, 3 right) starts at {U}_P_SENSOR(w):
+ * dark counts R, G, B (+0..2), gain x integration (+3), 1 / gamma (+4), inverse crosstalk row-major
+ * (+5..13). */
+#define {U}_P_SENSOR(w) (3 + 14 * (w))
+
+/* Fills `params` with the values this policy was exported with. */
+void {P}_default_params(float params[{U}_N_RUNTIME]);
+/* `PWP`: writes `count` (1..5) values at `offset`; returns 1, or 0 (and writes nothing) when the range
+ * leaves the block or a value is not finite, or not > 0 where a scale or a span must be. */
+int {P}_write_params(float params[{U}_N_RUNTIME], uint16_t offset, uint8_t count, const float values[]);
+/* {P}_encode / {P}_wheels / {P}_step with a runtime parameter block instead of the defaults. */
+void {P}_encode_with(const float params[{U}_N_RUNTIME], const uint16_t colour[12],
+    const uint16_t ir_on[3], const uint16_t ir_off[3], float last_left, float last_right,
+    float obs[{U}_OBS_DIM]);
+void {P}_wheels_with(const float params[{U}_N_RUNTIME], const float action[{U}_ACT_DIM],
+    float *left, float *right);
+void {P}_step_with(const float params[{U}_N_RUNTIME], const uint16_t colour[12],
+    const uint16_t ir_on[3], const uint16_t ir_off[3], float *left, float *right);
+
 /* Raw readings -> observation. colour: the 12 counts in the telemetry's order (front R, G, B, back
  * R, G, B, left ..., right ...); ir_on / ir_off: the bumpers' counts with the emitter on and off (left, middle, right);
  * last_left / last_right: the wheel speeds last commanded, m/s (non-finite reads as 0). */
@@ -157,8 +187,11 @@ void {P}_step(const uint16_t colour[12], const uint16_t ir_on[3], const uint16_t
 def _encode_source(p: dict) -> str:
     P = p["prefix"]
     k = pow_unit_constants()
-    inv = p["inverse"]
-    inv_rows = ",\n".join("    {" + ", ".join(c_hex(np.float32(x)) for x in r) + "}" for r in inv)
+    U = P.upper()
+    d = [c_hex(np.float32(x)) for x in p["runtime_defaults"]]
+    rows = [", ".join(d[:3]) + ", /* max speed, 1 / max speed, bumper span */"]
+    rows += [", ".join(d[3 + 14 * w : 3 + 14 * (w + 1)]) + f", /* sensor {w} */" for w in range(4)]
+    defaults = "\n".join("    " + r for r in rows)
     return f"""\
 /* ---- Observation encoding (colcos env/src/encoding.rs, sim/src/sensors/colour.rs) ---- */
 
@@ -166,17 +199,11 @@ def _encode_source(p: dict) -> str:
  * (gain x integration), clamped to [0, 1]; intensity = light^(1 / gamma); a saturated channel (65535)
  * reads 1. Calibration: gamma {p["gamma"]}, gain {p["gain"]} counts per unit light per ms, integration
  * {p["integration_ms"]} ms, dark {p["dark_counts"]} counts, crosstalk {p["crosstalk_text"]}. */
-static const float {P}_DARK = {c_hex(p["dark_f32"])};
-static const float {P}_SCALE = {c_hex(p["scale_f32"])}; /* gain x integration */
-static const float {P}_INV_GAMMA = {c_hex(p["inv_gamma_f32"])};
-static const float {P}_INVERSE[3][3] = {{
-{inv_rows}
+static const float {P}_DEFAULTS[{U}_N_RUNTIME] = {{
+{defaults}
 }};
 /* Telemetry colour sensor w (front, back, left, right) -> observation slot (right, front, left, back). */
 static const uint8_t {P}_SLOT[4] = {{{", ".join(str(s) for s in TELEMETRY_TO_SIM)}}};
-/* Bumper reading = (on - off) / span, clamped to [0, 1] (the digital twin's IR scale). */
-static const float {P}_BUMPER_SPAN = {c_float(p["bumper_span"])};
-static const float {P}_INV_MAX_SPEED = {c_hex(p["inv_max_speed_f32"])};
 
 typedef union {{
     float f;
@@ -220,34 +247,72 @@ static float {P}_clamp1(float v)
     return v != v ? 0.0f : (v < -1.0f ? -1.0f : (v > 1.0f ? 1.0f : v));
 }}
 
-void {P}_encode(const uint16_t colour[12], const uint16_t ir_on[3], const uint16_t ir_off[3],
-    float last_left, float last_right, float obs[17])
+void {P}_default_params(float params[{U}_N_RUNTIME])
+{{
+    int i;
+    for (i = 0; i < {U}_N_RUNTIME; ++i)
+        params[i] = {P}_DEFAULTS[i];
+}}
+
+/* Scales and spans divide: they must stay > 0. */
+static int {P}_positive_slot(int i)
+{{
+    return i <= {U}_P_BUMPER_SPAN || (i - 3) % 14 == 3 || (i - 3) % 14 == 4;
+}}
+
+int {P}_write_params(float params[{U}_N_RUNTIME], uint16_t offset, uint8_t count, const float values[])
+{{
+    int k;
+    if (count == 0 || count > 5 || offset >= {U}_N_RUNTIME || count > {U}_N_RUNTIME - offset)
+        return 0;
+    for (k = 0; k < count; ++k) {{
+        float v = values[k];
+        if (v != v || v - v != 0.0f) /* NaN or infinite */
+            return 0;
+        if ({P}_positive_slot(offset + k) && !(v > 0.0f))
+            return 0;
+    }}
+    for (k = 0; k < count; ++k)
+        params[offset + k] = values[k];
+    return 1;
+}}
+
+void {P}_encode_with(const float params[{U}_N_RUNTIME], const uint16_t colour[12],
+    const uint16_t ir_on[3], const uint16_t ir_off[3], float last_left, float last_right, float obs[17])
 {{
     int w, c;
     for (w = 0; w < 4; ++w) {{
+        const float *s = params + {U}_P_SENSOR(w);
         float sig[3];
         float *out = obs + 3 * {P}_SLOT[w];
         for (c = 0; c < 3; ++c)
-            sig[c] = ((float)colour[3 * w + c] - {P}_DARK) / {P}_SCALE;
+            sig[c] = ((float)colour[3 * w + c] - s[c]) / s[3];
         for (c = 0; c < 3; ++c) {{
-            float light = {P}_INVERSE[c][0] * sig[0] + {P}_INVERSE[c][1] * sig[1]
-                + {P}_INVERSE[c][2] * sig[2];
+            float light = s[5 + 3 * c] * sig[0] + s[6 + 3 * c] * sig[1] + s[7 + 3 * c] * sig[2];
             light = light > 0.0f ? (light < 1.0f ? light : 1.0f) : 0.0f;
-            out[c] = colour[3 * w + c] == 65535u ? 1.0f : {P}_pow_unit(light, {P}_INV_GAMMA);
+            out[c] = colour[3 * w + c] == 65535u ? 1.0f : {P}_pow_unit(light, s[4]);
         }}
     }}
     for (c = 0; c < 3; ++c) {{
-        float r = ir_on[c] > ir_off[c] ? (float)(ir_on[c] - ir_off[c]) / {P}_BUMPER_SPAN : 0.0f;
+        float r = ir_on[c] > ir_off[c]
+            ? (float)(ir_on[c] - ir_off[c]) / params[{U}_P_BUMPER_SPAN] : 0.0f;
         obs[12 + c] = r < 1.0f ? r : 1.0f;
     }}
-    obs[15] = {P}_clamp1(last_left * {P}_INV_MAX_SPEED);
-    obs[16] = {P}_clamp1(last_right * {P}_INV_MAX_SPEED);
+    obs[15] = {P}_clamp1(last_left * params[{U}_P_INV_MAX_SPEED]);
+    obs[16] = {P}_clamp1(last_right * params[{U}_P_INV_MAX_SPEED]);
+}}
+
+void {P}_encode(const uint16_t colour[12], const uint16_t ir_on[3], const uint16_t ir_off[3],
+    float last_left, float last_right, float obs[17])
+{{
+    {P}_encode_with({P}_DEFAULTS, colour, ir_on, ir_off, last_left, last_right, obs);
 }}
 """
 
 
 def _network_source(p: dict) -> str:
     P = p["prefix"]
+    U = P.upper()
     layers = p["layers"]
     parts = ["/* ---- The network ---- */\n"]
     norm = p["norm"]
@@ -310,19 +375,30 @@ void {P}_act(const float obs[17], float action[2])
     action[1] = action[1] < -1.0f ? -1.0f : (action[1] > 1.0f ? 1.0f : action[1]);
 }}
 
+void {P}_wheels_with(const float params[{U}_N_RUNTIME], const float action[2], float *left, float *right)
+{{
+    *left = {P}_clamp1(action[0]) * params[{U}_P_MAX_SPEED];
+    *right = {P}_clamp1(action[1]) * params[{U}_P_MAX_SPEED];
+}}
+
 void {P}_wheels(const float action[2], float *left, float *right)
 {{
-    *left = {P}_clamp1(action[0]) * {c_float(p["max_wheel_speed"])};
-    *right = {P}_clamp1(action[1]) * {c_float(p["max_wheel_speed"])};
+    {P}_wheels_with({P}_DEFAULTS, action, left, right);
+}}
+
+void {P}_step_with(const float params[{U}_N_RUNTIME], const uint16_t colour[12],
+    const uint16_t ir_on[3], const uint16_t ir_off[3], float *left, float *right)
+{{
+    float obs[17], action[2];
+    {P}_encode_with(params, colour, ir_on, ir_off, *left, *right, obs);
+    {P}_act(obs, action);
+    {P}_wheels_with(params, action, left, right);
 }}
 
 void {P}_step(const uint16_t colour[12], const uint16_t ir_on[3], const uint16_t ir_off[3],
     float *left, float *right)
 {{
-    float obs[17], action[2];
-    {P}_encode(colour, ir_on, ir_off, *left, *right, obs);
-    {P}_act(obs, action);
-    {P}_wheels(action, left, right);
+    {P}_step_with({P}_DEFAULTS, colour, ir_on, ir_off, left, right);
 }}
 """)
     return "".join(parts)

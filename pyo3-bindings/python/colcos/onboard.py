@@ -18,6 +18,7 @@ The policy can be a torch `nn.Sequential` of `Linear` layers and activations (`T
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import re
@@ -34,6 +35,7 @@ from colcos._core import ColcosError
 __all__ = ["Encoding", "Export", "ExportError", "encode_counts", "export_c"]
 
 OBS_DIM = 17
+MANIFEST_FORMAT = "colcos-onboard-policy/1"
 ACT_DIM = 2
 ACTIVATIONS = ("tanh", "relu", "sigmoid", "identity")
 _TORCH_ACTIVATIONS = {"Tanh": "tanh", "ReLU": "relu", "Sigmoid": "sigmoid"}
@@ -115,6 +117,18 @@ class Encoding:
             raise ExportError(f"`crosstalk` = {self.crosstalk!r}: matrix is singular: the sensor could not be calibrated")
         return self
 
+    def runtime_params(self) -> np.ndarray:
+        """The exported C's runtime parameter block (`<PREFIX>_N_RUNTIME` f32, the layout in its header)
+        for this encoding: what `<prefix>_default_params` fills and the host may rewrite with `PWP`."""
+        f32 = np.float32
+        out = [f32(self.max_wheel_speed), f32(1.0) / f32(self.max_wheel_speed), f32(self.bumper_span)]
+        inverse = self.inverse()
+        for _ in range(4):
+            out += [f32(self.dark_counts)] * 3
+            out += [f32(self.gain) * f32(self.integration_ms), f32(1.0) / f32(self.gamma)]
+            out += list(inverse.ravel())
+        return np.array(out, dtype=np.float32)
+
     def inverse(self) -> np.ndarray:
         """The crosstalk's inverse as the simulator computes it (f64 adjugate / det, rounded to f32)."""
         inv = _invert3(np.asarray(self.crosstalk, dtype=np.float32))
@@ -136,6 +150,10 @@ class Export:
     stack_bytes: int
     macs: int
     encoding: Encoding = field(repr=False)
+    policy_hash: int = 0
+    """The network's FNV-1a hash (`<PREFIX>_HASH`): what the host's `PRN` names."""
+    manifest: Path | None = None
+    """`<path>.json`: what the bridge and the digital twin read (`[rig] onboard`)."""
 
 
 def export_c(
@@ -194,6 +212,8 @@ def export_c(
         )
 
     acts = [a for _, _, a in layers]
+    policy_hash = _policy_hash(layers, norm)
+    runtime = enc.runtime_params()
     math_funcs = sorted({{"tanh": "tanhf", "sigmoid": "expf"}[a] for a in acts if a in ("tanh", "sigmoid")})
     f32 = np.float32
     params = {
@@ -223,9 +243,36 @@ def export_c(
         "inverse": enc.inverse(),
         "layers": layers,
         "norm": norm,
+        "hash_hex": f"0x{policy_hash:08x}",
+        "n_runtime": len(runtime),
+        "runtime_defaults": runtime,
     }
     header_path.write_text(_onboard_c.header(params))
     source_path.write_text(_onboard_c.source(params))
+    manifest_path = header_path.with_suffix(".json")
+    manifest = {
+        "format": MANIFEST_FORMAT,
+        "prefix": prefix,
+        "hash": policy_hash,
+        "source": source_path.name,
+        "header": header_path.name,
+        "layer_sizes": [OBS_DIM] + [int(w.shape[0]) for w, _, _ in layers],
+        "activations": acts,
+        "runtime_defaults": [float(v) for v in runtime],
+        "encoding": {
+            "gamma": enc.gamma,
+            "crosstalk": [list(r) for r in enc.crosstalk],
+            "gain": enc.gain,
+            "integration_ms": enc.integration_ms,
+            "dark_counts": enc.dark_counts,
+            "max_wheel_speed": enc.max_wheel_speed,
+            "bumper_span": enc.bumper_span,
+            "dt": enc.dt,
+        },
+    }
+    tmp = manifest_path.with_name(manifest_path.name + ".tmp")
+    tmp.write_text(json.dumps(manifest, indent=2) + "\n")
+    os.replace(tmp, manifest_path)
     return Export(
         header=header_path,
         source=source_path,
@@ -237,6 +284,8 @@ def export_c(
         stack_bytes=stack_bytes,
         macs=sum(w.size for w, _, _ in layers),
         encoding=enc,
+        policy_hash=policy_hash,
+        manifest=manifest_path,
     )
 
 
@@ -389,6 +438,29 @@ def _normaliser(
 
 
 # ---- helpers ----
+
+
+def _policy_hash(layers: list[tuple[np.ndarray, np.ndarray, str]], norm: Any) -> int:
+    """FNV-1a (32 bit) over the layer sizes, activations, f32 weights and normaliser."""
+    h = 0x811C9DC5
+
+    def feed(b: bytes) -> None:
+        nonlocal h
+        for byte in b:
+            h = ((h ^ byte) * 0x01000193) & 0xFFFFFFFF
+
+    for w, b, act in layers:
+        feed(np.array(w.shape, dtype="<u4").tobytes())
+        feed(act.encode() + b"\0")
+        feed(w.astype("<f4").tobytes())
+        feed(b.astype("<f4").tobytes())
+    if norm is None:
+        feed(b"raw")
+    else:
+        mean, std, clip = norm
+        feed(b"norm" + mean.astype("<f4").tobytes() + std.astype("<f4").tobytes())
+        feed(np.array([clip if clip is not None else 0.0], dtype="<f4").tobytes())
+    return h
 
 
 def _paths(path: Any) -> tuple[Path, Path]:

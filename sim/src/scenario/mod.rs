@@ -125,6 +125,7 @@ impl Scenario {
             .for_each(absolute);
         spec.rig.screen_calibration.iter_mut().for_each(absolute);
         spec.rig.colour_calibration.iter_mut().for_each(absolute);
+        spec.rig.onboard.iter_mut().for_each(absolute);
         toml::to_string_pretty(&spec).unwrap_or_default()
     }
 }

@@ -65,6 +65,11 @@ pub struct RigSpec {
     /// scenario's directory: the robots' raw counts go through its calibrated inverse.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub colour_calibration: Option<String>,
+    /// An on-board policy (the `.json` `colcos.onboard.export_c` writes beside the C), relative to
+    /// the scenario's directory: the robots run it themselves; the bridge uploads its runtime
+    /// parameters, starts it and sends only stops; the digital twin runs its C.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub onboard: Option<String>,
 }
 
 impl Default for RigSpec {
@@ -83,6 +88,7 @@ impl Default for RigSpec {
             shield: ShieldParams::default(),
             screen_calibration: None,
             colour_calibration: None,
+            onboard: None,
         }
     }
 }
@@ -182,14 +188,22 @@ impl RigSpec {
         for (key, path) in [
             ("screen_calibration", &self.screen_calibration),
             ("colour_calibration", &self.colour_calibration),
+            ("onboard", &self.onboard),
         ] {
             if path.as_ref().is_some_and(|p| p.trim().is_empty()) {
                 return Err(SimError::invalid(
                     format!("rig.{key}"),
                     "\"\"",
-                    "must name a calibration file",
+                    "must name a file",
                 ));
             }
+        }
+        if self.onboard.is_some() && self.firmware == Firmware::Motion {
+            return Err(SimError::invalid(
+                "rig.firmware",
+                "\"motion\"",
+                "an on-board policy (rig.onboard) needs the firmware that runs it: \"wheels\"",
+            ));
         }
         Ok(())
     }

@@ -1,0 +1,398 @@
+//! A policy on board, on the digital twin: the twin compiles the exported C (bridge/tests/data/onboard,
+//! written by scripts/onboard_fixture.py: both wheels at half the largest wheel speed, the left one
+//! slowed by the front-left bumper) and runs it on each robot's own readings; the bridge uploads the
+//! parameters, starts the policy and sends no wheel commands.
+use colcos_bridge::colias::{
+    CommandPacket, FrameDecoder, HostCommand, PolicyMode, TELEMETRY_LEN, Telemetry,
+};
+use colcos_bridge::frames::FrameServer;
+use colcos_bridge::live::{self, LiveOptions, LoopCore, replay};
+use colcos_bridge::onboard::{OnboardManifest, RUNTIME_LEN, robot_params};
+use colcos_bridge::recorder::read_log;
+use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::twin::{FIRMWARE_TIMEOUT, TrackerServer, Twin, UdpChannel};
+use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
+use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::scenario::Scenario;
+use std::net::UdpSocket;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+fn fixture() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/onboard/policy.json")
+}
+
+/// Three robots well inside the arena, heading along x; the rig's shield caps the wheels at 0.2 m/s,
+/// so the robots' parameter block must say 0.2 (the export says 0.35).
+fn scenario(onboard: &Path) -> Scenario {
+    let text = format!(
+        r#"
+name = "onboard"
+duration = 60.0
+dt = 0.02
+seed = 3
+[screen]
+resolution = [960, 540]
+size = [1.439, 0.809]
+[[robots]]
+count = 3
+behaviour = "wander"
+placement = "explicit"
+poses = [[0.3, 0.2, 0.0], [0.3, 0.4, 0.0], [0.3, 0.6, 0.0]]
+[rig]
+onboard = {onboard:?}
+[rig.shield]
+max_wheel_speed = 0.2
+"#
+    );
+    Scenario::from_toml_str(&text, ".").unwrap()
+}
+
+fn manifest() -> OnboardManifest {
+    OnboardManifest::load(&fixture()).unwrap()
+}
+
+/// The bridge's live loop and the twin over loopback for `seconds`; `host` is the bridge's scenario
+/// (it may name another policy than the twin's robots carry).
+fn run(
+    host: &Scenario,
+    seconds: f64,
+) -> (
+    Twin,
+    live::LiveReport,
+    Vec<colcos_bridge::recorder::Recorded>,
+) {
+    let twin_sc = scenario(&fixture());
+    let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
+    let tracker_addr = tracker.local_addr();
+    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let frames = FrameServer::bind("127.0.0.1:0").unwrap();
+    let mut twin = Twin::new(
+        &twin_sc,
+        tracker,
+        Box::new(channel),
+        Some(frames.local_addr()),
+    )
+    .unwrap();
+    let stop = Arc::new(AtomicBool::new(false));
+    let twin = {
+        let stop = stop.clone();
+        std::thread::spawn(move || {
+            twin.run(Some(seconds + 0.5), &stop);
+            twin
+        })
+    };
+    let source = open_pose_source(
+        &format!("swarmcon://{tracker_addr}"),
+        &SourceOptions::new(FrameTransform::new(host.arena_size().y as f64)),
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("rig.mcap");
+    let opts = LiveOptions {
+        duration: Some(seconds),
+        stream_width: 480,
+        log: Some(log.clone()),
+        ..LiveOptions::default()
+    };
+    let report = live::run(
+        host,
+        source,
+        open_robot_link(&url).unwrap(),
+        Some(frames),
+        opts,
+        Arc::new(AtomicBool::new(false)),
+    )
+    .unwrap();
+    let twin = twin.join().unwrap();
+    (twin, report, read_log(&std::fs::read(&log).unwrap()))
+}
+
+fn commands_to(twin: &Twin, radio: u8) -> Vec<HostCommand> {
+    twin.received()
+        .iter()
+        .filter(|r| r.packet.id == radio)
+        .map(|r| r.packet.command)
+        .collect()
+}
+
+/// The bridge uploads each robot's parameters (the rig's 0.2 m/s limit), starts the policy by its
+/// hash and never sends a wheel speed but stops; the robots drive themselves at the policy's half
+/// speed (0.1 m/s, straight), report it in telemetry, and the log replays to the same bytes.
+#[test]
+fn the_twins_robots_run_the_exported_policy_on_board() {
+    let m = manifest();
+    let host = scenario(&fixture());
+    let start: Vec<_> = colcos_sim::world::World::new(&host)
+        .unwrap()
+        .poses()
+        .to_vec();
+    let (twin, report, log) = run(&host, 2.5);
+    assert!(report.stops.is_empty(), "{report:?}");
+    let fleet = twin.onboard().expect("the twin's robots carry the policy");
+    for (i, radio) in [1u8, 2, 3].into_iter().enumerate() {
+        // Parameters as the host computed them, taken whole by the firmware.
+        let expected = robot_params(&m, 0.2, None, radio);
+        assert_eq!(expected.len(), RUNTIME_LEN);
+        assert_eq!(expected[0], 0.2);
+        assert_eq!(
+            fleet.params(i),
+            expected.as_slice(),
+            "robot {radio}'s parameters"
+        );
+        let sent = commands_to(&twin, radio);
+        let writes = sent
+            .iter()
+            .filter(|c| matches!(c, HostCommand::WriteParamsAt { .. }))
+            .count();
+        assert_eq!(writes, RUNTIME_LEN.div_ceil(5), "robot {radio}: one upload");
+        assert!(sent.contains(&HostCommand::RunPolicy { hash: m.hash }));
+        let driven = sent.iter().any(|c| match c {
+            HostCommand::WheelSpeeds { left, right } => *left != 0.0 || *right != 0.0,
+            HostCommand::Motion { speed, .. } => *speed != 0.0,
+            _ => false,
+        });
+        assert!(!driven, "robot {radio} got a wheel command from the host");
+        // Straight along x at 0.1 m/s while the policy ran (~2.5 s less the start).
+        let moved = twin.plant().poses()[i].pos - start[i].pos;
+        assert!(
+            (0.17..0.27).contains(&moved.x) && moved.y.abs() < 0.01,
+            "robot {radio} moved {moved:?}"
+        );
+    }
+    // Telemetry said so: running, this hash, 0.1 m/s on both wheels.
+    let mut decoder = FrameDecoder::<TELEMETRY_LEN>::new();
+    let mut payloads = Vec::new();
+    for m in log
+        .iter()
+        .filter(|m| m.topic == colcos_bridge::recorder::Topic::Telemetry)
+    {
+        decoder.feed_into(&m.data, &mut payloads);
+    }
+    let running: Vec<_> = payloads
+        .iter()
+        .map(|p| Telemetry::decode(p).onboard())
+        .filter(|s| s.mode == PolicyMode::Running)
+        .collect();
+    assert!(running.len() >= 5, "{} running reports", running.len());
+    for s in &running {
+        assert_eq!(s.hash, m.hash);
+        assert_eq!(s.writes_accepted, 12);
+        assert_eq!(s.writes_refused, 0);
+        assert!(
+            (s.left - 0.1).abs() < 1e-6 && (s.right - 0.1).abs() < 1e-6,
+            "{s:?}"
+        );
+    }
+    // The exit stop took every robot back from its policy.
+    for i in 0..3 {
+        assert!(!fleet.running(i));
+        assert_eq!(twin.plant().command(i), WheelCommand::STOP);
+    }
+    // The same poses and telemetry through a fresh loop give the same frames.
+    let ticks = replay::ticks_of(&log, 3).unwrap();
+    let same = replay::replay(
+        &mut LoopCore::new(&host, Default::default()).unwrap(),
+        &ticks,
+    );
+    assert_eq!(same.mismatched_ticks, 0, "{same:?}");
+}
+
+/// A bridge that expects another policy than the robots carry: they refuse it, the bridge says which
+/// robot and what it carries, holds them stopped, and nothing moves.
+#[test]
+fn robots_flashed_with_another_policy_are_held() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(fixture()).unwrap();
+    let other_hash = manifest().hash ^ 1;
+    let json = text.replace(
+        &format!("\"hash\": {}", manifest().hash),
+        &format!("\"hash\": {other_hash}"),
+    );
+    assert_ne!(json, text);
+    std::fs::write(dir.path().join("policy.json"), json).unwrap();
+    let host = scenario(&dir.path().join("policy.json"));
+    let start: Vec<_> = colcos_sim::world::World::new(&host)
+        .unwrap()
+        .poses()
+        .to_vec();
+    let (twin, _report, log) = run(&host, 1.5);
+    let events: Vec<String> = log
+        .iter()
+        .filter(|m| m.topic == colcos_bridge::recorder::Topic::Events)
+        .map(|m| String::from_utf8_lossy(&m.data).into_owned())
+        .filter(|e| e.contains("onboard_policy_refused"))
+        .collect();
+    assert_eq!(events.len(), 3, "{events:?}");
+    assert!(
+        events[0].contains(&format!("{other_hash:#010x}")),
+        "{events:?}"
+    );
+    for (i, s) in start.iter().enumerate() {
+        let moved = twin.plant().poses()[i].pos.distance(s.pos);
+        assert!(moved < 1e-4, "robot {i} moved {moved} m");
+    }
+}
+
+/// The twin's robots without a bridge: frames by hand over UDP, the twin stepped by hand.
+struct Bench {
+    twin: Twin,
+    host: UdpSocket,
+    decoder: FrameDecoder<TELEMETRY_LEN>,
+}
+
+impl Bench {
+    fn new() -> Bench {
+        let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
+        let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+        let addr = channel.local_addr().unwrap();
+        let twin = Twin::new(&scenario(&fixture()), tracker, Box::new(channel), None).unwrap();
+        let host = UdpSocket::bind("127.0.0.1:0").unwrap();
+        host.connect(addr).unwrap();
+        host.set_read_timeout(Some(std::time::Duration::from_millis(500)))
+            .unwrap();
+        Bench {
+            twin,
+            host,
+            decoder: FrameDecoder::new(),
+        }
+    }
+    fn send(&mut self, radio: u8, cmd: HostCommand) {
+        self.host
+            .send(&CommandPacket::new(radio, 0, cmd).to_frame())
+            .unwrap();
+        // Loopback delivery is not instant: wait until the twin has it.
+        let before = self.twin.received().len();
+        for _ in 0..200 {
+            self.twin.tick();
+            if self.twin.received().len() > before {
+                return;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        panic!("the twin never received {cmd:?}");
+    }
+    fn steps(&mut self, n: usize) {
+        for _ in 0..n {
+            self.twin.tick();
+        }
+    }
+    fn status(&mut self, radio: u8) -> colcos_bridge::colias::OnboardStatus {
+        self.send(radio, HostCommand::RequestTelemetry(1));
+        let mut buf = [0u8; 256];
+        let mut out = Vec::new();
+        while out.is_empty() {
+            let k = self.host.recv(&mut buf).unwrap();
+            self.decoder.feed_into(&buf[..k], &mut out);
+        }
+        Telemetry::decode(&out[0]).onboard()
+    }
+}
+
+/// Refused writes are counted and change nothing; a stop overrides the policy; link silence stops
+/// the robot within the firmware's timeout; `PRN` with another hash is refused.
+#[test]
+fn the_robots_firmware_obeys_stops_and_silence() {
+    let m = manifest();
+    let mut b = Bench::new();
+    // Out of the block, and a zero scale: refused.
+    let bad_range = HostCommand::WriteParamsAt {
+        offset: (RUNTIME_LEN - 2) as u16,
+        count: 5,
+        values: [1.0; 5],
+    };
+    let zero_span = HostCommand::WriteParamsAt {
+        offset: 2,
+        count: 1,
+        values: [0.0; 5],
+    };
+    b.send(1, bad_range);
+    b.send(1, zero_span);
+    let s = b.status(1);
+    assert_eq!(
+        (s.mode, s.writes_accepted, s.writes_refused),
+        (PolicyMode::Host, 0, 2)
+    );
+    assert_eq!(s.hash, m.hash);
+    assert_eq!(
+        b.twin.onboard().unwrap().params(0),
+        m.runtime_defaults.as_slice()
+    );
+    // Another hash: refused, no motion.
+    b.send(1, HostCommand::RunPolicy { hash: m.hash ^ 4 });
+    b.steps(10);
+    assert_eq!(b.status(1).mode, PolicyMode::Refused);
+    assert_eq!(b.twin.plant().command(0), WheelCommand::STOP);
+    // The right one: half the export's 0.35 m/s.
+    b.send(1, HostCommand::RunPolicy { hash: m.hash });
+    b.steps(5);
+    let s = b.status(1);
+    assert_eq!(s.mode, PolicyMode::Running);
+    assert!((s.left - 0.175).abs() < 1e-6, "{s:?}");
+    // A stop from the host wins.
+    b.send(
+        1,
+        HostCommand::WheelSpeeds {
+            left: 0.0,
+            right: 0.0,
+        },
+    );
+    b.steps(5);
+    assert_eq!(b.status(1).mode, PolicyMode::Host);
+    assert_eq!(b.twin.plant().command(0), WheelCommand::STOP);
+    // Started again, then silence: stopped by the firmware within its timeout (+ a tick).
+    b.send(1, HostCommand::RunPolicy { hash: m.hash });
+    b.steps(3);
+    assert_ne!(b.twin.plant().command(0), WheelCommand::STOP);
+    let dt = b.twin.plant().world().dt() as f64;
+    let silent_steps = (FIRMWARE_TIMEOUT / dt).ceil() as usize + 2;
+    b.steps(silent_steps);
+    assert_eq!(b.twin.plant().command(0), WheelCommand::STOP);
+    assert_eq!(b.status(1).mode, PolicyMode::Host);
+    // The other robots never heard a thing.
+    assert_eq!(b.twin.plant().command(1), WheelCommand::STOP);
+}
+
+/// A manifest that does not fit is refused naming `rig.onboard` and the field.
+#[test]
+fn bad_manifests_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(fixture()).unwrap();
+    for (from, to, says) in [
+        (
+            "colcos-onboard-policy/1",
+            "colcos-onboard-policy/9",
+            "`format`",
+        ),
+        (
+            "\"prefix\": \"twin_policy\"",
+            "\"prefix\": \"9x\"",
+            "`prefix`",
+        ),
+        ("3000.0", "-3000.0", "`runtime_defaults[2]`"),
+    ] {
+        let path = dir.path().join("policy.json");
+        std::fs::write(&path, text.replacen(from, to, 1)).unwrap();
+        let err = OnboardManifest::load(&path).unwrap_err().to_string();
+        assert!(err.contains("rig.onboard") && err.contains(says), "{err}");
+    }
+    let err = OnboardManifest::load(&dir.path().join("missing.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("rig.onboard"), "{err}");
+    // The C missing beside a good manifest: the twin says so.
+    std::fs::write(dir.path().join("policy.json"), &text).unwrap();
+    let sc = scenario(&dir.path().join("policy.json"));
+    let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
+    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+    let err = Twin::new(&sc, tracker, Box::new(channel), None)
+        .err()
+        .expect("no C source")
+        .to_string();
+    assert!(
+        err.contains("rig.onboard") && err.contains("C source"),
+        "{err}"
+    );
+}
