@@ -291,3 +291,76 @@ def test_refuses_what_it_cannot_export(tmp_path):
     with pytest.raises(ExportError, match="is a directory"):
         export_c(ok, tmp_path)
     assert issubclass(ExportError, colcos.ColcosError)
+
+
+def test_runtime_parameters_rewrite_the_encoding(tmp_path):
+    """The C's runtime block (what the bridge writes with `PWP`): the defaults are the export's
+    encoding; a block from another calibration encodes as that calibration does; bad writes change
+    nothing."""
+    rng = np.random.default_rng(11)
+    info = export_c([(rng.normal(0, 0.3, (2, 17)), np.zeros(2))], tmp_path / "p", prefix="rt")
+    so = tmp_path / "librt.so"
+    r = subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic", "-shared", "-fPIC",
+                        str(info.source), "-o", str(so), "-lm"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    lib = ctypes.CDLL(str(so))
+    n = len(info.encoding.runtime_params())
+    params = np.zeros(n, dtype=np.float32)
+    lib.rt_default_params(params.ctypes.data_as(F32P))
+    assert np.array_equal(params, Encoding().runtime_params())
+    other = Encoding(gain=900.0, dark_counts=55.0, gamma=1.9, max_wheel_speed=0.2,
+                     crosstalk=((1.0, 0.2, 0.0), (0.1, 0.9, 0.1), (0.0, 0.15, 1.1)))
+    block = other.runtime_params()
+    write = lib.rt_write_params
+    write.argtypes = [F32P, ctypes.c_uint16, ctypes.c_uint8, F32P]
+    for k in range(0, n, 5):
+        chunk = np.zeros(5, dtype=np.float32)
+        chunk[: min(5, n - k)] = block[k : k + 5]
+        assert write(params.ctypes.data_as(F32P), k, min(5, n - k), chunk.ctypes.data_as(F32P)) == 1
+    assert np.array_equal(params, block)
+    for offset, values in [(n - 2, [1.0] * 3), (2, [0.0]), (3 + 14 + 3, [-1.0]), (0, [np.inf]), (7, [np.nan])]:
+        v = np.array(values + [0.0] * (5 - len(values)), dtype=np.float32)
+        assert write(params.ctypes.data_as(F32P), offset, len(values), v.ctypes.data_as(F32P)) == 0, (offset, values)
+    assert np.array_equal(params, block)
+    colour = rng.integers(0, 65536, size=(300, 4, 3)).astype(np.uint16)
+    on, off = rng.integers(0, 4000, size=(300, 3)).astype(np.uint16), np.full((300, 3), 100, np.uint16)
+    last = rng.uniform(-0.4, 0.4, size=(300, 2)).astype(np.float32)
+    enc = lib.rt_encode_with
+    enc.argtypes = [F32P, U16P, U16P, U16P, ctypes.c_float, ctypes.c_float, F32P]
+    got = np.zeros((300, 17), dtype=np.float32)
+    for i in range(300):
+        c = np.ascontiguousarray(colour[i].reshape(12))
+        enc(params.ctypes.data_as(F32P), c.ctypes.data_as(U16P), on[i].ctypes.data_as(U16P), off[i].ctypes.data_as(U16P),
+            float(last[i, 0]), float(last[i, 1]), got[i].ctypes.data_as(F32P))
+    want = encode_counts(colour, on, off, last, encoding=other)
+    assert float(np.abs(got - want).max()) <= 2e-6
+
+
+def test_hash_and_manifest(tmp_path):
+    """The manifest names the policy (hash of its network) and its runtime defaults; the hash moves
+    with any weight and not with the encoding."""
+    import json
+
+    rng = np.random.default_rng(3)
+    layers = [(rng.normal(0, 0.3, (4, 17)), rng.normal(0, 0.1, 4)), (rng.normal(0, 0.3, (2, 4)), np.zeros(2))]
+    a = export_c(layers, tmp_path / "a")
+    m = json.loads(a.manifest.read_text())
+    assert m["format"] == "colcos-onboard-policy/1" and m["hash"] == a.policy_hash and m["source"] == "a.c"
+    assert np.array_equal(np.array(m["runtime_defaults"], dtype=np.float32), Encoding().runtime_params())
+    assert f"#define COLCOS_POLICY_HASH 0x{a.policy_hash:08x}u" in a.header.read_text()
+    assert export_c(layers, tmp_path / "b", encoding=Encoding(gain=700.0)).policy_hash == a.policy_hash
+    nudged = [(layers[0][0], layers[0][1]), (layers[1][0] + np.float32(1e-3), layers[1][1])]
+    assert export_c(nudged, tmp_path / "c").policy_hash != a.policy_hash
+
+
+def test_the_bridges_fixture_is_what_export_c_writes(tmp_path):
+    """bridge/tests/data/onboard is the twin's on-board policy in the Rust tests: written by
+    scripts/onboard_fixture.py, and byte for byte what `export_c` writes now."""
+    spec = importlib.util.spec_from_file_location("onboard_fixture", REPO / "scripts" / "onboard_fixture.py")
+    assert spec is not None and spec.loader is not None
+    fixture = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(fixture)
+    fixture.write(tmp_path)
+    for name in ("policy.c", "policy.h", "policy.json"):
+        committed = (REPO / "bridge" / "tests" / "data" / "onboard" / name).read_text()
+        assert (tmp_path / name).read_text() == committed, f"{name}: run python scripts/onboard_fixture.py"

@@ -328,6 +328,7 @@ def _network_source(p: dict) -> str:
         parts.append(c_array(f"{P}_W{i}", w))
         parts.append(c_array(f"{P}_B{i}", b))
     width = max([17] + [w.shape[0] for w, _, _ in layers])
+    buffers = f", h[{width}]" if len(layers) > 1 else ""  # a single layer writes straight to `out`
     parts.append(f"""
 /* y = W x + b, W row-major (n_out x n_in), summed in input order. */
 static void {P}_dense(const float *w, const float *b, const float *x, int n_in, int n_out, float *y)
@@ -344,7 +345,7 @@ static void {P}_dense(const float *w, const float *b, const float *x, int n_in, 
 
 void {P}_forward(const float obs[17], float out[2])
 {{
-    float a[{width}], h[{width}];
+    float a[{width}]{buffers};
     int i;
 """)
     if norm is not None:

@@ -153,7 +153,7 @@ static void twin_policy_dense(const float *w, const float *b, const float *x, in
 
 void twin_policy_forward(const float obs[17], float out[2])
 {
-    float a[17], h[17];
+    float a[17];
     int i;
     for (i = 0; i < 17; ++i)
         a[i] = obs[i];
