@@ -60,11 +60,11 @@ echo "   the policy adds $((t1 + d1 - t0 - d0)) bytes of flash (text + data); li
 comm -13 <(syms "$out/firmware_none.elf") <(syms "$out/firmware.elf") | sed 's/^/     /'
 read -r pt pd pb _ < <(arm-none-eabi-size "$out/policy.o" | tail -1)
 
-step="$(frame colcos_policy_step)"; encode="$(frame colcos_policy_encode)"; pow="$(frame colcos_policy_pow_unit)"
+step="$(frame colcos_policy_step_with)"; encode="$(frame colcos_policy_encode_with)"; pow="$(frame colcos_policy_pow_unit)"
 act="$(frame colcos_policy_act)"; forward="$(frame colcos_policy_forward)"; dense="$(frame colcos_policy_dense)"
 tanh="$(libm_frame tanhf)"; expm1="$(libm_frame expm1f)"
 enc_chain=$((encode + ${pow:-0}))
 net_chain=$((act + forward + (${dense:-0} > tanh + expm1 ? ${dense:-0} : tanh + expm1)))
 deepest=$((step + (enc_chain > net_chain ? enc_chain : net_chain)))
-echo "== deepest stack below control_tick: step $step + max(encode $encode + pow_unit ${pow:-inlined}, act $act + forward $forward + max(dense ${dense:-inlined}, tanhf $tanh + expm1f $expm1)) = $deepest bytes"
-echo "== summary: flash $((t1 + d1 - t0 - d0)) bytes of 65536 (policy.o $((pt + pd)) + libm and the rest), static RAM $((pd + pb)) bytes (policy.o data + bss), stack $deepest bytes of 12288 SRAM"
+echo "== deepest stack below control_tick: step_with $step + max(encode $encode + pow_unit ${pow:-inlined}, act $act + forward $forward + max(dense ${dense:-inlined}, tanhf $tanh + expm1f $expm1)) = $deepest bytes"
+echo "== summary: flash $((t1 + d1 - t0 - d0)) bytes of 65536 (policy.o $((pt + pd)) + libm and the rest), static RAM $((pd + pb)) bytes in policy.o, $((d1 + b1 - d0 - b0)) added to the firmware (its parameter block and state), stack $deepest bytes of 12288 SRAM"

@@ -11,6 +11,11 @@ sensor's calibrated inverse in `sim/src/sensors/colour.rs` do) and the action de
     info = export_c(model.pi, "firmware/policy", obs_norm=model.obs_norm)   # policy.h, policy.c
     info.weight_bytes, info.stack_bytes                                     # (21904, 512) for 17-64-64-2
 
+Beside the C it writes `<path>.json`, the policy's manifest (its hash and its runtime parameter block:
+the largest wheel speed, the bumper span and each colour sensor's calibration, which the host may
+rewrite over the radio): name it in a scenario's `[rig] onboard` and the bridge uploads each robot's
+parameters and starts the policy, and the digital twin runs this C on its robots (docs/bridge.md).
+
 The policy can be a torch `nn.Sequential` of `Linear` layers and activations (`Tanh`, `ReLU`,
 `Sigmoid`, `Identity`), or plain arrays: a list of `(weight, bias)` pairs, `weight` shaped
 `(out, in)` as in `torch.nn.Linear`, with `activation=` for the hidden layers (the last is linear).
