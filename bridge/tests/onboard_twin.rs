@@ -2,18 +2,20 @@
 //! written by scripts/onboard_fixture.py: both wheels at half the largest wheel speed, the left one
 //! slowed by the front-left bumper) and runs it on each robot's own readings; the bridge uploads the
 //! parameters, starts the policy and sends no wheel commands.
+use colcos_bridge::colias::colour_from_sim;
 use colcos_bridge::colias::{
     CommandPacket, FrameDecoder, HostCommand, PolicyMode, TELEMETRY_LEN, Telemetry,
 };
 use colcos_bridge::frames::FrameServer;
 use colcos_bridge::live::{self, LiveOptions, LoopCore, replay};
-use colcos_bridge::onboard::{OnboardManifest, RUNTIME_LEN, robot_params};
+use colcos_bridge::onboard::{OnboardFirmware, OnboardManifest, RUNTIME_LEN, robot_params};
 use colcos_bridge::recorder::read_log;
 use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
 use colcos_bridge::twin::{FIRMWARE_TIMEOUT, TrackerServer, Twin, UdpChannel};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;
+use colcos_sim::sensors::{ColourCalibration, RobotColour, SensorFit};
 use std::net::UdpSocket;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -395,4 +397,65 @@ fn bad_manifests_are_refused_by_name() {
         err.contains("rig.onboard") && err.contains("C source"),
         "{err}"
     );
+}
+
+/// A robot's own four sensors, written into its block from the colour calibration, let the firmware's
+/// encoding read the screen's intensities from that robot's raw counts; the export's nominal sensor
+/// model would not.
+#[test]
+fn a_robots_calibration_on_board_recovers_the_screen() {
+    let m = manifest();
+    let fw = OnboardFirmware::build(&m).unwrap();
+    let fits: [SensorFit; 4] = std::array::from_fn(|s| {
+        let x = 0.04 * s as f64;
+        SensorFit::from_parts(
+            1.8 + 0.1 * s as f64,
+            1200.0 + 150.0 * s as f64,
+            [
+                [1.0, 0.1 + x, 0.02],
+                [0.05, 1.0, 0.12 - x],
+                [0.03, 0.1, 1.0],
+            ],
+            [20.0 + 5.0 * s as f64, 25.0, 31.0],
+            24.0,
+        )
+    });
+    let cal = ColourCalibration::new(
+        "2026-01-01T00:00:00Z".into(),
+        24.0,
+        vec![RobotColour {
+            radio_id: 1,
+            sensors: fits,
+        }],
+        0.0,
+    );
+    let own = robot_params(&m, 0.35, Some(&cal), 1);
+    let (mut worst_own, mut worst_nominal) = (0.0f64, 0.0f64);
+    for r in (40..=255).step_by(43) {
+        for g in (40..=255).step_by(43) {
+            for b in (40..=255).step_by(43) {
+                let levels = [r as f64, g as f64, b as f64];
+                let sim: [[u16; 3]; 4] =
+                    std::array::from_fn(|s| fits[s].predict(levels).map(|v| v.round() as u16));
+                let colour = colour_from_sim(sim);
+                for (params, worst) in [
+                    (&own, &mut worst_own),
+                    (&m.runtime_defaults, &mut worst_nominal),
+                ] {
+                    let obs = fw.encode(params, &colour, &[100; 3], &[100; 3], (0.0, 0.0));
+                    for s in 0..4 {
+                        for c in 0..3 {
+                            let err = (obs[3 * s + c] as f64 - levels[c] / 255.0).abs();
+                            *worst = worst.max(err);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "largest intensity error: own calibration {worst_own:.2e}, nominal {worst_nominal:.2e}"
+    );
+    assert!(worst_own < 2e-4, "{worst_own}");
+    assert!(worst_nominal > 0.03, "{worst_nominal}");
 }

@@ -9,12 +9,15 @@ use std::process::Command;
 
 type DefaultParams = unsafe extern "C" fn(*mut f32);
 type WriteParams = unsafe extern "C" fn(*mut f32, u16, u8, *const f32) -> i32;
+type EncodeWith =
+    unsafe extern "C" fn(*const f32, *const u16, *const u16, *const u16, f32, f32, *mut f32);
 type StepWith =
     unsafe extern "C" fn(*const f32, *const u16, *const u16, *const u16, *mut f32, *mut f32);
 
 pub struct OnboardFirmware {
     default_params: DefaultParams,
     write_params: WriteParams,
+    encode_with: EncodeWith,
     step_with: StepWith,
     hash: u32,
     // Last: the functions above point into it.
@@ -56,17 +59,19 @@ impl OnboardFirmware {
                     *lib.get(format!("{p}_default_params\0").as_bytes())?;
                 let write_params: WriteParams =
                     *lib.get(format!("{p}_write_params\0").as_bytes())?;
+                let encode_with: EncodeWith = *lib.get(format!("{p}_encode_with\0").as_bytes())?;
                 let step_with: StepWith = *lib.get(format!("{p}_step_with\0").as_bytes())?;
-                Ok((lib, default_params, write_params, step_with))
+                Ok((lib, default_params, write_params, encode_with, step_with))
             })
         };
         // Mapped once loaded: the file itself is not needed any more.
         let _ = std::fs::remove_file(&lib_path);
-        let (lib, default_params, write_params, step_with) =
+        let (lib, default_params, write_params, encode_with, step_with) =
             loaded.map_err(|e| bad(format!("cannot load the compiled policy: {e}")))?;
         let fw = OnboardFirmware {
             default_params,
             write_params,
+            encode_with,
             step_with,
             hash: manifest.hash,
             _lib: lib,
@@ -106,6 +111,34 @@ impl OnboardFirmware {
         }
         // SAFETY: `params` is a whole block; the C reads at most `count` <= 5 of `values`.
         unsafe { (self.write_params)(params.as_mut_ptr(), offset, count, values.as_ptr()) == 1 }
+    }
+
+    /// `<prefix>_encode_with`: the 17 observations the policy sees for raw readings (colour in the
+    /// telemetry's order) and the wheel speeds last chosen.
+    pub fn encode(
+        &self,
+        params: &[f32],
+        colour: &[[u16; 3]; 4],
+        ir_on: &[u16; 3],
+        ir_off: &[u16; 3],
+        last: (f32, f32),
+    ) -> [f32; 17] {
+        let mut obs = [0.0f32; 17];
+        if params.len() == RUNTIME_LEN {
+            // SAFETY: sizes as the header declares them; `obs` holds the 17 outputs.
+            unsafe {
+                (self.encode_with)(
+                    params.as_ptr(),
+                    colour.as_flattened().as_ptr(),
+                    ir_on.as_ptr(),
+                    ir_off.as_ptr(),
+                    last.0,
+                    last.1,
+                    obs.as_mut_ptr(),
+                )
+            };
+        }
+        obs
     }
 
     /// `<prefix>_step_with`: the wheel speeds (m/s) the policy chooses from raw readings, `last` the
