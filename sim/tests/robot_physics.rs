@@ -184,3 +184,122 @@ proptest! {
         }
     }
 }
+
+/// Six robots in a small arena under random commands: steps with and without rapier's pipeline
+/// (a step in which no contact is possible) give the same poses, bit for bit, as rapier alone.
+#[test]
+fn free_steps_are_bit_identical_to_rapier() {
+    for seed in [7, 11, 23, 99] {
+        free_steps_match(seed);
+    }
+}
+
+fn free_steps_match(seed: u32) {
+    let p = ColiasParams::default();
+    let size = Vec2::new(0.5, 0.4);
+    let start = grid(6, size, 0.1);
+    let mut fast = ArenaPhysics::with_backend(size, &p, &start, PhysicsBackend::Rapier);
+    let mut slow = ArenaPhysics::with_backend(size, &p, &start, PhysicsBackend::Rapier);
+    slow.set_free_steps(false);
+    let mut s = seed;
+    let mut next = move || {
+        s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (s >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let (mut touching, mut apart) = (0, 0);
+    let mut v = vec![(0.0, 0.0); 6];
+    for k in 0..3000 {
+        if k % 25 == 0 {
+            for c in &mut v {
+                *c = (0.7 * (next() - 0.3), 20.0 * (next() - 0.5));
+            }
+        }
+        if k == 1500 {
+            // A teleport between free steps keeps the other robots' free moves.
+            fast.set_pose(2, Pose::new(0.25, 0.2, 1.0));
+            slow.set_pose(2, Pose::new(0.25, 0.2, 1.0));
+        }
+        fast.step(&v, DT);
+        slow.step(&v, DT);
+        for (i, (a, b)) in fast.poses().iter().zip(slow.poses()).enumerate() {
+            let bits = |q: &Pose| (q.pos.x.to_bits(), q.pos.y.to_bits(), q.heading.to_bits());
+            assert_eq!(
+                bits(a),
+                bits(b),
+                "robot {i} differs at step {k}: {a:?} vs {b:?}"
+            );
+        }
+        let q = fast.poses();
+        let gap = (0..6)
+            .flat_map(|i| (i + 1..6).map(move |j| (i, j)))
+            .map(|(i, j)| (q[i].pos - q[j].pos).length())
+            .fold(f32::INFINITY, f32::min);
+        if gap < 2.0 * p.radius + 0.005 {
+            touching += 1;
+        } else if gap > 2.0 * p.radius + 0.03 {
+            apart += 1;
+        }
+    }
+    // Both kinds of step happened.
+    assert!(
+        touching > 100 && apart > 100,
+        "touching {touching}, apart {apart}"
+    );
+}
+
+/// In free space a robot driven at constant speed goes `v t` along its heading and turns by
+/// `omega t` (both solvers; rapier's linearised rotation is within 1e-4 rad over 1 s).
+#[test]
+fn constant_speed_in_free_space_is_analytic() {
+    for backend in BACKENDS {
+        let p = ColiasParams::default();
+        let (v, heading) = (0.2f32, 0.5f32);
+        let start = Pose::new(0.3, 0.3, heading);
+        let mut phys = ArenaPhysics::with_backend(Vec2::new(1.0, 1.0), &p, &[start], backend);
+        for _ in 0..50 {
+            phys.step(&[(v, 0.0)], DT);
+        }
+        let expected = start.pos + Vec2::from_angle(heading) * v * 1.0;
+        let q = phys.poses()[0];
+        assert!(
+            (q.pos - expected).length() < 1e-5,
+            "{backend:?}: {q:?} vs {expected:?}"
+        );
+        assert!((q.heading - heading).abs() < 1e-5);
+        // Turning on the spot: 0.4 rad/s for 1 s.
+        for _ in 0..50 {
+            phys.step(&[(0.0, 0.4)], DT);
+        }
+        let q2 = phys.poses()[0];
+        assert!((q2.pos - q.pos).length() < 1e-6);
+        assert!(
+            (q2.heading - (heading + 0.4)).abs() < 1e-4,
+            "{backend:?}: {}",
+            q2.heading
+        );
+    }
+}
+
+/// Two robots driven into each other side by side for 4 s overlap by at most 1 mm.
+#[test]
+fn robots_pushed_together_overlap_at_most_a_millimetre() {
+    for backend in BACKENDS {
+        let p = ColiasParams::default();
+        let mut phys = ArenaPhysics::with_backend(
+            Vec2::new(1.0, 1.0),
+            &p,
+            &[
+                Pose::new(0.45, 0.5, 0.0),
+                Pose::new(0.55, 0.5, std::f32::consts::PI),
+            ],
+            backend,
+        );
+        let mut worst = 0.0f32;
+        for _ in 0..200 {
+            phys.step(&[(p.max_wheel_speed, 0.0); 2], DT);
+            let d = (phys.poses()[0].pos - phys.poses()[1].pos).length();
+            worst = worst.max(2.0 * p.radius - d);
+        }
+        assert!(worst <= 1e-3, "{backend:?}: overlap {worst} m");
+    }
+}

@@ -101,6 +101,15 @@ impl ArenaPhysics {
         self.obstacles = obstacles;
     }
 
+    /// Whether the rapier solver may take a step in which no contact is possible without its
+    /// pipeline (on by default; the result is bit-identical, this switch is there to test that).
+    /// No effect on the disc solver.
+    pub fn set_free_steps(&mut self, on: bool) {
+        if let Solver::Rapier(state) = &mut self.solver {
+            state.free_steps = on;
+        }
+    }
+
     /// The solver in use.
     pub fn backend(&self) -> PhysicsBackend {
         match self.solver {
@@ -125,7 +134,15 @@ impl ArenaPhysics {
         };
         let (lo, hi) = self.bounds();
         match &mut self.solver {
-            Solver::Rapier(state) => state.step(&mut self.poses, velocity, dt, lo, hi),
+            Solver::Rapier(state) => state.step(
+                &mut self.poses,
+                velocity,
+                dt,
+                lo,
+                hi,
+                self.radius,
+                &self.obstacles,
+            ),
             Solver::Discs(state) => {
                 state.step(
                     &mut self.poses,

@@ -1,7 +1,9 @@
 //! The rapier2d solver: dynamic discs driven by velocity in four thick static wall boxes.
 use super::FRICTION;
+use crate::arena::Obstacles;
 use crate::robot::{ColiasParams, Pose};
 use glam::Vec2;
+use rapier2d::math::Pose as Pose2;
 use rapier2d::prelude::{
     ColliderBuilder, IntegrationParameters, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle,
     Rotation, SpringCoefficients, Vector,
@@ -20,9 +22,24 @@ const PREDICTION_DISTANCE: f32 = 0.02;
 /// compress by centimetres; 300 Hz keeps overlaps under half a millimetre.
 const CONTACT_FREQUENCY: f32 = 300.0;
 
+/// Margin on rapier's prediction distance before a step counts as free of contacts, m.
+const FREE_MARGIN: f32 = 0.001;
+/// Most robots for which the free-step test checks every pair (a large swarm always has contacts).
+const FREE_MAX_ROBOTS: usize = 64;
+/// rapier's cap on a body's rotation per step, rad (its solver's `MAX_ROTATION`).
+const MAX_ROTATION: f32 = std::f32::consts::FRAC_PI_4;
+
 pub(super) struct RapierState {
     pub(super) world: PhysicsWorld,
     pub(super) bodies: Vec<RigidBodyHandle>,
+    /// Each body's pose as rapier holds it (rotation as a unit complex), mirrored here so that a
+    /// step in which no contact is possible moves the bodies without a rapier call.
+    rotations: Vec<Rotation>,
+    translations: Vec<Vec2>,
+    /// Free steps moved the mirror since rapier's bodies were last written.
+    stale: bool,
+    /// Whether free steps are taken (off: every step goes through rapier's pipeline).
+    pub(super) free_steps: bool,
 }
 
 impl RapierState {
@@ -35,6 +52,12 @@ impl RapierState {
             normalized_prediction_distance: PREDICTION_DISTANCE / LENGTH_UNIT,
             contact_softness: SpringCoefficients::new(CONTACT_FREQUENCY, 10.0),
             static_contact_softness: SpringCoefficients::new(CONTACT_FREQUENCY, 10.0),
+            // Recycling keeps a pair's old contact points until the pair moved 1 cm (rapier's
+            // 0.05 length units): half a robot radius of stale contact, and a history that free
+            // steps would change. Every pair is recomputed every step instead.
+            contact_recycling: false,
+            // No CCD: a robot moves at most 7 mm a step, well within the prediction distance.
+            max_ccd_substeps: 0,
             ..IntegrationParameters::default()
         };
         let (w, h) = (size.x, size.y);
@@ -68,9 +91,27 @@ impl RapierState {
             );
             bodies.push(body);
         }
-        RapierState { world, bodies }
+        let rotations = bodies
+            .iter()
+            .map(|&b| *world.bodies[b].rotation())
+            .collect();
+        let translations = bodies
+            .iter()
+            .map(|&b| world.bodies[b].translation())
+            .collect();
+        RapierState {
+            world,
+            bodies,
+            rotations,
+            translations,
+            stale: false,
+            free_steps: true,
+        }
     }
 
+    /// One step of `dt`: without rapier when no contact is possible (see [`Self::free_of_contacts`]),
+    /// else a full rapier step. Bodies leaving `lo..hi` are put back (the last guard).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn step(
         &mut self,
         poses: &mut [Pose],
@@ -78,38 +119,138 @@ impl RapierState {
         dt: f32,
         lo: Vec2,
         hi: Vec2,
+        radius: f32,
+        obstacles: &Obstacles,
     ) {
+        if self.free_steps && self.free_of_contacts(radius, lo, hi, obstacles) {
+            self.free_step(velocity, dt);
+        } else {
+            self.rapier_step(velocity, dt);
+        }
+        for (i, pose) in poses.iter_mut().enumerate() {
+            let p = self.translations[i];
+            let heading = self.rotations[i].angle();
+            let q = p.clamp(lo, hi);
+            if q != p || !q.is_finite() {
+                // The last guard: put it back inside and stop it.
+                let q = if q.is_finite() { q } else { pose.pos };
+                let body = &mut self.world.bodies[self.bodies[i]];
+                body.set_translation(q, false);
+                body.set_linvel(Vec2::ZERO, false);
+                self.translations[i] = q;
+                *pose = Pose { pos: q, heading };
+            } else {
+                *pose = Pose { pos: p, heading };
+            }
+        }
+    }
+
+    /// True when rapier would find no contact at the start of this step: every robot is farther
+    /// than its prediction distance (plus a margin) from the walls, the obstacles and every other
+    /// robot. rapier builds its contacts from the poses at the start of a step only, so such a step
+    /// has no constraint and moves every body freely.
+    fn free_of_contacts(&self, radius: f32, lo: Vec2, hi: Vec2, obstacles: &Obstacles) -> bool {
+        let n = self.translations.len();
+        if n > FREE_MAX_ROBOTS {
+            return false;
+        }
+        let reach = PREDICTION_DISTANCE + FREE_MARGIN;
+        let (inner_lo, inner_hi) = (lo + reach, hi - reach);
+        let pair = 2.0 * radius + reach;
+        for (i, &p) in self.translations.iter().enumerate() {
+            if !(p.cmpgt(inner_lo).all() && p.cmplt(inner_hi).all()) {
+                return false;
+            }
+            if self.translations[i + 1..]
+                .iter()
+                .any(|&q| p.distance_squared(q) <= pair * pair)
+            {
+                return false;
+            }
+        }
+        obstacles.is_empty()
+            || self
+                .translations
+                .iter()
+                .all(|&p| obstacles.overlapping(p, radius + reach, 0.0).is_none())
+    }
+
+    /// A step with no contact, integrated exactly as rapier's solver integrates a free body: the
+    /// same speed caps and, per substep, the same linearised rotation and translation update, in
+    /// the same f32 operations (a test compares the two bit for bit).
+    fn free_step(&mut self, velocity: impl Fn(usize) -> (f32, f32), dt: f32) {
+        let params = &self.world.integration_parameters;
+        let substeps = params.num_solver_iterations.max(1);
+        let sub_dt = dt / substeps as f32;
+        let max_lin = params.max_linear_velocity();
+        let max_ang = MAX_ROTATION * (1.0 / dt);
+        for (i, (rot, t)) in self
+            .rotations
+            .iter_mut()
+            .zip(&mut self.translations)
+            .enumerate()
+        {
+            let (forward, yaw) = velocity(i);
+            let mut lin = Vec2::from_angle(rot.angle()) * forward;
+            let mut ang = yaw;
+            for _ in 0..substeps {
+                let n = lin.length();
+                if n > max_lin {
+                    lin *= max_lin / n;
+                }
+                if ang.abs() > max_ang {
+                    ang = ang.signum() * max_ang;
+                }
+                let dang = ang * sub_dt;
+                let (re, im) = (rot.re, rot.im);
+                *rot = Rotation::from_cos_sin_unchecked(re - dang * im, im + dang * re);
+                rot.normalize_mut();
+                *t += lin * sub_dt;
+            }
+        }
+        self.stale = true;
+    }
+
+    /// A full rapier step (after writing the poses free steps moved into rapier's bodies).
+    fn rapier_step(&mut self, velocity: impl Fn(usize) -> (f32, f32), dt: f32) {
         self.world.integration_parameters.dt = dt;
         for (i, &handle) in self.bodies.iter().enumerate() {
             let (forward, yaw) = velocity(i);
             let body = &mut self.world.bodies[handle];
-            let dir = Vec2::from_angle(body.rotation().angle());
+            if self.stale {
+                body.set_position(
+                    Pose2::from_parts(self.translations[i], self.rotations[i]),
+                    true,
+                );
+            }
+            let dir = Vec2::from_angle(self.rotations[i].angle());
             body.set_linvel(dir * forward, true);
             body.set_angvel(yaw, true);
         }
+        self.stale = false;
         self.world.step();
         for (i, &handle) in self.bodies.iter().enumerate() {
-            let body = &mut self.world.bodies[handle];
-            let p = body.translation();
-            let heading = body.rotation().angle();
-            let q = p.clamp(lo, hi);
-            if q != p || !q.is_finite() {
-                // The last guard: put it back inside and stop it.
-                let q = if q.is_finite() { q } else { poses[i].pos };
-                body.set_translation(q, false);
-                body.set_linvel(Vec2::ZERO, false);
-                poses[i] = Pose { pos: q, heading };
-            } else {
-                poses[i] = Pose { pos: p, heading };
-            }
+            let body = &self.world.bodies[handle];
+            self.rotations[i] = *body.rotation();
+            self.translations[i] = body.translation();
         }
     }
 
     /// Teleports body `i` to `p`, `heading` at rest.
     pub(super) fn set_pose(&mut self, i: usize, p: Vec2, heading: f32) {
+        if self.stale {
+            // Write the other bodies' free moves first: this one's alone would be kept.
+            for (k, &handle) in self.bodies.iter().enumerate() {
+                let pose = Pose2::from_parts(self.translations[k], self.rotations[k]);
+                self.world.bodies[handle].set_position(pose, true);
+            }
+            self.stale = false;
+        }
         let body = &mut self.world.bodies[self.bodies[i]];
         body.set_translation(p, true);
         body.set_rotation(Rotation::new(heading), true);
+        self.rotations[i] = *body.rotation();
+        self.translations[i] = body.translation();
         body.set_linvel(Vec2::ZERO, true);
         body.set_angvel(0.0, true);
     }
