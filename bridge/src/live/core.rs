@@ -253,7 +253,7 @@ impl LoopCore {
             let stopped = input.stopped.get(i).copied().unwrap_or(false);
             if let Some(onboard) = &mut self.onboard {
                 // The robot drives itself; the shield can only look ahead and stop it.
-                let cmd = onboard.driving(i);
+                let cmd = onboard.intent(i);
                 let (_, intervention) = self.shield.apply(&self.host.poses()[i], cmd);
                 self.interventions[i] = intervention;
                 self.counters.shield.add(intervention);

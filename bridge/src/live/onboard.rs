@@ -20,6 +20,8 @@ struct Robot {
     last_frame: f64,
     /// The robot's last report.
     status: Option<OnboardStatus>,
+    /// The wheel speeds its policy last chose while running (stop until it has run).
+    chosen: WheelCommand,
     /// It runs another policy, or none: held stopped, said once.
     refused: bool,
 }
@@ -52,6 +54,7 @@ impl OnboardHost {
                 started: false,
                 last_frame: f64::NEG_INFINITY,
                 status: None,
+                chosen: WheelCommand::STOP,
                 refused: false,
             })
             .collect();
@@ -67,6 +70,12 @@ impl OnboardHost {
         let r = self.robots.get_mut(i)?;
         let status = tm.onboard();
         r.status = Some(status);
+        if status.mode == PolicyMode::Running {
+            r.chosen = WheelCommand {
+                left: status.left,
+                right: status.right,
+            };
+        }
         let wrong = match status.mode {
             PolicyMode::None => Some("its firmware reports no on-board policy".to_string()),
             PolicyMode::Refused => Some(format!(
@@ -89,17 +98,12 @@ impl OnboardHost {
         )
     }
 
-    /// The command robot `i` drives with as far as the host knows: what it last reported choosing
-    /// while its policy runs, else a stop.
-    pub fn driving(&self, i: usize) -> WheelCommand {
+    /// What robot `i`'s policy last chose (a stop before it has run): the command the shield looks
+    /// ahead with, also while the robot is held. The host cannot ask the policy what it would do
+    /// now, so a robot the shield stopped stays stopped while that choice would still cross a wall.
+    pub fn intent(&self, i: usize) -> WheelCommand {
         match self.robots.get(i) {
-            Some(r) if r.started && !r.refused => match r.status {
-                Some(s) if s.mode == PolicyMode::Running => WheelCommand {
-                    left: s.left,
-                    right: s.right,
-                },
-                _ => WheelCommand::STOP,
-            },
+            Some(r) if !r.refused => r.chosen,
             _ => WheelCommand::STOP,
         }
     }
