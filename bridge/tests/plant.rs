@@ -109,6 +109,20 @@ fn a_plant_without_what_it_needs_names_it() {
     replay.log = Some("/nonexistent/rig.mcap".into());
     assert!(err(replay).contains("/nonexistent/rig.mcap"));
     assert!("simulator".parse::<PlantKind>().is_err());
+    // Robots that run their own policy would ignore the environment's actions.
+    let mut onboard = config();
+    let text = include_str!("../../env/scenarios/aggregation.toml");
+    onboard.scenario = colcos_env::ScenarioSource::Text(format!(
+        "{text}\n[rig]\nonboard = \"firmware/policy.json\"\n"
+    ));
+    let e = LiveEnv::new(&onboard, &PlantOptions::new(PlantKind::Twin))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("rig.onboard") && e.contains("colcos bridge"),
+        "{e}"
+    );
 }
 
 /// Steps (20 ms) from the first full-ahead command until the tracker shows the host any robot moved
