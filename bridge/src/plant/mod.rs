@@ -12,9 +12,11 @@
 mod calibration_gate;
 pub(crate) mod driver;
 mod goto;
+mod options;
 mod twin_scenario;
 
 pub use goto::GoTo;
+pub use options::{PlantError, PlantKind, PlantOptions};
 pub use twin_scenario::TwinScenario;
 
 use crate::calibrate::RigCalibration;
@@ -32,104 +34,12 @@ use colcos_sim::robot::Pose;
 use colcos_sim::scenario::{Scenario, SensorSource};
 use colcos_sim::world::WorldParts;
 use driver::{Driver, TwinThread};
-use std::path::PathBuf;
 use std::time::Instant;
 
 /// The frames the host streams to a twin started here whose robots read their own sensors: wide
 /// enough for a sensor's footprint to cover a few pixels, at twice the default telemetry rate.
 const TWIN_FRAME_WIDTH: u32 = 480;
 const TWIN_FRAME_HZ: f64 = 10.0;
-
-/// Where a plant's arena is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PlantKind {
-    Twin,
-    Rig,
-    Replay,
-}
-
-impl std::str::FromStr for PlantKind {
-    type Err = PlantError;
-    fn from_str(s: &str) -> Result<Self, PlantError> {
-        match s {
-            "twin" => Ok(PlantKind::Twin),
-            "rig" => Ok(PlantKind::Rig),
-            "replay" => Ok(PlantKind::Replay),
-            _ => Err(PlantError::option(
-                "plant",
-                format!("{s:?} is not \"sim\", \"twin\", \"rig\" or \"replay\""),
-            )),
-        }
-    }
-}
-
-/// How to reach a plant.
-#[derive(Clone, Debug)]
-pub struct PlantOptions {
-    pub kind: PlantKind,
-    /// The tracker's URL (`swarmcon://HOST:PORT`, `udp://...`); a twin without one starts in-process.
-    pub tracker: Option<String>,
-    /// The robots' link URL (`serial://...`, `udp://...`).
-    pub robots: Option<String>,
-    /// `replay`: the rig log to replay. `twin`, `rig`: where to write the rig log (none: no log).
-    pub log: Option<PathBuf>,
-    /// `reset` drives the robots to the episode's start poses (twin, rig).
-    pub goto: bool,
-    /// Longest a reset's go-to may take, s.
-    pub goto_timeout: f64,
-    /// `rig`: the screen calibration may be at most this old, s (a week by default) ...
-    pub calibration_max_age: f64,
-    /// ... and its RMS reprojection error at most this, mm.
-    pub calibration_max_error_mm: f64,
-    /// `twin` started here: the scenario the twin plays (its true tracker latency, sensors, robot
-    /// body) where it differs from the host's; None: the host's own.
-    pub twin_scenario: Option<TwinScenario>,
-}
-
-impl PlantOptions {
-    pub fn new(kind: PlantKind) -> PlantOptions {
-        PlantOptions {
-            kind,
-            tracker: None,
-            robots: None,
-            log: None,
-            goto: true,
-            goto_timeout: 30.0,
-            calibration_max_age: 7.0 * 86400.0,
-            calibration_max_error_mm: 3.0,
-            twin_scenario: None,
-        }
-    }
-}
-
-#[derive(Debug, thiserror::Error)]
-pub enum PlantError {
-    #[error(transparent)]
-    Env(#[from] EnvError),
-    #[error(transparent)]
-    Sim(#[from] colcos_sim::error::SimError),
-    #[error("tracker: {0}")]
-    Source(#[from] crate::SourceError),
-    #[error("robot link: {0}")]
-    Link(#[from] crate::LinkError),
-    #[error(transparent)]
-    Replay(#[from] replay::ReplayError),
-    #[error("{0}")]
-    Io(String),
-    #[error("`{key}`: {reason}")]
-    Option { key: String, reason: String },
-    #[error("{0}")]
-    State(String),
-}
-
-impl PlantError {
-    fn option(key: &str, reason: impl Into<String>) -> PlantError {
-        PlantError::Option {
-            key: key.into(),
-            reason: reason.into(),
-        }
-    }
-}
 
 /// What the last reset's go-to did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
