@@ -39,7 +39,7 @@ pub enum PhysicsBackend {
 }
 
 enum Solver {
-    Rapier(Box<RapierState>),
+    Rapier(RapierState),
     Discs(DiscState),
 }
 
@@ -82,12 +82,7 @@ impl ArenaPhysics {
             });
         }
         if backend == PhysicsBackend::Rapier {
-            physics.solver = Solver::Rapier(Box::new(RapierState::new(
-                size,
-                params,
-                radius,
-                &physics.poses,
-            )));
+            physics.solver = Solver::Rapier(RapierState::new(size, params, radius, &physics.poses));
         }
         physics
     }
@@ -97,6 +92,7 @@ impl ArenaPhysics {
     pub fn set_obstacles(&mut self, obstacles: Arc<Obstacles>) {
         if let Solver::Rapier(state) = &mut self.solver {
             obstacle_contacts::add_colliders(&mut state.world, &obstacles, FRICTION);
+            state.has_obstacles = !obstacles.is_empty();
         }
         self.obstacles = obstacles;
     }

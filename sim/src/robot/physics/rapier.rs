@@ -5,9 +5,10 @@ use crate::robot::{ColiasParams, Pose};
 use glam::Vec2;
 use rapier2d::math::Pose as Pose2;
 use rapier2d::prelude::{
-    ColliderBuilder, IntegrationParameters, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle,
-    Rotation, SpringCoefficients, Vector,
+    ColliderBuilder, IntegrationParameters, PhysicsPipeline, PhysicsWorld, RigidBodyBuilder,
+    RigidBodyHandle, Rotation, SpringCoefficients, Vector,
 };
+use std::cell::RefCell;
 
 /// Half-thickness of the wall boxes, m: thick enough that nothing can tunnel through.
 const WALL_HALF_THICKNESS: f32 = 0.5;
@@ -29,8 +30,16 @@ const FREE_MAX_ROBOTS: usize = 64;
 /// rapier's cap on a body's rotation per step, rad (its solver's `MAX_ROTATION`).
 const MAX_ROTATION: f32 = std::f32::consts::FRAC_PI_4;
 
+thread_local! {
+    /// rapier's pipeline holds only scratch buffers between steps: one per thread serves every
+    /// arena stepped on it, so a batch of many small arenas keeps one set of them in cache.
+    static PIPELINE: RefCell<PhysicsPipeline> = RefCell::new(PhysicsPipeline::new());
+}
+
+/// The rapier solver's state. What a free step reads is kept in this small struct, held inline by
+/// the arena; the rapier world (several KB of its own) is touched only by full steps.
 pub(super) struct RapierState {
-    pub(super) world: PhysicsWorld,
+    pub(super) world: Box<PhysicsWorld>,
     pub(super) bodies: Vec<RigidBodyHandle>,
     /// Each body's pose as rapier holds it (rotation as a unit complex), mirrored here so that a
     /// step in which no contact is possible moves the bodies without a rapier call.
@@ -40,6 +49,11 @@ pub(super) struct RapierState {
     stale: bool,
     /// Whether free steps are taken (off: every step goes through rapier's pipeline).
     pub(super) free_steps: bool,
+    /// Whether the arena has obstacles (set with them).
+    pub(super) has_obstacles: bool,
+    /// rapier's substeps per step and linear speed cap, m/s (copied from its parameters).
+    substeps: usize,
+    max_lin: f32,
 }
 
 impl RapierState {
@@ -99,13 +113,18 @@ impl RapierState {
             .iter()
             .map(|&b| world.bodies[b].translation())
             .collect();
+        let substeps = world.integration_parameters.num_solver_iterations.max(1);
+        let max_lin = world.integration_parameters.max_linear_velocity();
         RapierState {
-            world,
+            world: Box::new(world),
             bodies,
             rotations,
             translations,
             stale: false,
             free_steps: true,
+            has_obstacles: false,
+            substeps,
+            max_lin,
         }
     }
 
@@ -168,7 +187,7 @@ impl RapierState {
                 return false;
             }
         }
-        obstacles.is_empty()
+        !self.has_obstacles
             || self
                 .translations
                 .iter()
@@ -179,10 +198,8 @@ impl RapierState {
     /// same speed caps and, per substep, the same linearised rotation and translation update, in
     /// the same f32 operations (a test compares the two bit for bit).
     fn free_step(&mut self, velocity: impl Fn(usize) -> (f32, f32), dt: f32) {
-        let params = &self.world.integration_parameters;
-        let substeps = params.num_solver_iterations.max(1);
+        let (substeps, max_lin) = (self.substeps, self.max_lin);
         let sub_dt = dt / substeps as f32;
-        let max_lin = params.max_linear_velocity();
         let max_ang = MAX_ROTATION * (1.0 / dt);
         for (i, (rot, t)) in self
             .rotations
@@ -228,7 +245,24 @@ impl RapierState {
             body.set_angvel(yaw, true);
         }
         self.stale = false;
-        self.world.step();
+        let w = &mut self.world;
+        PIPELINE.with_borrow_mut(|pipeline| {
+            pipeline.step(
+                w.gravity,
+                &w.integration_parameters,
+                &mut w.islands,
+                &mut w.broad_phase,
+                &mut w.narrow_phase,
+                &mut w.bodies,
+                &mut w.colliders,
+                &mut w.impulse_joints,
+                &mut w.multibody_joints,
+                &mut w.soft_bodies,
+                &mut w.ccd_solver,
+                &(),
+                &(),
+            )
+        });
         for (i, &handle) in self.bodies.iter().enumerate() {
             let body = &self.world.bodies[handle];
             self.rotations[i] = *body.rotation();
