@@ -391,6 +391,16 @@ fn bad_manifests_are_refused_by_name() {
         let err = OnboardManifest::load(&path).unwrap_err().to_string();
         assert!(err.contains("rig.onboard") && err.contains(says), "{err}");
     }
+    let big = dir.path().join("big.json");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(64 << 20)
+        .unwrap();
+    let err = OnboardManifest::load(&big).unwrap_err().to_string();
+    assert!(
+        err.contains("rig.onboard") && err.contains("67108864 bytes"),
+        "{err}"
+    );
     let err = OnboardManifest::load(&dir.path().join("missing.json"))
         .unwrap_err()
         .to_string();

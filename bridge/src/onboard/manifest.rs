@@ -6,6 +6,9 @@ use colcos_sim::error::{Result, SimError};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
+/// Largest manifest read, bytes.
+const MAX_MANIFEST_BYTES: u64 = 1 << 20;
+
 /// The format this bridge reads.
 pub const FORMAT: &str = "colcos-onboard-policy/1";
 
@@ -46,6 +49,15 @@ impl OnboardManifest {
     /// Reads and checks `path`.
     pub fn load(path: &Path) -> Result<OnboardManifest> {
         let bad = |why: String| SimError::invalid("rig.onboard", path.display(), why);
+        // A manifest is a few KB; a path to anything else must not be read whole.
+        let len = std::fs::metadata(path)
+            .map_err(|e| bad(format!("cannot read it: {e}")))?
+            .len();
+        if len > MAX_MANIFEST_BYTES {
+            return Err(bad(format!(
+                "{len} bytes: not an on-board policy manifest (at most {MAX_MANIFEST_BYTES})"
+            )));
+        }
         let text =
             std::fs::read_to_string(path).map_err(|e| bad(format!("cannot read it: {e}")))?;
         let mut m: OnboardManifest = serde_json::from_str(&text).map_err(|e| {
