@@ -10,16 +10,27 @@ of the same shape (random weights, numpy only: what `scripts/onboard_footprint.s
 sizes do not depend on the values). `--scenario` takes the sensor calibration and the largest wheel
 speed from a scenario file instead of the simulator's defaults. `--check N` compiles the C with the
 host's `cc` and drives N episodes of the `aggregation` task with it and with the same network in numpy
-(same seeds): the returns and the largest action difference, a check before flashing.
+(same seeds): the returns and the largest action difference, a check before flashing. `--twin S` runs
+the exported C on the robots of the digital twin for S seconds: a scenario naming the export's manifest
+in `[rig] onboard`, `colcos twin` and `colcos bridge` over loopback (the bridge uploads each robot's
+parameters, starts the policy and sends only stops; the twin compiles the C and runs it on each
+robot's own readings of the screen the bridge shows), then what the robots did.
+
+    python examples/onboard_export.py --policy runs/aggregation/policy.pt --out firmware/policy --twin 20
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import ctypes
+import json
+import re
 import shutil
+import socket
 import subprocess
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -135,6 +146,74 @@ def episode_returns(
     return total / episodes, seen
 
 
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def run_on_twin(info, seconds: float, scenario: str | None, colcos_bin: str) -> None:
+    """The exported C on the twin's robots, driven by `colcos bridge` with `[rig] onboard`."""
+    binary = shutil.which(colcos_bin) or (colcos_bin if Path(colcos_bin).is_file() else None)
+    if binary is None:
+        raise SystemExit(f"--colcos {colcos_bin}: no such program (cargo build --release builds target/release/colcos)")
+    text = Path(scenario).read_text() if scenario else colcos.default_scenario("aggregation")
+    line = f'onboard = "{info.manifest.name}"'
+    if re.search(r"^\[rig\]\s*$", text, re.M):
+        text = re.sub(r"^\[rig\]\s*$", f"[rig]\n{line}", text, count=1, flags=re.M)
+    else:
+        text += f"\n[rig]\n{line}\n"
+    work = info.manifest.parent
+    sc = work / "twin_scenario.toml"
+    sc.write_text(text)
+    out = work / "twin_run"
+    tracker, robots, frames = free_port(), free_port(), free_port()
+    twin = subprocess.Popen(
+        [binary, "twin", str(sc), "--tracker", f"127.0.0.1:{tracker}", "--robots", f"udp://127.0.0.1:{robots}",
+         "--frames", f"127.0.0.1:{frames}", "--duration", str(seconds + 5)],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    try:
+        deadline = time.monotonic() + 30  # the twin compiles the C first
+        while True:
+            try:
+                socket.create_connection(("127.0.0.1", tracker), timeout=0.2).close()
+                break
+            except OSError:
+                if twin.poll() is not None or time.monotonic() > deadline:
+                    raise SystemExit(f"the twin did not start:\n{twin.communicate()[0]}") from None
+                time.sleep(0.1)
+        bridge = subprocess.run(
+            [binary, "bridge", str(sc), "--tracker", f"swarmcon://127.0.0.1:{tracker}", "--robots",
+             f"udp://127.0.0.1:{robots}", "--frames", f"127.0.0.1:{frames}", "--duration", str(seconds),
+             "--out", str(out)],
+            capture_output=True, text=True,
+        )
+        if bridge.returncode != 0:
+            raise SystemExit(f"colcos bridge failed:\n{bridge.stderr}")
+    finally:
+        twin.terminate()
+        twin.wait()
+    rows = list(csv.DictReader((out / "trajectory.csv").open()))
+    robots_n = 1 + max(int(r["robot"]) for r in rows)
+    ticks = sorted({int(r["tick"]) for r in rows})
+    at = {(int(r["tick"]), int(r["robot"])): (float(r["x"]), float(r["y"])) for r in rows}
+    seen = [t for t in ticks if all(at.get((t, i), (0.0, 0.0)) != (0.0, 0.0) for i in range(robots_n))]
+    first, last = np.array([at[(seen[0], i)] for i in range(robots_n)]), np.array([at[(seen[-1], i)] for i in range(robots_n)])
+
+    def spread(p: np.ndarray) -> float:
+        d = np.linalg.norm(p[:, None] - p[None], axis=-1)
+        return float(d.sum() / (robots_n * (robots_n - 1)))
+
+    summary = json.loads((out / "summary.json").read_text())
+    print(
+        f"on the twin, {robots_n} robots ran the C on board for {seconds:g} s: moved {np.linalg.norm(last - first, axis=1).mean():.3f} m "
+        f"each on average (start to end), mean distance between robots {spread(first):.3f} -> {spread(last):.3f} m; "
+        f"the bridge sent {summary.get('commands_sent', '?')} frames (parameters, starts, telemetry requests, stops), "
+        f"safety stops: {summary.get('stops') or 'none'}; run in {out}"
+    )
+
+
 def main() -> None:
     p = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -159,6 +238,8 @@ def main() -> None:
         metavar="N",
         help="run N aggregation episodes with the C and with numpy",
     )
+    p.add_argument("--twin", type=float, default=0.0, metavar="S", help="run the C on the digital twin's robots for S s")
+    p.add_argument("--colcos", default="target/release/colcos", help="the colcos program (for --twin)")
     args = p.parse_args()
     pairs, mean, var = (
         actor_from_state_dict(args.policy)
@@ -174,7 +255,7 @@ def main() -> None:
         scenario=args.scenario,
         prefix=args.prefix,
     )
-    print(f"wrote {info.header} and {info.source}")
+    print(f"wrote {info.header}, {info.source} and {info.manifest}")
     print(
         f"network {'-'.join(map(str, info.layer_sizes))} ({', '.join(info.activations)}): {info.n_params:,} parameters, "
         f"{info.weight_bytes:,} bytes of weights in flash, {info.stack_bytes:,} bytes of layer buffers on the stack, "
@@ -192,6 +273,8 @@ def main() -> None:
             f"check over {args.check} episodes of 500 steps: mean return per agent, C {ret_c:.2f}, numpy {ret_np:.2f}; "
             f"largest action difference on the C run's {len(obs):,} observations {diff:.3g}"
         )
+    if args.twin > 0:
+        run_on_twin(info, args.twin, args.scenario, args.colcos)
 
 
 if __name__ == "__main__":

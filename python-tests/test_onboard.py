@@ -364,3 +364,24 @@ def test_the_bridges_fixture_is_what_export_c_writes(tmp_path):
     for name in ("policy.c", "policy.h", "policy.json"):
         committed = (REPO / "bridge" / "tests" / "data" / "onboard" / name).read_text()
         assert (tmp_path / name).read_text() == committed, f"{name}: run python scripts/onboard_fixture.py"
+
+
+def test_the_example_runs_the_c_on_the_twins_robots(tmp_path):
+    """`examples/onboard_export.py --twin`: the exported C on board the twin's robots, driven by
+    `colcos bridge` with `[rig] onboard` (target/release/colcos, which `cargo test --release` builds)."""
+    binary = REPO / "target" / "release" / "colcos"
+    if not binary.is_file():
+        pytest.skip(f"{binary} is missing: build it with `cargo build --release`")
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, str(REPO / "examples" / "onboard_export.py"), "--out", str(tmp_path / "policy"),
+         "--twin", "2", "--colcos", str(binary)],
+        capture_output=True, text=True, timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    line = done.stdout.strip().splitlines()[-1]
+    assert "robots ran the C on board for 2 s" in line and "safety stops: none" in line, line
+    moved = float(line.split("moved ")[1].split(" m")[0])
+    assert moved > 0.005, line
+    assert (tmp_path / "twin_run" / "rig.mcap").is_file()
