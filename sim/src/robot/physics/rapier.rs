@@ -16,8 +16,9 @@ const WALL_HALF_THICKNESS: f32 = 0.5;
 /// to the 2 cm robots.
 const LENGTH_UNIT: f32 = 0.2;
 /// Distance at which rapier starts predictive contacts, m. It must exceed the distance two robots
-/// close in one step (2 x 0.35 m/s x 20 ms = 14 mm), or robots meeting head-on overlap by up to that.
-const PREDICTION_DISTANCE: f32 = 0.02;
+/// close in one step (2 x 0.35 m/s x 20 ms = 14 mm), or robots meeting head-on overlap by up to that;
+/// no larger, as every pair and wall within it costs a contact and a step through the pipeline.
+const PREDICTION_DISTANCE: f32 = 0.015;
 /// Natural frequency of the contact springs, Hz (rapier's default is 30 Hz for dynamic pairs and
 /// 60 Hz against fixed bodies). With 20 ms steps those let a line of robots pushed into a wall
 /// compress by centimetres; 300 Hz keeps overlaps under half a millimetre.
