@@ -118,6 +118,8 @@ pub struct EnvConfig {
     pub seed: u64,
     /// Field backend of the grid pheromones; `None`: the scenario's `[field] backend`.
     pub backend: Option<colcos_sim::field::BackendChoice>,
+    /// The worlds' contact solver; `None`: the scenario's `physics` (rapier unless it says `discs`).
+    pub physics: Option<colcos_sim::robot::PhysicsBackend>,
     /// Pass the agents' commands through the safety shield (`[rig] shield` of the scenario), as every
     /// plant does on the rig, so that training sees what deployment does.
     pub shield: bool,
@@ -138,6 +140,7 @@ impl EnvConfig {
             num_threads: None,
             seed: 0,
             backend: None,
+            physics: None,
             shield: true,
         }
     }

@@ -67,6 +67,9 @@ impl VecEnv {
         if let Some(b) = cfg.backend {
             scenario.spec.field.backend = b;
         }
+        if let Some(p) = cfg.physics {
+            scenario.spec.physics = p;
+        }
         let mut backend = EnvBackend::resolve(scenario.spec.field.backend)?;
         let max_cycles = if cfg.max_cycles > 0 {
             cfg.max_cycles

@@ -1,10 +1,12 @@
 //! Golden outputs of the batched environment: observations, rewards, terminations and global state of
 //! every task, under fixed actions and under a baseline policy, hash to exactly these values. A
 //! refactoring that changes any of them changes behaviour. Each is pinned with the safety shield off
-//! (the simulator alone) and on (the default: what every plant does to the agents' commands).
+//! (the simulator alone) and on (the default: what every plant does to the agents' commands), for the
+//! default solver (rapier) and for the disc solver.
 //! `COLCOS_GOLDEN_PRINT=1 cargo test --release -p colcos-env --test golden -- --nocapture` prints them.
 use colcos_env::baseline::BaselinePolicy;
 use colcos_env::{Actions, EnvConfig, VecEnv};
+use colcos_sim::robot::PhysicsBackend;
 
 /// FNV-1a, 64-bit, over the bytes of every value fed to it.
 struct Fnv(u64);
@@ -32,8 +34,9 @@ fn record(env: &VecEnv, h: &mut Fnv) {
     h.flags(env.final_mask());
 }
 
-fn config(task: &str, shield: bool) -> EnvConfig {
+fn config(task: &str, shield: bool, physics: Option<PhysicsBackend>) -> EnvConfig {
     let mut c = EnvConfig::new(task);
+    c.physics = physics;
     c.shield = shield;
     c.num_envs = 4;
     c.max_cycles = 40;
@@ -43,8 +46,8 @@ fn config(task: &str, shield: bool) -> EnvConfig {
 }
 
 /// Fixed, varied actions (a sine over world, agent, wheel and step) through two episodes.
-fn scripted_actions(task: &str, shield: bool) -> u64 {
-    let mut env = VecEnv::new(&config(task, shield)).unwrap();
+fn scripted_actions(task: &str, shield: bool, physics: Option<PhysicsBackend>) -> u64 {
+    let mut env = VecEnv::new(&config(task, shield, physics)).unwrap();
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
     env.reset(Some(11), None).unwrap();
     record(&env, &mut h);
@@ -60,8 +63,14 @@ fn scripted_actions(task: &str, shield: bool) -> u64 {
 }
 
 /// The task's scenario behaviour as a baseline policy, through two episodes.
-fn baseline(task: &str, behaviour: &str, params: serde_json::Value, shield: bool) -> u64 {
-    let mut env = VecEnv::new(&config(task, shield)).unwrap();
+fn baseline(
+    task: &str,
+    behaviour: &str,
+    params: serde_json::Value,
+    shield: bool,
+    physics: Option<PhysicsBackend>,
+) -> u64 {
+    let mut env = VecEnv::new(&config(task, shield, physics)).unwrap();
     env.reset(Some(5), None).unwrap();
     let mut policy = BaselinePolicy::new(&env, behaviour, &params, 5).unwrap();
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
@@ -83,57 +92,91 @@ fn check(label: &str, got: u64, want: u64) {
     }
 }
 
-#[test]
-fn every_task_under_fixed_actions() {
-    for (task, without, with) in [
-        ("aggregation", 0xadf11341867d8529u64, 0x246f71c184135465u64),
-        ("foraging", 0xe84fe0d65f7cb0d5, 0xe84fe0d65f7cb0d5),
-        ("trail", 0x673dabe31bf0b339, 0x3143367b5283c4a6),
-    ] {
-        check(task, scripted_actions(task, false), without);
+/// Every task under fixed actions, shield off and on, with `physics` (None: the scenario's).
+fn fixed_actions(physics: Option<PhysicsBackend>, want: [(&str, u64, u64); 3]) {
+    for (task, without, with) in want {
+        let tag = physics.map_or("default".to_string(), |p| format!("{p:?}"));
         check(
-            &format!("{task} (shield)"),
-            scripted_actions(task, true),
+            &format!("{task} [{tag}]"),
+            scripted_actions(task, false, physics),
+            without,
+        );
+        check(
+            &format!("{task} (shield) [{tag}]"),
+            scripted_actions(task, true, physics),
             with,
         );
     }
 }
 
-#[test]
-fn baselines() {
-    for (task, behaviour, params, without, with) in [
-        (
-            "aggregation",
-            "aggregation_follower",
-            serde_json::json!({}),
-            0xaa4d94bce0cff459u64,
-            0x25f99dacd10e76c8u64,
-        ),
-        (
-            "foraging",
-            "forage",
-            serde_json::json!({}),
-            0x0f924c66bd414548,
-            0x0f924c66bd414548,
-        ),
-        (
-            "trail",
-            "follow",
-            serde_json::json!({"channel": "b"}),
-            0x137cf18b419c7b0f,
-            0x74607472e76cbfa4,
-        ),
-    ] {
-        let label = format!("{task}/{behaviour}");
+/// Every task's baseline policy, shield off and on.
+fn baselines(physics: Option<PhysicsBackend>, want: [(u64, u64); 3]) {
+    let policies = [
+        ("aggregation", "aggregation_follower", serde_json::json!({})),
+        ("foraging", "forage", serde_json::json!({})),
+        ("trail", "follow", serde_json::json!({"channel": "b"})),
+    ];
+    for ((task, behaviour, params), (without, with)) in policies.into_iter().zip(want) {
+        let tag = physics.map_or("default".to_string(), |p| format!("{p:?}"));
+        let label = format!("{task}/{behaviour} [{tag}]");
         check(
             &label,
-            baseline(task, behaviour, params.clone(), false),
+            baseline(task, behaviour, params.clone(), false, physics),
             without,
         );
         check(
             &format!("{label} (shield)"),
-            baseline(task, behaviour, params, true),
+            baseline(task, behaviour, params, true, physics),
             with,
         );
     }
+}
+
+/// The default solver, rapier.
+#[test]
+fn every_task_under_fixed_actions() {
+    fixed_actions(
+        None,
+        [
+            ("aggregation", 0xaee3d71bb9491d34, 0x8fd6d284b1219559),
+            ("foraging", 0x44a08f13ea024f94, 0x44a08f13ea024f94),
+            ("trail", 0xc4f22a3d0cc98d4b, 0x454368c6991fa6d3),
+        ],
+    );
+}
+
+#[test]
+fn every_task_under_fixed_actions_discs() {
+    fixed_actions(
+        Some(PhysicsBackend::Discs),
+        [
+            ("aggregation", 0xadf11341867d8529, 0x246f71c184135465),
+            ("foraging", 0xe84fe0d65f7cb0d5, 0xe84fe0d65f7cb0d5),
+            ("trail", 0x673dabe31bf0b339, 0x3143367b5283c4a6),
+        ],
+    );
+}
+
+#[test]
+fn baselines_rapier() {
+    baselines(
+        None,
+        [
+            (0xb9c5e5b158daa3f7, 0x17641f0e1980a989),
+            (0x5b06673915d8e210, 0x5b06673915d8e210),
+            (0x92303b1c29d7da7d, 0x6228a79982175c49),
+        ],
+    );
+}
+
+#[test]
+fn baselines_discs() {
+    baselines(
+        Some(PhysicsBackend::Discs),
+        [
+            (0xaa4d94bce0cff459, 0x25f99dacd10e76c8),
+            (0x0f924c66bd414548, 0x0f924c66bd414548),
+            (0x137cf18b419c7b0f, 0x74607472e76cbfa4),
+        ],
+    );
 }

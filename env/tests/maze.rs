@@ -1,27 +1,24 @@
 //! The `trail` task's `maze` option: the walled corridor is built, agents driven straight stay out of
 //! its walls and their bumpers see them; `maze = true` on a scenario without obstacles is refused.
 use colcos_env::{Actions, EnvConfig, ScenarioSource, VecEnv};
+use colcos_sim::robot::PhysicsBackend;
 
-fn maze_config(physics: &str) -> EnvConfig {
+fn maze_config(physics: PhysicsBackend) -> EnvConfig {
     let mut cfg = EnvConfig::new("trail");
     cfg.params = serde_json::json!({ "maze": true });
     cfg.num_envs = 4;
     cfg.shield = false;
-    if physics != "discs" {
-        let text = colcos_env::task::trail::MAZE_SCENARIO
-            .replace("physics = \"discs\"", &format!("physics = \"{physics}\""));
-        cfg.scenario = ScenarioSource::Text(text);
-    }
+    cfg.physics = Some(physics);
     cfg
 }
 
 #[test]
 fn agents_driven_straight_meet_the_walls_and_stay_out() {
-    for physics in ["discs", "rapier"] {
+    for physics in [PhysicsBackend::Discs, PhysicsBackend::Rapier] {
         let mut env = VecEnv::new(&maze_config(physics)).unwrap();
         env.reset(Some(3), None).unwrap();
         let world = env.world(0).unwrap();
-        assert!(!world.obstacles().is_empty(), "{physics}: no obstacles");
+        assert!(!world.obstacles().is_empty(), "{physics:?}: no obstacles");
         let n = env.spec().num_agents * 4;
         // Full speed ahead with a slight left turn: the agents leave the loop's curve and hit walls.
         let actions: Vec<f32> = (0..n).flat_map(|_| [1.0, 0.8]).collect();
@@ -35,7 +32,7 @@ fn agents_driven_straight_meet_the_walls_and_stay_out() {
                     // rapier's contacts are stiff springs: allow 2 mm.
                     assert!(
                         w.obstacles().overlapping(p.pos, r, 0.002).is_none(),
-                        "{physics}: world {e} robot {i} at {:?} inside a wall",
+                        "{physics:?}: world {e} robot {i} at {:?} inside a wall",
                         p.pos
                     );
                 }
@@ -46,7 +43,7 @@ fn agents_driven_straight_meet_the_walls_and_stay_out() {
         }
         assert!(
             bumped > 0.5,
-            "{physics}: the bumpers never saw a wall ({bumped})"
+            "{physics:?}: the bumpers never saw a wall ({bumped})"
         );
     }
 }
