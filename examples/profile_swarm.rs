@@ -94,6 +94,9 @@ fn main() {
     time_scenario("bench: 10,000 robots, discs", || {
         swarm_scenario::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Discs)
     });
+    time_scenario("bench: 10,000 robots, rapier", || {
+        swarm_scenario::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Rapier)
+    });
     time_scenario("bench: 100 robots, 65-inch, 5 mm, rapier", || {
         swarm_scenario::scenario(100, [1.439, 0.809], [3840, 2160], 0.005, Rapier)
     });
