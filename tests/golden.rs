@@ -173,19 +173,19 @@ const THREE_TRAILS: &[(&str, u64)] = &[
     ("trajectory.csv", 0x271f7d04f28e7b5e),
 ];
 const CASE1_G3: &[(&str, u64)] = &[
-    ("fields/LAP.npy", 0xe8cb475867314762),
-    ("fields/SAP.npy", 0xcc50079de2c6e3a2),
-    ("fields/SRP.npy", 0x59f90e33281bf1e2),
-    ("scenario.toml", 0xc8ca8ddd11a4a1fb),
-    ("screen.png", 0x8d50e96e7620b236),
-    ("trajectory.csv", 0x52c7dee15bc6e136),
+    ("fields/LAP.npy", 0xc952b4dfdfe5505b),
+    ("fields/SAP.npy", 0xdfff4a782f01fa42),
+    ("fields/SRP.npy", 0xc2747a75adaa7feb),
+    ("scenario.toml", 0xd468996410fb0dfb),
+    ("screen.png", 0x2ee51d14a5cdd68a),
+    ("trajectory.csv", 0x71f3656813402e13),
 ];
 const CASE1_B_G2: &[(&str, u64)] = &[
-    ("fields/LAP.npy", 0xbb38b73bead5efa2),
-    ("fields/SAP.npy", 0x3064cab20eeb52a2),
-    ("scenario.toml", 0x8800dd7c0ed3ecb2),
-    ("screen.png", 0x9dafe67cdf6df998),
-    ("trajectory.csv", 0x6e255977eb3ccd51),
+    ("fields/LAP.npy", 0xbe447f50d106e252),
+    ("fields/SAP.npy", 0xe8b8112fc4e75cb2),
+    ("scenario.toml", 0xbbaf23960a581f0e),
+    ("screen.png", 0xb8b059c87c25f51d),
+    ("trajectory.csv", 0x51d4f7dd2f7da5ec),
 ];
 const CASE2: &[(&str, u64)] = &[
     ("fields/AGP.npy", 0x17190009229fb89e),

@@ -2,11 +2,11 @@
 //! `trials` trials each; one robot per trial starting at the nest; a trial ends when the robot comes
 //! within `arrival_radius` of an end point, or times out.
 //!
-//! Speed-up (exact): with `d = 0` the field of eq. (2) under a static injection `J` tends to the steady
-//! state `e J`, and `Phi = e J` stays there for ever (`Phi <- a Phi + e (1 - a) J = e J`). The paper
-//! builds the trails before the robot starts ("the pheromone branches have been constructed already"),
-//! so every trial pre-loads `e J` at t = 0 and freezes the grid (no evaporation, no injection), which
-//! leaves the same field without stepping 140,000 cells per time step.
+//! The paper builds the trails before the robot starts ("the pheromone branches have been constructed
+//! already"), so the scenarios pre-load the steady state `e J` at t = 0 (`preload = true`).
+//! Speed-up (exact): with `d = 0`, `Phi = e J` stays there for ever (`Phi <- a Phi + e (1 - a) J =
+//! e J`), so every trial freezes the grid (no evaporation, no injection), which leaves the same field
+//! without stepping 140,000 cells per time step.
 use super::layout::TrailLayout;
 use anyhow::Result;
 use colcos_sim::behaviour::WheelCommand;
@@ -97,21 +97,19 @@ pub struct Case1Result {
     pub wall_seconds: f64,
 }
 
-/// Sets every static grid field with no diffusion or wind to its steady state `e J` and freezes it.
-pub fn preload_steady_state(world: &mut World) {
-    for p in world.pheromones_mut() {
+/// Freezes every pre-loaded static grid field (already at its steady state `e J`, which stepping
+/// would keep): no injection, no evaporation.
+pub fn freeze_steady_state(world: &mut World, scenario: &Scenario) {
+    for (p, spec) in world
+        .pheromones_mut()
+        .iter_mut()
+        .zip(&scenario.spec.pheromones)
+    {
+        if !spec.preload {
+            continue;
+        }
         if let FieldModel::Grid(g) = &mut p.model {
             let mut params = *g.params();
-            let e = params.evaporation;
-            if params.diffusion != 0.0 || params.wind != Vec2::ZERO || !(e.is_finite() && e > 0.0) {
-                continue;
-            }
-            let Some(j) = g.static_injection().map(|j| j.to_vec()) else {
-                continue;
-            };
-            for (v, j) in g.values_mut().iter_mut().zip(j) {
-                *v = e * j;
-            }
             g.clear_static_injection();
             params.evaporation = f32::INFINITY;
             g.set_params(params);
@@ -128,7 +126,7 @@ pub fn run_trial(
     every: u64,
 ) -> Result<Trial> {
     let mut world = World::with_index(scenario, trial as u64)?;
-    preload_steady_state(&mut world);
+    freeze_steady_state(&mut world, scenario);
     // One still step so that the first observation the robot acts on sees the loaded trails.
     world.step_with_commands(&[WheelCommand::STOP]);
     let mut path = vec![world.poses()[0].pos];

@@ -1,7 +1,7 @@
 //! Fig. 6: the trajectories of case I over the screen of their group. Every trial is drawn
 //! half-transparent and shifted by up to 6 pixels (4 mm) (in the drawing only), so paths that share a trail
 //! show as a denser bundle rather than one line; the end points are numbered and a bar gives the scale.
-use super::case1::{Case1Result, preload_steady_state};
+use super::case1::{Case1Result, freeze_steady_state};
 use super::plots::{boxed_label, label, save};
 use anyhow::Result;
 use colcos_sim::behaviour::WheelCommand;
@@ -27,7 +27,7 @@ const PALETTE: [[u8; 3]; 6] = [
 pub fn case1_screen(r: &Case1Result, g: usize, width: u32) -> Result<RgbImage> {
     let sc = r.config.scenario(g)?;
     let mut world = World::new(&sc)?;
-    preload_steady_state(&mut world);
+    freeze_steady_state(&mut world, &sc);
     world.step_with_commands(&[WheelCommand::STOP]);
     let s = *world.screen();
     let height = (width as f32 * s.size[1] / s.size[0]).round() as u32;

@@ -321,7 +321,7 @@ impl TrailLayout {
 
     /// The scenario of one case-I group: `pheromones` is a subset of `["LAP", "SAP", "SRP"]`; one robot
     /// at the nest heading along the trunk, behaviour `forage`. Table I: e = 50 s, d = 0, J from the
-    /// maps (steady state `e J = 1`, drawn at full level 255).
+    /// maps (steady state `e J = 1`, drawn at full level 255), pre-loaded at t = 0 (`preload`).
     pub fn scenario_spec(
         &self,
         foods: &[usize],
@@ -364,6 +364,7 @@ impl TrailLayout {
             };
             scenario = scenario.pheromone(PheromoneSpec {
                 maps,
+                preload: true,
                 ..PheromoneSpec::grid(name, colour).with_evaporation(50.0)
             });
         }

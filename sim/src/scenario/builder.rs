@@ -159,6 +159,7 @@ impl PheromoneSpec {
             wind: [0.0, 0.0],
             maps: Vec::new(),
             sources: Vec::new(),
+            preload: false,
         }
     }
 

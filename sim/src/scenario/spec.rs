@@ -162,6 +162,10 @@ pub struct PheromoneSpec {
     /// Fixed Gaussian sources (gaussian only).
     #[serde(default)]
     pub sources: Vec<SourceSpec>,
+    /// Start with the field at the steady state `e J` of its static maps (grid, evaporation set, no
+    /// diffusion or wind): trails already built at t = 0, as in the paper's case I.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub preload: bool,
 }
 
 /// A static injection map: a polyline with a width, or an image.

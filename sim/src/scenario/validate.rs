@@ -214,6 +214,24 @@ fn det3(m: &[[f32; 3]; 3]) -> f32 {
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
+/// `preload` sets the field to `e J`, the steady state of eq. (2) only without diffusion or wind.
+fn check_preload(i: usize, p: &super::spec::PheromoneSpec) -> Result<()> {
+    let why = if p.maps.is_empty() {
+        "needs static maps (the steady state is e J of the maps)"
+    } else if p.evaporation.is_none() {
+        "needs an evaporation time (without it the field grows for ever)"
+    } else if p.diffusion != 0.0 || p.wind != [0.0, 0.0] {
+        "needs diffusion = 0 and no wind (e J is the steady state of evaporation alone)"
+    } else {
+        return Ok(());
+    };
+    Err(SimError::invalid(
+        format!("pheromones[{i}].preload"),
+        "true",
+        why,
+    ))
+}
+
 fn validate_pheromones(sc: &Scenario, grid: &crate::field::GridSpec) -> Result<()> {
     let s = &sc.spec;
     for (i, p) in s.pheromones.iter().enumerate() {
@@ -247,6 +265,9 @@ fn validate_pheromones(sc: &Scenario, grid: &crate::field::GridSpec) -> Result<(
                     ));
                 }
                 limits::check_substeps(sc, i, grid)?;
+                if p.preload {
+                    check_preload(i, p)?;
+                }
                 for (m, map) in p.maps.iter().enumerate() {
                     let key = format!("pheromones[{i}].maps[{m}]");
                     validate_map(&key, map)?;
@@ -262,6 +283,13 @@ fn validate_pheromones(sc: &Scenario, grid: &crate::field::GridSpec) -> Result<(
                         k("evaporation"),
                         "missing",
                         "the Gaussian model needs an evaporation time",
+                    ));
+                }
+                if p.preload {
+                    return Err(SimError::invalid(
+                        k("preload"),
+                        "true",
+                        "pre-loading static maps belongs to the grid model",
                     ));
                 }
                 if p.diffusion != 0.0 || p.wind != [0.0, 0.0] || !p.maps.is_empty() {
