@@ -6,7 +6,8 @@
 //! the arena. Two interchangeable solvers ([`PhysicsBackend`]):
 //!
 //! - [`PhysicsBackend::Rapier`] (the default): rapier2d dynamic discs (no gravity, low friction) in
-//!   four thick static wall boxes; one rapier step per call. Full rigid-body contact dynamics.
+//!   four thick static wall boxes; one rapier step per call. Full rigid-body contact dynamics. A step
+//!   in which no contact is possible moves the discs without rapier's pipeline, bit-identically.
 //! - [`PhysicsBackend::Discs`]: a purpose-built position solver for equal discs: move, then a few
 //!   Gauss-Seidel passes that separate overlapping pairs (found with a uniform grid) and clamp to the
 //!   walls. Several times faster than rapier for large swarms (10,000 robots), with the same
