@@ -1,7 +1,9 @@
 //! rapier2d arena: walls hold, contacts separate, runs repeat bit for bit.
+use colcos_sim::arena::Obstacles;
 use colcos_sim::robot::{ArenaPhysics, ColiasParams, PhysicsBackend, Pose};
 use glam::Vec2;
 use proptest::prelude::*;
+use std::sync::Arc;
 
 const DT: f32 = 0.02;
 const BACKENDS: [PhysicsBackend; 2] = [PhysicsBackend::Rapier, PhysicsBackend::Discs];
@@ -190,16 +192,39 @@ proptest! {
 #[test]
 fn free_steps_are_bit_identical_to_rapier() {
     for seed in [7, 11, 23, 99] {
-        free_steps_match(seed);
+        free_steps_match(seed, None);
+    }
+    // A box and a disc in the middle of the arena.
+    let text = "duration = 1.0\n[[obstacles]]\nshape = \"box\"\ncentre = [0.25, 0.2]\nsize = [0.08, 0.05]\n\
+                [[obstacles]]\nshape = \"disc\"\ncentre = [0.4, 0.3]\nradius = 0.03\n";
+    let spec = colcos_sim::scenario::parse_spec(text).unwrap();
+    let obstacles = Obstacles::build(
+        &spec.obstacles,
+        Vec2::new(0.5, 0.4),
+        std::path::Path::new("."),
+    )
+    .unwrap();
+    for seed in [5, 42] {
+        free_steps_match(seed, Some(Arc::new(obstacles.clone())));
     }
 }
 
-fn free_steps_match(seed: u32) {
+fn free_steps_match(seed: u32, obstacles: Option<Arc<Obstacles>>) {
     let p = ColiasParams::default();
     let size = Vec2::new(0.5, 0.4);
-    let start = grid(6, size, 0.1);
+    let start: Vec<Pose> = match &obstacles {
+        // A row along the top, clear of the obstacles.
+        Some(_) => (0..6)
+            .map(|i| Pose::new(0.06 + 0.076 * i as f32, 0.36, i as f32))
+            .collect(),
+        None => grid(6, size, 0.1),
+    };
     let mut fast = ArenaPhysics::with_backend(size, &p, &start, PhysicsBackend::Rapier);
     let mut slow = ArenaPhysics::with_backend(size, &p, &start, PhysicsBackend::Rapier);
+    if let Some(obs) = obstacles {
+        fast.set_obstacles(obs.clone());
+        slow.set_obstacles(obs);
+    }
     slow.set_free_steps(false);
     let mut s = seed;
     let mut next = move || {
