@@ -28,6 +28,17 @@ pub struct TrailNode {
     pub parent: Option<usize>,
 }
 
+/// How an edge turns from its fork toward its child.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Corners {
+    /// A smooth cubic Bezier curve.
+    #[default]
+    Rounded,
+    /// Straight segments with sharp corners, as a user draws a polyline: out of the fork along the
+    /// branch's angle, straight to the start of the approach, then the approach.
+    Straight,
+}
+
 /// A tree of trails from a nest to numbered end points.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrailLayout {
@@ -46,6 +57,7 @@ pub struct TrailLayout {
     pub srp_start: f32,
     /// ...to this many.
     pub srp_end: f32,
+    pub corners: Corners,
 }
 
 /// Length of the straight run at the end of every edge, m.
@@ -112,6 +124,7 @@ fn banded(name: &str, bands: [Band; 4], mirror: bool) -> TrailLayout {
         arena: Vec2::from(SCREEN),
         srp_start: 0.03,
         srp_end: 0.15,
+        corners: Corners::Rounded,
     }
 }
 
@@ -222,6 +235,9 @@ impl TrailLayout {
         let len = p0.distance(p3);
         let a = 0.3 * len;
         let p1 = p0 + Vec2::from_angle(start) * a;
+        if self.corners == Corners::Straight {
+            return densify(&[p0, p1, p3, c.pos], 0.01);
+        }
         let p2 = p3 - end_dir * a;
         let n = ((len / 0.01).ceil() as usize).max(2);
         let mut pts: Vec<Vec2> = (0..=n)
@@ -376,6 +392,16 @@ impl TrailLayout {
             )
             .spec()
     }
+}
+
+/// `pts` with points added so that no two consecutive ones are more than `step` apart.
+fn densify(pts: &[Vec2], step: f32) -> Vec<Vec2> {
+    let mut out = vec![pts[0]];
+    for w in pts.windows(2) {
+        let n = ((w[0].distance(w[1]) / step).ceil() as usize).max(1);
+        out.extend((1..=n).map(|k| w[0].lerp(w[1], k as f32 / n as f32)));
+    }
+    out
 }
 
 fn round5(v: f32) -> f32 {
