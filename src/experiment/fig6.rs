@@ -155,7 +155,7 @@ fn scale_bar(img: &mut RgbImage, r: &Case1Result, size: f64) -> Result<()> {
 }
 
 /// The trajectories of group `g` over its dimmed screen, `width` pixels wide.
-fn trajectories_panel(r: &Case1Result, g: usize, width: u32) -> Result<RgbImage> {
+pub(super) fn trajectories_panel(r: &Case1Result, g: usize, width: u32) -> Result<RgbImage> {
     let mut img = case1_screen(r, g, width)?;
     for p in img.pixels_mut() {
         p.0 = p.0.map(|v| (v as f32 * 0.55) as u8);

@@ -13,6 +13,9 @@ pub mod fig78;
 pub mod layout;
 pub mod moments;
 pub mod plots;
+pub mod random_map;
+pub mod random_plots;
+pub mod random_run;
 pub mod summary;
 
 use anyhow::{Context, Result, bail};
@@ -24,6 +27,16 @@ pub enum Which {
     Case1,
     Case2,
     All,
+}
+
+/// Which trail maps case I runs on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Maps {
+    /// The layout of `--layout` (A or B).
+    #[default]
+    Layout,
+    /// `--count` random maps by the paper's rule (seeded by `--seed`).
+    Random,
 }
 
 /// Arguments of `colcos experiment`.
@@ -50,6 +63,13 @@ pub struct ExperimentArgs {
     /// Available food points of case I, 1-based, comma separated [default: the layout's, A: 3,10].
     #[arg(long, value_delimiter = ',')]
     pub foods: Option<Vec<usize>>,
+    /// Trail maps of case I: layout (the one of --layout) or random (--count maps drawn by the
+    /// paper's rule, each with its own food points).
+    #[arg(long, value_enum, default_value_t = Maps::Layout)]
+    pub maps: Maps,
+    /// Random maps of case I (with --maps random).
+    #[arg(long, default_value_t = 10)]
+    pub count: usize,
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -68,6 +88,8 @@ pub struct Options {
     pub seed: u64,
     pub layout: layout::TrailLayout,
     pub foods: Vec<usize>,
+    /// Case I on this many random maps instead of `layout`.
+    pub random_maps: Option<usize>,
     pub progress: bool,
 }
 
@@ -84,6 +106,7 @@ impl Options {
             seed: 1,
             layout,
             foods,
+            random_maps: None,
             progress: false,
         }
     }
@@ -105,6 +128,16 @@ impl Options {
         if a.trials == 0 {
             bail!("--trials must be at least 1");
         }
+        let random_maps = match a.maps {
+            Maps::Layout => None,
+            Maps::Random if a.count == 0 => bail!("--count must be at least 1"),
+            Maps::Random if a.foods.is_some() => {
+                bail!(
+                    "--foods applies to layouts A and B: each random map draws its own food points"
+                )
+            }
+            Maps::Random => Some(a.count),
+        };
         Ok(Options {
             which: a.which,
             trials: a.trials,
@@ -113,6 +146,7 @@ impl Options {
             seed: a.seed,
             layout,
             foods,
+            random_maps,
             progress: !a.quiet,
         })
     }
@@ -121,6 +155,7 @@ impl Options {
 /// What an experiment produced.
 pub struct Report {
     pub case1: Option<case1::Case1Result>,
+    pub case1_random: Option<random_run::RandomCase1>,
     pub case2: Option<case2::Case2Result>,
     pub files: Vec<PathBuf>,
     pub wall_seconds: f64,
@@ -147,6 +182,8 @@ pub fn run(opts: &Options) -> Result<Report> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let do1 = matches!(opts.which, Which::Case1 | Which::All);
     let do2 = matches!(opts.which, Which::Case2 | Which::All);
+    let random = opts.random_maps.filter(|_| do1);
+    let do1 = do1 && random.is_none();
     let cfg1 = do1.then(|| {
         let mut c = case1::Case1Config::new(opts.layout.clone(), opts.trials, opts.seed);
         c.foods = opts.foods.clone();
@@ -157,16 +194,25 @@ pub fn run(opts: &Options) -> Result<Report> {
     } else {
         None
     };
-    let total = cfg1.as_ref().map_or(0, case1::task_count) + cfg2.as_ref().map_or(0, |c| c.runs);
+    let total = cfg1.as_ref().map_or(0, case1::task_count)
+        + cfg2.as_ref().map_or(0, |c| c.runs)
+        + random.map_or(0, |n| random_run::task_count(n, opts.trials));
     let bar = progress_bar(total as u64, opts.progress);
     let tick = || bar.inc(1);
     // Both cases share the pool: case II's few long runs start first, case I's trials fill the gaps.
-    let (r2, r1) = rayon::join(
+    let (r2, (r1, rr)) = rayon::join(
         || cfg2.as_ref().map(|c| case2::run(c, &tick)).transpose(),
-        || cfg1.as_ref().map(|c| case1::run(c, &tick)).transpose(),
+        || {
+            let r1 = cfg1.as_ref().map(|c| case1::run(c, &tick)).transpose();
+            let forage = toml::Table::new();
+            let rr = random
+                .map(|n| random_run::run(opts.seed, n, opts.trials, &forage, &tick))
+                .transpose();
+            (r1, rr)
+        },
     );
     bar.finish_and_clear();
-    let (r1, r2) = (r1?, r2?);
+    let (r1, r2, rr) = (r1?, r2?, rr?);
     let mut files = Vec::new();
     if let Some(r) = &r1 {
         files.extend(write_case1(r, &out.join("case1"))?);
@@ -174,10 +220,14 @@ pub fn run(opts: &Options) -> Result<Report> {
     if let Some(r) = &r2 {
         files.extend(write_case2(r, &out.join("case2"))?);
     }
+    if let Some(r) = &rr {
+        files.extend(write_case1_random(r, &out.join("case1_random"))?);
+    }
     let wall = started.elapsed().as_secs_f64();
     files.extend(summary::write(out, r1.as_ref(), r2.as_ref(), wall)?);
     Ok(Report {
         case1: r1,
+        case1_random: rr,
         case2: r2,
         files,
         wall_seconds: wall,
@@ -220,6 +270,31 @@ fn write_case1(r: &case1::Case1Result, dir: &Path) -> Result<Vec<PathBuf>> {
     let all = dir.join("trajectories_all_groups.png");
     fig6::trajectories_all_groups(r, &all)?;
     files.push(all);
+    Ok(files)
+}
+
+fn write_case1_random(r: &random_run::RandomCase1, dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut files = Vec::new();
+    for (name, text) in [
+        ("maps.csv", random_run::maps_csv(r)),
+        ("summary.md", random_run::markdown(r)),
+        (
+            "claims.json",
+            serde_json::to_string_pretty(&random_run::claims(r))? + "\n",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        files.push(path);
+    }
+    let fail = dir.join("failures.png");
+    if random_plots::failures(r, &fail, 12)? {
+        files.push(fail);
+    }
+    let maps = dir.join("maps.png");
+    random_plots::overview(r, &maps, 6)?;
+    files.push(maps);
     Ok(files)
 }
 

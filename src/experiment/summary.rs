@@ -316,6 +316,9 @@ pub fn console(report: &Report) -> String {
             c.g3_ok, c.g1_ok, c.g2_ok
         ));
     }
+    if let Some(r) = &report.case1_random {
+        s.push_str(&super::random_run::markdown(r));
+    }
     if let Some(r) = &report.case2 {
         let c = case2_claims(r);
         s.push_str(&format!(
