@@ -158,7 +158,10 @@ impl colcos_display::FrameSource for WorldFrames {
             self.world.step();
         }
         self.first = false;
-        if let Some(g) = self.gpu.as_mut() {
+        // Printed obstacles are painted on the CPU: a world with some composes its screen there.
+        if let Some(g) = self.gpu.as_mut()
+            && self.world.obstacles().printed().is_none()
+        {
             match g.render(&self.world, self.size) {
                 Ok(b) => return Some(colcos_display::Frame::Buffer(b)),
                 Err(e) => {
@@ -168,12 +171,11 @@ impl colcos_display::FrameSource for WorldFrames {
             }
         }
         let s = *self.world.screen();
-        Some(colcos_display::Frame::Rgba(rgba(screen::render(
-            self.world.pheromones(),
-            &s,
-            self.size.0,
-            self.size.1,
-        ))))
+        let mut img = screen::render(self.world.pheromones(), &s, self.size.0, self.size.1);
+        if let Some(printed) = self.world.obstacles().printed() {
+            printed.paint(&mut img, &s);
+        }
+        Some(colcos_display::Frame::Rgba(rgba(img)))
     }
     fn device(&self) -> Option<colcos_display::SharedDevice> {
         self.gpu.as_ref().map(|g| colcos_display::SharedDevice {
@@ -230,6 +232,10 @@ pub fn main(args: DisplayArgs) -> Result<()> {
         };
         #[cfg(not(feature = "display"))]
         let img = screen::render(world.pheromones(), world.screen(), size.0, size.1);
+        let mut img = img;
+        if let Some(printed) = world.obstacles().printed() {
+            printed.paint(&mut img, world.screen());
+        }
         #[cfg(feature = "display")]
         let img = {
             let rgba =

@@ -242,12 +242,18 @@ impl Host {
 
     /// The screen image, eq. (1), drawn into `img` at its size (reusing its buffer).
     pub fn render_into(&self, img: &mut RgbImage) {
-        colcos_sim::screen::render_into(self.parts.fields.pheromones(), &self.screen, img)
+        colcos_sim::screen::render_into(self.parts.fields.pheromones(), &self.screen, img);
+        // The LCD draws printed obstacles over the pheromones (physical ones it cannot).
+        if let Some(printed) = self.parts.sensing.obstacles().printed() {
+            printed.paint(img, &self.screen);
+        }
     }
 
     /// The screen image, eq. (1), at `width x height` (the panel's resolution for the LCD).
     pub fn render(&self, width: u32, height: u32) -> RgbImage {
-        colcos_sim::screen::render(self.parts.fields.pheromones(), &self.screen, width, height)
+        let mut img = RgbImage::new(width, height);
+        self.render_into(&mut img);
+        img
     }
 }
 

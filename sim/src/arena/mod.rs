@@ -7,11 +7,13 @@
 //! the robot only, never at all of them.
 mod boundary;
 mod mask;
+mod printed;
 mod shapes;
 mod spec;
 
 pub use boundary::{BOUNDARY, BOUNDARY_THICKNESS, Inside};
 pub use mask::{MaskRect, merge_runs, solid_rects};
+pub use printed::Printed;
 pub use spec::{ArenaShape, ObstacleKind, ObstacleShape, ObstacleSpec};
 
 use crate::error::Result;
@@ -20,6 +22,7 @@ use parry2d::math::Pose;
 use parry2d::query::Ray;
 use parry2d::shape::SharedShape;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Most grid cells per axis: bounds the table for tiny obstacles in a large arena.
 const MAX_CELLS_PER_AXIS: f32 = 256.0;
@@ -53,6 +56,8 @@ pub struct Obstacles {
     items: Vec<u32>,
     /// Where robots may be, for an arena of another shape than its rectangle.
     inside: Option<Inside>,
+    /// The obstacles drawn on the screen (`kind = "printed"`), apart from the physical ones.
+    printed: Option<Arc<Printed>>,
 }
 
 impl Obstacles {
@@ -73,10 +78,20 @@ impl Obstacles {
         if let Some(shape) = shape {
             boundary::add(&mut out, shape, arena)?;
         }
+        let mut printed = Printed::default();
         for (i, spec) in specs.iter().enumerate() {
-            shapes::add(&mut out, i, spec, arena, base_dir)?;
+            if spec.kind == ObstacleKind::Printed {
+                shapes::add(&mut printed.layer, i, spec, arena, base_dir)?;
+            } else {
+                shapes::add(&mut out, i, spec, arena, base_dir)?;
+            }
         }
         out.index(arena);
+        if !printed.layer.parts.is_empty() {
+            printed.layer.index(arena);
+            printed.colours = specs.iter().map(|s| s.colour.unwrap_or([0; 3])).collect();
+            out.printed = Some(Arc::new(printed));
+        }
         Ok(out)
     }
 
@@ -90,9 +105,14 @@ impl Obstacles {
         )
     }
 
-    /// True when there are no obstacles.
+    /// True when there are no physical obstacles (nothing to collide with or see by bumper).
     pub fn is_empty(&self) -> bool {
         self.parts.is_empty()
+    }
+
+    /// The printed obstacles, if any.
+    pub fn printed(&self) -> Option<&Printed> {
+        self.printed.as_deref()
     }
 
     /// Whether a disc of `radius` at `p` lies within the arena's shape (always, for a rectangle).

@@ -2,7 +2,7 @@
 //! the key: missing or stray keys, degenerate shapes, shapes reaching outside the arena.
 use super::Obstacles;
 use super::mask;
-use super::spec::{ObstacleShape, ObstacleSpec};
+use super::spec::{ObstacleKind, ObstacleShape, ObstacleSpec};
 use crate::error::{Result, SimError};
 use glam::Vec2;
 use parry2d::math::Pose;
@@ -75,6 +75,13 @@ pub(super) fn add(
             format!("a {shape_name} obstacle needs it"),
         )
     };
+    if spec.colour.is_some() && spec.kind != ObstacleKind::Printed {
+        return Err(SimError::invalid(
+            key("colour"),
+            "(set)",
+            "only a printed obstacle (kind = \"printed\") is drawn in a colour",
+        ));
+    }
     let first_part = out.parts.len();
     match spec.shape {
         ObstacleShape::Box => {

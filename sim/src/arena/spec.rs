@@ -26,6 +26,9 @@ pub enum ObstacleKind {
     /// LCD does not draw it (it lies under the object); views of the arena draw its outline.
     #[default]
     Physical,
+    /// Drawn on the LCD in `colour` (on top of the pheromones): the robots' colour sensors see it;
+    /// robots drive over it and their bumpers do not.
+    Printed,
 }
 
 /// One `[[obstacles]]` entry. Which keys are needed depends on `shape`; the others must be absent.
@@ -35,6 +38,9 @@ pub struct ObstacleSpec {
     pub shape: ObstacleShape,
     #[serde(default)]
     pub kind: ObstacleKind,
+    /// Screen levels r, g, b (0-255) a printed obstacle is drawn in (default black).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<[u8; 3]>,
     /// Centre, m (`box`, `disc`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub centre: Option<[f32; 2]>,

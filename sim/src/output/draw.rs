@@ -226,9 +226,13 @@ pub fn robots(
 /// Outline colour of physical obstacles: amber, apart from every pheromone and group colour's grey rim.
 pub const OBSTACLE_OUTLINE: Rgb<u8> = Rgb([255, 176, 0]);
 
-/// Every physical obstacle as its outline, as the overhead camera sees an object on the screen (the
-/// LCD under it draws nothing): a closed line two pixels wide.
+/// Every obstacle: a printed one filled in its colour, as the LCD shows it; a physical one as its
+/// outline, as the overhead camera sees an object on the screen (the LCD under it draws nothing): a
+/// closed line two pixels wide.
 pub fn obstacles(img: &mut RgbImage, screen: &ScreenSpec, obstacles: &crate::arena::Obstacles) {
+    if let Some(printed) = obstacles.printed() {
+        printed.paint(img, screen);
+    }
     let (w, h) = (img.width(), img.height());
     for (_, ring) in obstacles.outlines() {
         for k in 0..ring.len() {

@@ -9,6 +9,7 @@
 //! sums to 1.16), well below saturation with room for noise; at 40 ms or more white saturates every
 //! channel (`1500 * 40 * 1.11 > 65,535`), as a real TCS34725 does with too long an integration time.
 use super::pow_unit;
+use crate::arena::Printed;
 use crate::field::{FrozenSources, Pheromone};
 use crate::rng::SimRng;
 use crate::screen::ScreenSpec;
@@ -192,6 +193,19 @@ impl ColourSensor {
         screen: &ScreenSpec,
         sensors: &[Vec2; S],
     ) -> [[u32; 3]; S] {
+        self.footprint_sums_printed(pheromones, frozen, screen, None, sensors)
+    }
+
+    /// [`ColourSensor::footprint_sums`] of a screen that also shows `printed` obstacles (drawn over
+    /// the pheromones).
+    pub fn footprint_sums_printed<const S: usize>(
+        &self,
+        pheromones: &[Pheromone],
+        frozen: &FrozenSources,
+        screen: &ScreenSpec,
+        printed: Option<&Printed>,
+        sensors: &[Vec2; S],
+    ) -> [[u32; 3]; S] {
         // Const-generic array lengths cannot be computed (`S * 9`) on stable Rust: up to four sensors
         // go through one fixed-size batch, more in batches of four.
         const BATCH: usize = 4;
@@ -203,8 +217,17 @@ impl ColourSensor {
             for (k, points) in points.chunks_mut(FOOTPRINT_POINTS).enumerate() {
                 points.copy_from_slice(&self.sample_points(*sensors.get(k).unwrap_or(&sensors[0])));
             }
-            let levels =
+            let mut levels =
                 crate::screen::levels_at(pheromones, frozen, screen, &points, points.len());
+            if let Some(printed) = printed {
+                for (k, p) in points.iter().enumerate() {
+                    if let Some(c) = printed.colour_at(screen, *p) {
+                        for (ch, v) in c.iter().enumerate() {
+                            levels[ch][k] = *v as u32;
+                        }
+                    }
+                }
+            }
             for (c, levels) in levels.iter().enumerate() {
                 for (sum, levels) in sums.iter_mut().zip(levels.chunks(FOOTPRINT_POINTS)) {
                     sum[c] = levels.iter().sum();
@@ -249,7 +272,20 @@ impl ColourSensor {
         sensors: &[Vec2; S],
         rng: &mut SimRng,
     ) -> [[u16; 3]; S] {
-        let sums = self.footprint_sums(pheromones, frozen, screen, sensors);
+        self.read_all_printed(pheromones, frozen, screen, None, sensors, rng)
+    }
+
+    /// [`ColourSensor::read_all`] of a screen that also shows `printed` obstacles.
+    pub fn read_all_printed<const S: usize>(
+        &self,
+        pheromones: &[Pheromone],
+        frozen: &FrozenSources,
+        screen: &ScreenSpec,
+        printed: Option<&Printed>,
+        sensors: &[Vec2; S],
+        rng: &mut SimRng,
+    ) -> [[u16; 3]; S] {
+        let sums = self.footprint_sums_printed(pheromones, frozen, screen, printed, sensors);
         let lut = &self.light_by_sum;
         let light = sums.map(|sum| sum.map(|s| lut[s as usize]));
         self.counts_for_lights(&light, rng)

@@ -127,6 +127,7 @@ pub fn sense(
     let robot_sensors = &sensing.robot_sensors;
     let (radius, arena) = (sensing.radius, sensing.arena);
     let obstacles = &*sensing.obstacles;
+    let printed = obstacles.printed();
     let prefetcher = GridPrefetcher::new(pheromones);
     let sense = |(i, (slot, obs)): (usize, (&mut RobotSlot, &mut Observation))| {
         // The grid cells under the next robot's sensors are scattered over large fields: ask for
@@ -143,14 +144,27 @@ pub fn sense(
             Some(own) => {
                 // One sensor at a time, in order: the same draws as `read_all`'s.
                 for (k, p) in sensor_points[i].iter().enumerate() {
-                    let c = own.truth[k].read(pheromones, frozen, screen, *p, &mut slot.rng);
+                    let c = own.truth[k].read_all_printed(
+                        pheromones,
+                        frozen,
+                        screen,
+                        printed,
+                        &[*p],
+                        &mut slot.rng,
+                    )[0];
                     o.counts[k] = c;
                     o.intensity[k] = own.inverse[k].intensity(c);
                 }
             }
             None => {
-                o.counts =
-                    sensor.read_all(pheromones, frozen, screen, &sensor_points[i], &mut slot.rng);
+                o.counts = sensor.read_all_printed(
+                    pheromones,
+                    frozen,
+                    screen,
+                    printed,
+                    &sensor_points[i],
+                    &mut slot.rng,
+                );
                 o.intensity = sensor.intensities(&o.counts);
             }
         }
