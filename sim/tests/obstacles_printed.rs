@@ -145,3 +145,45 @@ fn a_colour_on_a_physical_obstacle_or_a_bad_one_is_refused() {
     let e = err("shape = \"disc\"\nkind = \"printed\"\ncentre = [5.0, 0.4]\nradius = 0.05");
     assert!(e.contains("obstacles[0].centre"), "{e}");
 }
+
+/// `scenarios/printed_track.toml`: four `follow` robots keep to a blue loop that only the printed
+/// obstacle draws (no pheromone makes it): within 4 cm of its centre line for the whole 30 s.
+#[test]
+fn robots_follow_a_printed_track() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenarios/printed_track.toml"
+    );
+    let sc = Scenario::from_file(path).unwrap();
+    let track: Vec<glam::Vec2> = sc.spec.obstacles[0]
+        .points
+        .as_ref()
+        .unwrap()
+        .iter()
+        .map(|p| glam::Vec2::from(*p))
+        .collect();
+    let off = |p: glam::Vec2| {
+        track
+            .windows(2)
+            .map(|s| {
+                let (a, d) = (s[0], s[1] - s[0]);
+                let t = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+                p.distance(a + t * d)
+            })
+            .fold(f32::INFINITY, f32::min)
+    };
+    let mut w = World::new(&sc).unwrap();
+    let mut worst = 0.0f32;
+    let mut travelled = vec![0.0f32; 4];
+    while !w.is_finished() {
+        let before: Vec<_> = w.poses().iter().map(|p| p.pos).collect();
+        w.step();
+        for (i, p) in w.poses().iter().enumerate() {
+            worst = worst.max(off(p.pos));
+            travelled[i] += p.pos.distance(before[i]);
+        }
+    }
+    assert!(worst < 0.04, "a robot left the track by {worst} m");
+    // At up to 6 cm/s for 30 s each goes most of the way round the 1.6 m loop.
+    assert!(travelled.iter().all(|&d| d > 1.0), "{travelled:?}");
+}
