@@ -178,14 +178,14 @@ const CASE1_G3: &[(&str, u64)] = &[
     ("fields/SRP.npy", 0xc2747a75adaa7feb),
     ("scenario.toml", 0xd468996410fb0dfb),
     ("screen.png", 0x2ee51d14a5cdd68a),
-    ("trajectory.csv", 0x71f3656813402e13),
+    ("trajectory.csv", 0xfe7357d964c72483),
 ];
 const CASE1_B_G2: &[(&str, u64)] = &[
     ("fields/LAP.npy", 0xbe447f50d106e252),
     ("fields/SAP.npy", 0xe8b8112fc4e75cb2),
     ("scenario.toml", 0xbbaf23960a581f0e),
     ("screen.png", 0xb8b059c87c25f51d),
-    ("trajectory.csv", 0x51d4f7dd2f7da5ec),
+    ("trajectory.csv", 0x899008ca3e7852fc),
 ];
 const CASE2: &[(&str, u64)] = &[
     ("fields/AGP.npy", 0x17190009229fb89e),

@@ -299,3 +299,102 @@ fn converges_onto_a_straight_trail() {
     );
     assert!(p.pos.x > 0.4, "it moved along the trail: {p:?}");
 }
+
+#[test]
+fn a_lost_trail_is_searched_for_on_the_side_it_was_last_seen() {
+    let mut f = forager();
+    let mut r = rng::stream(1, 0, 0);
+    let at = |t: f32, o: Observation| Observation { time: t, ..o };
+    // Drifting off to the right: the left sensor saw the trail last.
+    assert_eq!(
+        f.decide(&at(1.0, obs(OFF, BLUE_, BLUE_, OFF)), &mut r),
+        ForagingDecision::FollowLap
+    );
+    let lost = at(1.02, obs(OFF, OFF, OFF, OFF));
+    assert_eq!(
+        f.decide(&lost, &mut r),
+        ForagingDecision::Recover { side: Side::Left }
+    );
+    // A pivot in place toward the left.
+    let c = f.act(&at(1.04, obs(OFF, OFF, OFF, OFF)), &mut r);
+    assert!(
+        c.left < 0.0 && c.right > 0.0 && (c.left + c.right).abs() < 1e-6,
+        "{c:?}"
+    );
+    // 180 degrees at 3 rad/s take 1.05 s; after that it wanders.
+    assert_eq!(
+        f.decide(&at(2.0, obs(OFF, OFF, OFF, OFF)), &mut r),
+        ForagingDecision::Recover { side: Side::Left }
+    );
+    assert_eq!(
+        f.decide(&at(2.1, obs(OFF, OFF, OFF, OFF)), &mut r),
+        ForagingDecision::Wander
+    );
+    assert_eq!(
+        f.decide(&at(2.2, obs(OFF, OFF, OFF, OFF)), &mut r),
+        ForagingDecision::Wander
+    );
+    // Found again: following, and a new loss on the right pivots right.
+    f.decide(&at(3.0, obs(BLUE_, BLUE_, OFF, OFF)), &mut r);
+    assert_eq!(
+        f.decide(&at(3.02, obs(OFF, OFF, OFF, OFF)), &mut r),
+        ForagingDecision::Recover { side: Side::Right }
+    );
+    // recover_turn = 0: Algorithm 1 as printed, it wanders at once.
+    let mut plain = Foraging::new(ForagingParams {
+        recover_turn: 0.0,
+        ..ForagingParams::default()
+    });
+    plain.decide(&at(1.0, obs(OFF, BLUE_, BLUE_, OFF)), &mut r);
+    assert_eq!(plain.decide(&lost, &mut r), ForagingDecision::Wander);
+}
+
+/// How close a robot following a trail with a sharp corner (a polyline turning by 110 degrees) comes
+/// to the trail's end within `seconds`, with `recover_turn`.
+fn around_a_corner(recover_turn: f32, seconds: f32) -> f32 {
+    let end = Vec2::new(0.43, 0.67);
+    let sc = ScenarioBuilder::new()
+        .duration(seconds)
+        .seed(5)
+        .screen([1440, 810], [1.439, 0.809])
+        .cell(0.005)
+        .pheromone(PheromoneSpec {
+            preload: true,
+            ..PheromoneSpec::grid("LAP", [0.0, 0.0, 255.0])
+                .with_evaporation(50.0)
+                .with_map(MapSpec::polyline(
+                    vec![[0.1, 0.2], [0.6, 0.2], [0.43, 0.67]],
+                    0.04,
+                    0.02,
+                ))
+        })
+        .robots(
+            RobotGroupSpec::new(1, "forage")
+                .at_poses(vec![[0.1, 0.2, 0.0]])
+                .with_param("recover_turn", recover_turn as f64),
+        )
+        .build()
+        .unwrap();
+    let mut w = World::new(&sc).unwrap();
+    let mut closest = f32::INFINITY;
+    while !w.is_finished() {
+        w.step();
+        closest = closest.min(w.poses()[0].pos.distance(end));
+    }
+    closest
+}
+
+#[test]
+fn a_sharp_corner_is_followed_after_recovering_the_trail() {
+    let with = around_a_corner(180.0, 14.0);
+    assert!(
+        with < 0.03,
+        "with recovery it came within {with} m of the end"
+    );
+    // Without the recovery the same robot runs off the corner and does not come back.
+    let without = around_a_corner(0.0, 14.0);
+    assert!(
+        without > 0.15,
+        "without recovery it came within {without} m of the end"
+    );
+}

@@ -6,7 +6,9 @@
 //! magenta. The robot:
 //!
 //! 1. avoids (a sharp pivot) on a bumper hit;
-//! 2. wanders (correlated random walk) when no sensor sees the LAP;
+//! 2. when no sensor sees the LAP: right after losing it, pivots toward the side it was last seen on
+//!    (`recover_turn`, [`Recovery`]: a bend sharper than the robot can steer, as drawn trails have, throws
+//!    it off the outer edge); otherwise wanders (correlated random walk);
 //! 3. at a bifurcation, picks a branch (below) and keeps to it for `commit_time` seconds;
 //! 4. otherwise follows the cyan trail (eq. 7 on the green channel) when any sensor sees cyan, else the
 //!    blue trail (eq. 7 on the blue channel), with a damping term (`damping`, see [`ForagingParams`]).
@@ -49,9 +51,11 @@
 //! front sensor does. No new bifurcation is detected while committed.
 mod bifurcation;
 mod params;
+mod recovery;
 
 pub use bifurcation::{BifurcationKind, Side, Trail, TrailClass, detect_bifurcation};
 pub use params::ForagingParams;
+pub use recovery::Recovery;
 
 use super::{BLUE, GREEN, RED, SENSOR_FRONT, SENSOR_LEFT, SENSOR_RIGHT, eq7};
 use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
@@ -79,6 +83,8 @@ pub enum ForagingDecision {
     TurnInto { side: Side, trail: Trail },
     /// Following the branch chosen at a recent bifurcation (no new bifurcation is detected).
     Committed { side: Side, trail: Trail },
+    /// Every sensor has just left the LAP: pivoting toward the side it was last seen on.
+    Recover { side: Side },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,6 +104,7 @@ pub struct Foraging {
     pub wheel_base: f32,
     avoid: Avoid<Wander>,
     commit: Option<Commit>,
+    recovery: Recovery,
     /// (time, e) of the previous trail-following step, for the damping term.
     last_error: Option<(f32, f32)>,
 }
@@ -110,6 +117,7 @@ impl Foraging {
             wheel_base: crate::robot::ColiasParams::default().wheel_base,
             avoid,
             commit: None,
+            recovery: Recovery::default(),
             last_error: None,
         }
     }
@@ -181,13 +189,23 @@ impl Foraging {
     /// bifurcation).
     pub fn decide(&mut self, obs: &Observation, rng: &mut SimRng) -> ForagingDecision {
         if self.avoid.turning(obs.time) || obs.max_bumper() > self.avoid.threshold {
+            self.recovery.forget();
             return ForagingDecision::Avoid;
         }
-        let th = self.params.threshold;
+        let p = &self.params;
+        let th = p.threshold;
         if !obs.intensity.iter().any(|s| s[BLUE] > th) {
             self.commit = None;
-            return ForagingDecision::Wander;
+            // A pivot starts only right after the trail was lost (within a few control steps).
+            return match self
+                .recovery
+                .pivot_side(obs.time, p.recover_turn, p.recover_rate, 0.2)
+            {
+                Some(side) => ForagingDecision::Recover { side },
+                None => ForagingDecision::Wander,
+            };
         }
+        self.recovery.on_trail(obs);
         if let Some(c) = self.commit {
             if obs.time < c.turn_until {
                 return ForagingDecision::TurnInto {
@@ -295,6 +313,9 @@ impl Behaviour for Foraging {
             ForagingDecision::Bifurcation { side, .. }
             | ForagingDecision::TurnInto { side, .. } => self.turn_into(side, self.wheel_base),
             ForagingDecision::Committed { trail, side } => self.steer_committed(obs, trail, side),
+            ForagingDecision::Recover { side } => {
+                Recovery::command(side, self.params.recover_rate, self.wheel_base)
+            }
         }
     }
 }

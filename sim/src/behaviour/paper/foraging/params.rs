@@ -29,6 +29,11 @@ pub struct ForagingParams {
     pub turn_rate: f32,
     /// Forward speed during that turn, as a fraction of `speed`.
     pub commit_speed: f32,
+    /// On losing the trail, pivot toward the side last seen by up to this angle, degrees (0: wander
+    /// at once, as Algorithm 1 as printed).
+    pub recover_turn: f32,
+    /// Yaw rate of that pivot, rad/s.
+    pub recover_rate: f32,
 }
 
 impl Default for ForagingParams {
@@ -43,6 +48,8 @@ impl Default for ForagingParams {
             turn_angle: 35.0,
             turn_rate: 3.0,
             commit_speed: 0.5,
+            recover_turn: 180.0,
+            recover_rate: 3.0,
         }
     }
 }
@@ -104,6 +111,18 @@ impl ForagingParams {
             default: "0.5",
             meaning: "forward speed during that turn, as a fraction of speed",
         },
+        ParamDoc {
+            name: "recover_turn",
+            ty: "float, degrees, >= 0",
+            default: "180.0",
+            meaning: "on losing the trail, pivot toward the side last seen by up to this angle (0: wander at once)",
+        },
+        ParamDoc {
+            name: "recover_rate",
+            ty: "float, rad/s, >= 0.001",
+            default: "3.0",
+            meaning: "yaw rate of that pivot",
+        },
     ];
 
     /// Checks every value; `key` is the scenario key path of the group (for errors).
@@ -116,6 +135,8 @@ impl ForagingParams {
         check(key, "turn_angle", self.turn_angle, 0.0)?;
         check(key, "turn_rate", self.turn_rate, 1e-3)?;
         check(key, "commit_speed", self.commit_speed, 0.0)?;
+        check(key, "recover_turn", self.recover_turn, 0.0)?;
+        check(key, "recover_rate", self.recover_rate, 1e-3)?;
         if !(0.0..=1.0).contains(&self.cyan_probability) {
             return Err(crate::error::SimError::invalid(
                 format!("{key}.params.cyan_probability"),
