@@ -1,102 +1,165 @@
-//! Colour calibration on the twin, whose robots' sensors each have their own crosstalk, gain, dark
-//! counts and transfer curve: ramps shown through the frame stream, raw counts read over the radio
-//! link, each sensor fitted; the fit reproduces counts at colours it never saw, and its inverse
-//! gives the screen levels back.
+//! Colour calibration on the twin, whose robots' sensors come from a colour calibration file
+//! (`[sensor] per_robot = true`, `[rig] colour_calibration`): each of the twin's robots reports its
+//! own sensors' counts in telemetry; `colcos calibrate colour` on that twin (ramps shown through the
+//! frame stream, raw counts read over the radio link) gives the file's models back, reproduces counts
+//! at colours it never saw, and its inverse gives the screen levels back.
 mod calibrate_common;
 
-use calibrate_common::{TwinRun, scenario, start_with};
+use calibrate_common::{TwinRun, scenario};
+use colcos_bridge::calibrate::RigCalibration;
 use colcos_bridge::calibrate::run_colour::{ColourRunOptions, calibrate_colour};
-use colcos_bridge::calibrate::{ColourCalibration, RigCalibration};
+use colcos_bridge::twin::TwinPlant;
 use colcos_sim::rng::{Stream, stream_of};
-use colcos_sim::sensors::{ColourSensor, ColourSensorParams};
+use colcos_sim::scenario::Scenario;
+use colcos_sim::sensors::{ColourCalibration, ColourSensor, RobotColour, SensorFit};
+use image::RgbImage;
 
-fn robot_params() -> Vec<ColourSensorParams> {
-    let base = ColourSensorParams::default();
-    vec![
-        ColourSensorParams {
-            gain: 1300.0,
-            crosstalk: [[1.0, 0.12, 0.02], [0.05, 0.95, 0.14], [0.03, 0.10, 1.08]],
-            dark_counts: 45.0,
-            gamma: 2.35,
-            ..base
-        },
-        ColourSensorParams {
-            gain: 1700.0,
-            crosstalk: [[0.92, 0.05, 0.06], [0.09, 1.05, 0.07], [0.01, 0.16, 0.97]],
-            dark_counts: 20.0,
-            gamma: 2.1,
-            ..base
-        },
-        ColourSensorParams {
-            gain: 1500.0,
-            crosstalk: [[1.1, 0.02, 0.0], [0.02, 1.0, 0.2], [0.05, 0.05, 0.9]],
-            dark_counts: 60.0,
-            gamma: 2.2,
-            ..base
-        },
-    ]
+fn fit(gamma: f64, gain: f64, crosstalk: [[f64; 3]; 3], dark: [f64; 3]) -> SensorFit {
+    SensorFit::from_parts(gamma, gain, crosstalk, dark, 24.0)
+}
+
+/// Three robots: a dim red-leaning one; a bright one with strong green-blue crosstalk whose front
+/// sensor differs from its other three; a third with a high dark level.
+fn file_models() -> ColourCalibration {
+    let a = fit(
+        2.4,
+        900.0,
+        [[1.2, 0.02, 0.0], [0.03, 0.8, 0.05], [0.01, 0.04, 0.7]],
+        [20.0, 35.0, 50.0],
+    );
+    let b = fit(
+        1.9,
+        2100.0,
+        [[0.9, 0.15, 0.05], [0.1, 1.05, 0.3], [0.05, 0.35, 1.1]],
+        [60.0, 10.0, 25.0],
+    );
+    let b_front = fit(
+        2.1,
+        1800.0,
+        [[1.0, 0.05, 0.1], [0.2, 0.9, 0.1], [0.0, 0.1, 1.0]],
+        [40.0, 40.0, 15.0],
+    );
+    let c = fit(
+        2.2,
+        1500.0,
+        [[1.1, 0.02, 0.0], [0.02, 1.0, 0.2], [0.05, 0.05, 0.9]],
+        [60.0, 60.0, 60.0],
+    );
+    let robot = |radio_id, sensors| RobotColour { radio_id, sensors };
+    ColourCalibration::new(
+        "2026-11-24T00:00:00Z".into(),
+        24.0,
+        vec![
+            robot(1, [a; 4]),
+            robot(2, [b, b_front, b, b]),
+            robot(3, [c; 4]),
+        ],
+        6.0,
+    )
+}
+
+/// The twin of three robots reading through `file` (saved in `dir`).
+fn twin_scenario(file: &ColourCalibration, dir: &std::path::Path) -> Scenario {
+    let path = dir.join("colour.json");
+    file.save(&path).unwrap();
+    let rig = format!(
+        "colour_calibration = \"{}\"\n[sensor]\nper_robot = true",
+        path.display()
+    );
+    scenario(&[(0.3, 0.3, 0.0), (0.7, 0.4, 45.0), (1.1, 0.5, 90.0)], &rig)
+}
+
+/// What the twin's robots report for one uniform colour: each sensor's own model, within noise.
+#[test]
+fn the_twins_robots_read_through_their_own_sensors() {
+    let file = file_models();
+    let dir = tempfile::tempdir().unwrap();
+    let mut plant = TwinPlant::new(&twin_scenario(&file, dir.path())).unwrap();
+    let levels = [180.0, 90.0, 40.0];
+    let frame = RgbImage::from_pixel(384, 216, image::Rgb(levels.map(|v| v as u8)));
+    for (r, robot) in file.robots.iter().enumerate() {
+        let mut mean = [[0.0f64; 3]; 4];
+        for _ in 0..16 {
+            let counts = plant.colour_counts(r, Some(&frame));
+            for k in 0..4 {
+                for c in 0..3 {
+                    mean[k][c] += counts[k][c] as f64 / 16.0;
+                }
+            }
+        }
+        for (k, (mean, sensor)) in mean.iter().zip(&robot.sensors).enumerate() {
+            let want = sensor.predict(levels);
+            for c in 0..3 {
+                // Noise of 8 counts over 16 readings: 2 counts; rounding of the model in f32.
+                assert!(
+                    (mean[c] - want[c]).abs() < 8.0 + 0.002 * want[c],
+                    "robot {r} sensor {k}: {mean:?} against the file's {want:?}"
+                );
+            }
+        }
+    }
 }
 
 #[test]
-fn per_robot_sensors_are_fitted_and_reproduce_held_out_counts() {
-    let sc = scenario(&[(0.3, 0.3, 0.0), (0.7, 0.4, 45.0), (1.1, 0.5, 90.0)], "");
-    let truth = robot_params();
-    let t2 = truth.clone();
-    let mut run: TwinRun = start_with(&sc, None, 0.0, 0.0, 40.0, move |twin| {
-        for (i, p) in t2.into_iter().enumerate() {
-            twin.plant_mut().set_sensor(i, p);
-        }
-    });
+fn calibrating_the_twin_gives_the_file_back_and_predicts_unseen_colours() {
+    let file = file_models();
+    let dir = tempfile::tempdir().unwrap();
+    let sc = twin_scenario(&file, dir.path());
+    let mut run = TwinRun::start(&sc, None, 0.0, 0.0, 40.0);
     let started = std::time::Instant::now();
     let cal = calibrate_colour(&mut run.rig, &sc, &ColourRunOptions::default()).unwrap();
     let took = started.elapsed().as_secs_f64();
     drop(run.stop());
     assert_eq!(cal.robots.len(), 3);
 
-    // Fresh counts at colours the fit never saw, from each robot's true sensor (noise included).
+    // The models come back.
+    let (mut worst_gamma, mut worst_matrix, mut worst_dark) = (0.0f64, 0.0f64, 0.0f64);
+    for (want, got) in file.robots.iter().zip(&cal.robots) {
+        assert_eq!(want.radio_id, got.radio_id);
+        for (w, g) in want.sensors.iter().zip(&got.sensors) {
+            worst_gamma = worst_gamma.max((w.gamma - g.gamma).abs());
+            let scale = (0..3).map(|c| w.matrix[c][c]).fold(0.0, f64::max);
+            for c in 0..3 {
+                worst_dark = worst_dark.max((w.dark[c] - g.dark[c]).abs());
+                for k in 0..3 {
+                    worst_matrix =
+                        worst_matrix.max((w.matrix[c][k] - g.matrix[c][k]).abs() / scale);
+                }
+            }
+        }
+    }
+
+    // Fresh counts at colours the fit never saw, from each robot's true front sensor (noise
+    // included), and the levels back through the calibrated inverse and the nominal model.
     let mut rng = stream_of(21, 0, Stream::Telemetry(0));
     let (mut ss, mut n, mut worst) = (0.0, 0usize, 0.0f64);
     let mut worst_level = 0.0f64;
     let nominal = ColourSensor::new(sc.spec.sensor);
-    for (r, params) in truth.iter().enumerate() {
-        let sensor = ColourSensor::new(*params);
-        let fit = &cal.robots[r];
-        assert_eq!(fit.radio_id, r as u8 + 1);
-        for s in &fit.sensors {
-            let want = params.gain * params.integration_ms;
-            let got = s.gain * cal.integration_ms * s.crosstalk[0][0];
-            assert!(
-                ((got - (want * params.crosstalk[0][0]) as f64) / got).abs() < 0.03,
-                "robot {r}: {got} vs {want}"
-            );
-            assert!(
-                (s.gamma - params.gamma as f64).abs() < 0.08,
-                "robot {r}: {s:?}"
-            );
-        }
+    for (r, robot) in file.robots.iter().enumerate() {
+        let truth = robot.sensors[1].sensor(&sc.spec.sensor, 1.0, &[[0.0; 3]; 3]);
+        let fitted = &cal.robots[r].sensors[1];
         for k in 0..40 {
             let levels = [
                 (k * 53 % 256) as f32,
                 (k * 97 % 256) as f32,
                 (k * 31 % 256) as f32,
             ];
-            let counts = sensor.counts(levels, &mut rng);
-            let p = fit.sensors[1].predict(levels.map(|v| v as f64));
+            let counts = truth.counts(levels, &mut rng);
+            let p = fitted.predict(levels.map(|v| v as f64));
             for c in 0..3 {
                 let e = p[c] - counts[c] as f64;
                 ss += e * e;
                 n += 1;
                 worst = worst.max(e.abs());
             }
-            // Through the calibrated inverse and the nominal model: the levels come back.
             let mut robot_counts = [[0u16; 3]; 4];
             robot_counts[1] = counts;
             let as_nominal = cal.to_nominal(r as u8 + 1, robot_counts, &nominal);
             let back = nominal.intensity(as_nominal[1]);
             for c in 0..3 {
                 // Near black the transfer curve magnifies the sensor's own noise (8 counts are
-                // ~6 levels at level 10): that is noise, not calibration.
-                if levels[c] >= 40.0 {
+                // ~6 levels at level 10), and a saturated channel says nothing: not calibration.
+                if levels[c] >= 40.0 && counts[c] < 65_535 {
                     worst_level = worst_level.max((back[c] * 255.0 - levels[c]).abs() as f64);
                 }
             }
@@ -104,24 +167,31 @@ fn per_robot_sensors_are_fitted_and_reproduce_held_out_counts() {
     }
     let rms = (ss / n as f64).sqrt();
     eprintln!(
-        "colour calibration on the twin (3 robots, sensor noise 8 counts): held-out counts {rms:.1} counts RMS (worst {worst:.0}; full scale ~42,000), in the run {:.1} counts RMS; fitted samples {:.1} counts RMS; levels of 40 and up back through the calibrated inverse within {worst_level:.1} of 255; took {took:.1} s",
-        cal.held_out_rms_counts, cal.rms_counts
+        "colour file -> twin -> calibrate colour (3 robots, sensor noise 8 counts): gamma within {worst_gamma:.3}, matrix within {:.2} % of the sensor's largest entry, dark within {worst_dark:.1} counts; held-out counts {rms:.1} counts RMS (worst {worst:.0}), in the run {:.1}; fitted samples {:.1} counts RMS; levels of 40 and up back through the calibrated inverse within {worst_level:.1} of 255; took {took:.1} s",
+        100.0 * worst_matrix,
+        cal.held_out_rms_counts,
+        cal.rms_counts
     );
+    assert!(worst_gamma < 0.08, "{cal:?}");
+    assert!(worst_matrix < 0.03, "{cal:?}");
+    assert!(worst_dark < 15.0, "{cal:?}");
     assert!(rms < 20.0, "{rms}");
     assert!(cal.held_out_rms_counts < 20.0, "{cal:?}");
     assert!(worst_level < 3.0, "{worst_level}");
+}
 
-    // The file round-trips and the scenario's [rig] key loads it.
+/// The file round-trips, the scenario's `[rig]` key loads it, and a singular matrix is refused
+/// naming the sensor.
+#[test]
+fn calibration_files_load_and_bad_ones_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("colour.json");
-    cal.save(&path).unwrap();
+    file_models().save(&path).unwrap();
     let back = ColourCalibration::load(&path).unwrap();
     assert_eq!(back.robots.len(), 3);
     let rig_text = format!("colour_calibration = \"{}\"", path.display());
     let loaded = RigCalibration::load(&scenario(&[(0.3, 0.3, 0.0)], &rig_text)).unwrap();
     assert!(loaded.colour.is_some() && loaded.screen.is_none());
-
-    // A file with a singular matrix is refused, naming the sensor.
     let text = std::fs::read_to_string(&path).unwrap();
     let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
     json["robots"][1]["sensors"][2]["matrix"] =

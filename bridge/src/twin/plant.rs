@@ -7,7 +7,7 @@ use colcos_sim::error::Result;
 use colcos_sim::rng::{self, SimRng, Stream};
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::Scenario;
-use colcos_sim::sensors::{ColourSensor, ColourSensorParams, SENSOR_RADIUS, sensor_positions};
+use colcos_sim::sensors::{SENSOR_RADIUS, sensor_positions};
 use colcos_sim::tracker::TrackedPose;
 use colcos_sim::world::World;
 use glam::Vec2;
@@ -23,8 +23,6 @@ pub struct TwinPlant {
     heard: Vec<f64>,
     /// Per robot: a stream for the noise of its telemetry readings.
     telemetry_rng: Vec<SimRng>,
-    /// Per robot: its own colour sensor model where it differs from the scenario's (calibration).
-    sensors: Vec<Option<ColourSensor>>,
 }
 
 impl TwinPlant {
@@ -39,7 +37,6 @@ impl TwinPlant {
             telemetry_rng: (0..n)
                 .map(|i| rng::stream_of(seed, 0, Stream::Telemetry(i)))
                 .collect(),
-            sensors: vec![None; n],
         })
     }
 
@@ -112,13 +109,6 @@ impl TwinPlant {
         self.world.step_with_commands(&self.commands);
     }
 
-    /// Robot `i`'s colour sensors read frames with `params` instead of the scenario's sensor model.
-    pub fn set_sensor(&mut self, i: usize, params: ColourSensorParams) {
-        if let Some(s) = self.sensors.get_mut(i) {
-            *s = Some(ColourSensor::new(params));
-        }
-    }
-
     /// True poses.
     pub fn poses(&self) -> &[Pose] {
         self.world.poses()
@@ -140,14 +130,13 @@ impl TwinPlant {
                 let size = Vec2::from(self.world.screen().size);
                 let points = sensor_positions(&pose, SENSOR_RADIUS);
                 let rng = &mut self.telemetry_rng[i];
-                match (self.sensors.get(i), self.world.robot_sensors(i)) {
-                    (Some(Some(own)), _) => own.read_frame(frame, size, &points, rng),
+                match self.world.robot_sensors(i) {
                     // The scenario's per-robot sensors (`[sensor] per_robot`): each of the four
                     // its own model, read in order.
-                    (_, Some(own)) => std::array::from_fn(|k| {
+                    Some(own) => std::array::from_fn(|k| {
                         own.truth[k].read_frame(frame, size, &[points[k]], rng)[0]
                     }),
-                    _ => self.world.sensor().read_frame(frame, size, &points, rng),
+                    None => self.world.sensor().read_frame(frame, size, &points, rng),
                 }
             }
             None => self.world.observations()[i].counts,

@@ -76,47 +76,35 @@ impl TwinRun {
         jitter: f64,
         seconds: f64,
     ) -> TwinRun {
-        start_with(sc, camera, latency, jitter, seconds, |_| {})
+        let mut tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
+        tracker.set_delay(latency, jitter, 11);
+        let tracker_addr = tracker.local_addr();
+        let frames = FrameServer::bind("127.0.0.1:0").unwrap();
+        let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+        let link_url = format!("udp://{}", channel.local_addr().unwrap());
+        let mut twin =
+            Twin::new(sc, tracker, Box::new(channel), Some(frames.local_addr())).unwrap();
+        twin.set_camera(camera, 3);
+        let stop = Arc::new(AtomicBool::new(false));
+        let s = stop.clone();
+        let handle = std::thread::spawn(move || {
+            twin.run(Some(seconds), &s);
+            twin
+        });
+        let tracker = RawTracker::connect(&tracker_addr.to_string()).unwrap();
+        let link = open_robot_link(&link_url).unwrap();
+        TwinRun {
+            rig: Rig::new(tracker, frames, Some(link)),
+            tracker_addr,
+            twin: Some(handle),
+            stop,
+        }
     }
 
     /// Stops the twin and hands it back.
     pub fn stop(mut self) -> Twin {
         self.stop.store(true, Ordering::Relaxed);
         self.twin.take().unwrap().join().unwrap()
-    }
-}
-
-/// [`TwinRun::start`] with `setup` run on the twin before it starts.
-pub fn start_with(
-    sc: &Scenario,
-    camera: Option<CameraModel>,
-    latency: f64,
-    jitter: f64,
-    seconds: f64,
-    setup: impl FnOnce(&mut Twin),
-) -> TwinRun {
-    let mut tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
-    tracker.set_delay(latency, jitter, 11);
-    let tracker_addr = tracker.local_addr();
-    let frames = FrameServer::bind("127.0.0.1:0").unwrap();
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let link_url = format!("udp://{}", channel.local_addr().unwrap());
-    let mut twin = Twin::new(sc, tracker, Box::new(channel), Some(frames.local_addr())).unwrap();
-    twin.set_camera(camera, 3);
-    setup(&mut twin);
-    let stop = Arc::new(AtomicBool::new(false));
-    let s = stop.clone();
-    let handle = std::thread::spawn(move || {
-        twin.run(Some(seconds), &s);
-        twin
-    });
-    let tracker = RawTracker::connect(&tracker_addr.to_string()).unwrap();
-    let link = open_robot_link(&link_url).unwrap();
-    TwinRun {
-        rig: Rig::new(tracker, frames, Some(link)),
-        tracker_addr,
-        twin: Some(handle),
-        stop,
     }
 }
 
