@@ -28,6 +28,58 @@ fn bumpers(obs: &Obstacles, pose: Pose) -> [f32; 3] {
     index.bumpers_with(0, &[pose], R, ARENA, &BumperRays::new(&params), obs)
 }
 
+/// One obstacle of every shape: a rotated box, a disc, a concave polygon and a bent wall.
+const EVERY_SHAPE: &str = r#"
+[[obstacles]]
+shape = "box"
+centre = [0.3, 0.3]
+size = [0.15, 0.1]
+angle = 30
+[[obstacles]]
+shape = "disc"
+centre = [0.7, 0.3]
+radius = 0.08
+[[obstacles]]
+shape = "polygon"
+points = [[0.2, 0.6], [0.45, 0.6], [0.45, 0.85], [0.35, 0.85], [0.35, 0.7], [0.2, 0.7]]
+[[obstacles]]
+shape = "wall"
+points = [[0.6, 0.55], [0.8, 0.75], [0.9, 0.6]]
+thickness = 0.01
+"#;
+
+/// `poses` in the physics of `backend` among `obs`.
+fn physics_among(obs: &Arc<Obstacles>, poses: &[Pose], backend: PhysicsBackend) -> ArenaPhysics {
+    let mut phys = ArenaPhysics::with_backend(ARENA, &ColiasParams::default(), poses, backend);
+    phys.set_obstacles(obs.clone());
+    phys
+}
+
+/// Drives every robot of `phys` for `steps` steps of 20 ms, each with a new random (forward m/s,
+/// turn rad/s) from `forward` and `turn` every 25 steps; `check(step, poses)` after every step.
+fn drive_randomly(
+    phys: &mut ArenaPhysics,
+    seed: u64,
+    steps: usize,
+    (forward, turn): (std::ops::Range<f32>, std::ops::Range<f32>),
+    mut check: impl FnMut(usize, &[Pose]),
+) {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let mut v = vec![(0.0, 0.0); phys.poses().len()];
+    for step in 0..steps {
+        if step % 25 == 0 {
+            for x in v.iter_mut() {
+                *x = (
+                    rng.random_range(forward.clone()),
+                    rng.random_range(turn.clone()),
+                );
+            }
+        }
+        phys.step(&v, 0.02);
+        check(step, phys.poses());
+    }
+}
+
 fn close(a: f32, b: f32, tol: f32) -> bool {
     (a - b).abs() <= tol
 }
@@ -79,9 +131,7 @@ fn a_robot_driven_into_a_box_stops_at_its_face() {
         "[[obstacles]]\nshape = \"box\"\ncentre = [0.6, 0.5]\nsize = [0.2, 0.3]\n",
     ));
     for backend in BACKENDS {
-        let p = ColiasParams::default();
-        let mut phys = ArenaPhysics::with_backend(ARENA, &p, &[Pose::new(0.3, 0.5, 0.0)], backend);
-        phys.set_obstacles(obs.clone());
+        let mut phys = physics_among(&obs, &[Pose::new(0.3, 0.5, 0.0)], backend);
         for _ in 0..250 {
             phys.step(&[(0.1, 0.0)], 0.02);
         }
@@ -107,29 +157,8 @@ fn worst_overlap(obs: &Obstacles, poses: &[Pose]) -> f32 {
 
 #[test]
 fn robots_never_end_inside_obstacles_after_10000_random_steps() {
-    let obs = Arc::new(obstacles(
-        r#"
-[[obstacles]]
-shape = "box"
-centre = [0.3, 0.3]
-size = [0.15, 0.1]
-angle = 30
-[[obstacles]]
-shape = "disc"
-centre = [0.7, 0.3]
-radius = 0.08
-[[obstacles]]
-shape = "polygon"
-points = [[0.2, 0.6], [0.45, 0.6], [0.45, 0.85], [0.35, 0.85], [0.35, 0.7], [0.2, 0.7]]
-[[obstacles]]
-shape = "wall"
-points = [[0.6, 0.55], [0.8, 0.75], [0.9, 0.6]]
-thickness = 0.01
-"#,
-    ));
+    let obs = Arc::new(obstacles(EVERY_SHAPE));
     for backend in BACKENDS {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
-        let p = ColiasParams::default();
         // Robots on a grid, off the obstacles.
         let mut poses = Vec::new();
         for k in 0..100 {
@@ -138,25 +167,23 @@ thickness = 0.01
                 poses.push(Pose::new(q.x, q.y, k as f32));
             }
         }
-        let mut phys = ArenaPhysics::with_backend(ARENA, &p, &poses, backend);
-        phys.set_obstacles(obs.clone());
-        let mut v = vec![(0.0, 0.0); poses.len()];
-        for step in 0..10_000 {
-            if step % 25 == 0 {
-                for x in v.iter_mut() {
-                    *x = (rng.random_range(-0.1..0.35), rng.random_range(-4.0..4.0));
-                }
-            }
-            phys.step(&v, 0.02);
-            let w = worst_overlap(&obs, phys.poses());
-            // rapier's contacts are springs: a robot pushed by others may press a little in.
-            let tol = if backend == PhysicsBackend::Rapier {
-                0.002
-            } else {
-                0.0005
-            };
-            assert!(w <= tol, "{backend:?} step {step}: overlap {w} m");
-        }
+        // rapier's contacts are springs: a robot pushed by others may press a little in.
+        let tol = if backend == PhysicsBackend::Rapier {
+            0.002
+        } else {
+            0.0005
+        };
+        let mut phys = physics_among(&obs, &poses, backend);
+        drive_randomly(
+            &mut phys,
+            7,
+            10_000,
+            (-0.1..0.35, -4.0..4.0),
+            |step, poses| {
+                let w = worst_overlap(&obs, poses);
+                assert!(w <= tol, "{backend:?} step {step}: overlap {w} m");
+            },
+        );
     }
 }
 
@@ -379,18 +406,9 @@ fn a_disc_arena_holds_its_robots() {
         for p in &poses {
             assert!(obs.holds(p.pos, R), "{backend:?}: placed at {:?}", p.pos);
         }
-        let mut phys = ArenaPhysics::with_backend(ARENA, &ColiasParams::default(), &poses, backend);
-        phys.set_obstacles(obs.clone());
-        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
-        let mut v = vec![(0.0, 0.0); poses.len()];
-        for step in 0..3000 {
-            if step % 25 == 0 {
-                for x in v.iter_mut() {
-                    *x = (rng.random_range(0.0..0.35), rng.random_range(-3.0..3.0));
-                }
-            }
-            phys.step(&v, 0.02);
-            for p in phys.poses() {
+        let mut phys = physics_among(&obs, &poses, backend);
+        drive_randomly(&mut phys, 5, 3000, (0.0..0.35, -3.0..3.0), |step, poses| {
+            for p in poses {
                 // Within the disc, up to 2 mm into its wall.
                 assert!(
                     p.pos.distance(Vec2::splat(0.5)) <= 0.45 - R + 0.002,
@@ -398,7 +416,7 @@ fn a_disc_arena_holds_its_robots() {
                     p.pos
                 );
             }
-        }
+        });
     }
 }
 
@@ -434,28 +452,11 @@ fn arena_shapes_are_checked() {
 #[test]
 fn the_same_seed_gives_the_same_run_whatever_the_thread_count() {
     // 100 robots (the sense stage runs in parallel from 64) among obstacles of every shape.
-    let obstacles = r#"
-[[obstacles]]
-shape = "box"
-centre = [0.3, 0.3]
-size = [0.15, 0.1]
-angle = 30
-[[obstacles]]
-shape = "disc"
-centre = [0.7, 0.3]
-radius = 0.08
-[[obstacles]]
-shape = "polygon"
-points = [[0.2, 0.6], [0.45, 0.6], [0.45, 0.85], [0.35, 0.85], [0.35, 0.7], [0.2, 0.7]]
-[[obstacles]]
-shape = "wall"
-points = [[0.6, 0.55], [0.8, 0.75], [0.9, 0.6]]
-thickness = 0.01
-"#;
     for physics in ["rapier", "discs"] {
         let text = format!(
-            "physics = \"{physics}\"\n{}{obstacles}",
-            BASE.replace("count = 20", "count = 100")
+            "physics = \"{physics}\"\n{}{}",
+            BASE.replace("count = 20", "count = 100"),
+            EVERY_SHAPE
         );
         let sc = Scenario::from_toml_str(&text, ".").unwrap();
         let run = |threads: usize| {
