@@ -291,6 +291,14 @@ impl ColourSensor {
         self.counts_for_lights(&light, rng)
     }
 
+    /// Counts of one sensor whose footprint level sum is `sum` (one of
+    /// [`ColourSensor::footprint_sums_printed`]'s), drawing what `read_all_printed` of that sensor
+    /// draws: sensors with models of their own share one batched footprint pass.
+    pub fn counts_of_sum(&self, sum: [u32; 3], rng: &mut SimRng) -> [u16; 3] {
+        let lut = &self.light_by_sum;
+        self.counts_for_lights(&[sum.map(|s| lut[s as usize])], rng)[0]
+    }
+
     /// Light emitted per primary, in [0, 1], for 8-bit levels.
     pub fn light(&self, levels: [f32; 3]) -> [f32; 3] {
         levels.map(|l| light_of_level(l, self.params.gamma))

@@ -142,16 +142,17 @@ pub fn sense(
         };
         match robot_sensors.get(i) {
             Some(own) => {
-                // One sensor at a time, in order: the same draws as `read_all`'s.
-                for (k, p) in sensor_points[i].iter().enumerate() {
-                    let c = own.truth[k].read_all_printed(
-                        pheromones,
-                        frozen,
-                        screen,
-                        printed,
-                        &[*p],
-                        &mut slot.rng,
-                    )[0];
+                // The four footprints in one batched pass (they are all the drawn `[sensor]`
+                // section's), then each sensor's own model in order: the same draws as `read_all`'s.
+                let sums = own.truth[0].footprint_sums_printed(
+                    pheromones,
+                    frozen,
+                    screen,
+                    printed,
+                    &sensor_points[i],
+                );
+                for (k, sum) in sums.into_iter().enumerate() {
+                    let c = own.truth[k].counts_of_sum(sum, &mut slot.rng);
                     o.counts[k] = c;
                     o.intensity[k] = own.inverse[k].intensity(c);
                 }
