@@ -107,6 +107,21 @@ fn detects_bifurcations() {
     );
     assert_eq!(detect_bifurcation(&obs(OFF, BLUE_, BLUE_, BLUE_), th), None);
     assert_eq!(detect_bifurcation(&obs(OFF, OFF, BLUE_, BLUE_), th), None);
+    // Magenta seen by the front sensor first (the SRP piece starts a few cm into the blue branch).
+    assert_eq!(
+        detect_bifurcation(&obs(CYAN, MAGENTA, BLUE_, CYAN), th),
+        Some(BifurcationKind::Magenta)
+    );
+    // Blue beside magenta with the front on the trail: entering an SRP piece at an angle, one trail.
+    assert_eq!(
+        detect_bifurcation(&obs(MAGENTA, BLUE_, BLUE_, BLUE_), th),
+        None
+    );
+    // ...but the same sides with the front off is the wedge of a fork.
+    assert_eq!(
+        detect_bifurcation(&obs(MAGENTA, OFF, BLUE_, BLUE_), th),
+        Some(BifurcationKind::Magenta)
+    );
 }
 
 fn choices(o: &Observation, n: usize) -> (usize, Vec<ForagingDecision>) {

@@ -25,6 +25,7 @@ pub use aggregation::{
     AggregationDecision, AggregationParams, Follower, FollowerParams, Leader, LeaderParams,
 };
 pub use foraging::{
+    Recovery,
     BifurcationKind, Foraging, ForagingDecision, ForagingParams, Side, Trail, TrailClass,
     detect_bifurcation,
 };

@@ -79,20 +79,32 @@ pub enum BifurcationKind {
     Plain,
 }
 
+/// The front sensor is in the wedge between two branches below this fraction of the threshold: at the
+/// outer edge of a sharp bend it only grazes the trail, reading a little above that.
+const WEDGE_FRONT: f32 = 0.5;
+
 /// The bifurcation seen by the sensors, if any (see the module documentation).
 pub fn detect_bifurcation(obs: &Observation, threshold: f32) -> Option<BifurcationKind> {
+    use TrailClass::*;
     let class = |n: usize| TrailClass::of(obs.intensity[n], threshold);
     let (l, r, f) = (class(SENSOR_LEFT), class(SENSOR_RIGHT), class(SENSOR_FRONT));
-    if l == TrailClass::Off || r == TrailClass::Off {
+    if l == Off || r == Off {
         return None;
     }
-    if f != TrailClass::Off && l == r {
+    // The wedge between two branches, or cyan on one side only. Blue on one side and magenta on the
+    // other with the front on the trail is the start of an SRP piece seen at an angle, one trail.
+    let wedge = obs.intensity[SENSOR_FRONT][BLUE] < WEDGE_FRONT * threshold;
+    let cyan_split = (l == Cyan) != (r == Cyan);
+    if !wedge && !cyan_split {
         return None;
     }
-    use TrailClass::*;
-    Some(match (l, r) {
-        (Magenta, _) | (_, Magenta) => BifurcationKind::Magenta,
-        (Cyan, Blue) | (Blue, Cyan) => BifurcationKind::CyanBlue,
-        _ => BifurcationKind::Plain,
+    // The SRP piece begins a few centimetres into its branch, where the front sensor may see it
+    // before the side sensor over that branch does.
+    Some(if l == Magenta || r == Magenta || f == Magenta {
+        BifurcationKind::Magenta
+    } else if cyan_split {
+        BifurcationKind::CyanBlue
+    } else {
+        BifurcationKind::Plain
     })
 }

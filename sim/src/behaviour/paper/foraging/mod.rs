@@ -25,12 +25,14 @@
 //! * the front sensor (`n = 1`) is off the LAP: the robot straddles the wedge between two branches that
 //!   leave the fork at a clear angle (the trail maps use symmetric forks of +-35 degrees, so for a robot
 //!   within about a centimetre of the trail's centre line this pattern lasts 2-3 cm of travel), or
-//! * the left and right sensors see different classes (cyan on one side and blue or magenta on the
-//!   other), which happens a little earlier on the maps with SAP or SRP.
+//! * one of the left and right sensors sees cyan and the other does not (blue or magenta), which
+//!   happens a little earlier on the maps with SAP or SRP. (Blue on one side and magenta on the other
+//!   with the front on the trail is a robot entering an SRP piece at an angle, not a fork.)
 //!
 //! Its kind ([`BifurcationKind`]) and the branch taken ([`Side`]):
 //!
-//! * `Magenta`: a side sees magenta. Take the side whose sensor reads more `green - red` (the cyan
+//! * `Magenta`: a side or the front sees magenta (the SRP piece starts 3 cm into its branch, where the
+//!   front sensor may reach it before the side sensor over that branch does). Take the side whose sensor reads more `green - red` (the cyan
 //!   branch; a coin decides a tie). Algorithm 1: "follow the cyan trail" at an LAP/SRP bifurcation.
 //! * `CyanBlue`: one side cyan, the other blue. Take the cyan side with probability
 //!   `cyan_probability` (0.7), the blue one otherwise (Algorithm 1).
@@ -62,6 +64,10 @@ use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
 use crate::rng::SimRng;
 use rand::RngExt;
 
+/// A pivot to recover a lost trail starts only this soon after it was last seen (a few control
+/// steps), s.
+const RECOVER_GRACE: f32 = 0.2;
+
 /// The branch of Algorithm 1 taken in one control step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ForagingDecision {
@@ -83,7 +89,8 @@ pub enum ForagingDecision {
     TurnInto { side: Side, trail: Trail },
     /// Following the branch chosen at a recent bifurcation (no new bifurcation is detected).
     Committed { side: Side, trail: Trail },
-    /// Every sensor has just left the LAP: pivoting toward the side it was last seen on.
+    /// Every sensor has just left the LAP, or the cyan trail it was following: pivoting toward the side
+    /// it was last seen on.
     Recover { side: Side },
 }
 
@@ -197,15 +204,24 @@ impl Foraging {
         if !obs.intensity.iter().any(|s| s[BLUE] > th) {
             self.commit = None;
             // A pivot starts only right after the trail was lost (within a few control steps).
-            return match self
-                .recovery
-                .pivot_side(obs.time, p.recover_turn, p.recover_rate, 0.2)
-            {
+            return match self.recovery.lap.pivot_side(
+                obs.time,
+                p.recover_turn,
+                p.recover_rate,
+                RECOVER_GRACE,
+            ) {
                 Some(side) => ForagingDecision::Recover { side },
                 None => ForagingDecision::Wander,
             };
         }
         self.recovery.on_trail(obs);
+        let sees_cyan = obs
+            .intensity
+            .iter()
+            .any(|&s| TrailClass::of(s, th) == TrailClass::Cyan);
+        if sees_cyan && self.commit.is_none_or(|c| c.trail == Trail::Cyan) {
+            self.recovery.on_cyan(obs);
+        }
         if let Some(c) = self.commit {
             if obs.time < c.turn_until {
                 return ForagingDecision::TurnInto {
@@ -221,6 +237,16 @@ impl Foraging {
             }
             self.commit = None;
         }
+        if !sees_cyan
+            && let Some(side) = self.recovery.cyan.pivot_side(
+                obs.time,
+                p.recover_turn,
+                p.recover_rate,
+                RECOVER_GRACE,
+            )
+        {
+            return ForagingDecision::Recover { side };
+        }
         if let Some(kind) = detect_bifurcation(obs, th) {
             let (side, trail) = self.choose(kind, obs, rng);
             // Staying on the cyan trail needs no turn: following the green channel already keeps the
@@ -231,6 +257,10 @@ impl Foraging {
             } else {
                 self.params.turn_angle.to_radians() / self.params.turn_rate
             };
+            if trail != Trail::Cyan {
+                // Leaving the cyan trail on purpose: it is not lost.
+                self.recovery.cyan.forget();
+            }
             self.commit = Some(Commit {
                 turn_until: obs.time + turn,
                 until: obs.time + turn.max(self.params.commit_time),
@@ -239,11 +269,7 @@ impl Foraging {
             });
             return ForagingDecision::Bifurcation { kind, side, trail };
         }
-        if obs
-            .intensity
-            .iter()
-            .any(|&s| TrailClass::of(s, th) == TrailClass::Cyan)
-        {
+        if sees_cyan {
             ForagingDecision::FollowCyan
         } else {
             ForagingDecision::FollowLap
