@@ -104,3 +104,87 @@ fn maps_that_break_a_rule_are_refused() {
     let err = random_map(2, 0, &strict).unwrap_err().to_string();
     assert!(err.contains("20 draws"), "{err}");
 }
+
+#[test]
+fn g3_reaches_the_food_on_random_maps_and_g1_less_often() {
+    use colcos::experiment::random_run::{Tally, claims, run};
+    let r = run(3, 5, 5, &toml::Table::new(), &|| {}).unwrap();
+    assert_eq!(r.maps.len(), 5);
+    for m in &r.maps {
+        let t = Tally::of(m);
+        assert!(
+            t.at_food[2] >= 4,
+            "{}: G3 at food {}/5",
+            m.map.layout.name,
+            t.at_food[2]
+        );
+    }
+    let c = claims(&r);
+    assert!(
+        c.pooled.at_food[2] >= 24,
+        "G3 pooled {:?}",
+        c.pooled.at_food
+    );
+    assert!(
+        c.pooled.at_food[0] < c.pooled.at_food[2],
+        "{:?}",
+        c.pooled.at_food
+    );
+    // The same seed gives the same trials.
+    let again = run(3, 5, 5, &toml::Table::new(), &|| {}).unwrap();
+    assert_eq!(claims(&again).pooled.at_food, c.pooled.at_food);
+}
+
+#[test]
+fn the_command_line_runs_random_maps_and_refuses_bad_options() {
+    let colcos = env!("CARGO_BIN_EXE_colcos");
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(colcos)
+        .args([
+            "experiment",
+            "case1",
+            "--maps",
+            "random",
+            "--count",
+            "2",
+            "--trials",
+            "2",
+        ])
+        .args(["--seed", "4", "--quiet", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("Case I on 2 random trail maps"), "{stdout}");
+    for f in ["maps.csv", "summary.md", "claims.json", "maps.png"] {
+        assert!(dir.path().join("case1_random").join(f).is_file(), "{f}");
+    }
+    let csv = std::fs::read_to_string(dir.path().join("case1_random/maps.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    for (args, want) in [
+        (vec!["--count", "0"], "--count must be at least 1"),
+        (vec!["--foods", "1"], "--foods applies to layouts A and B"),
+    ] {
+        let out = std::process::Command::new(colcos)
+            .args([
+                "experiment",
+                "case1",
+                "--maps",
+                "random",
+                "--quiet",
+                "--out",
+            ])
+            .arg(dir.path())
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(want), "{args:?}: {err}");
+    }
+}
