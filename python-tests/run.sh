@@ -65,7 +65,7 @@ if [ "${COLCOS_PY_PEERS:-1}" = 0 ]; then
     "$work/venv-core/bin/python" -m pytest -q -p no:cacheprovider \
         test_pettingzoo.py test_errors.py test_misuse.py test_misuse_adapters.py test_hypothesis.py \
         test_vector.py test_determinism.py test_backend.py test_render_human.py test_behaviours.py \
-        test_sweep.py test_plants.py test_preflight.py test_tutorial.py test_obstacles.py "$@" || status=1
+        test_sweep.py test_plants.py test_preflight.py test_tutorial.py test_obstacles.py test_physics.py "$@" || status=1
     lap "core suites"
     echo "== python part done in $(($(stamp) - t0)) s (status $status)"
     exit $status

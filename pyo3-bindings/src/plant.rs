@@ -78,7 +78,7 @@ impl PyPlant {
     /// of key paths and values over the host's scenario): what a twin started here plays instead.
     /// The other arguments are `VecEnv`'s (one world).
     #[new]
-    #[pyo3(signature = (plant, task, tracker=None, robots=None, log=None, goto=None, goto_timeout=None, twin_scenario=None, twin_scenario_text=None, twin_overrides_json=None, seed=None, scenario=None, scenario_text=None, max_cycles=None, action=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None))]
+    #[pyo3(signature = (plant, task, tracker=None, robots=None, log=None, goto=None, goto_timeout=None, twin_scenario=None, twin_scenario_text=None, twin_overrides_json=None, seed=None, scenario=None, scenario_text=None, max_cycles=None, action=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None, physics=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -102,6 +102,7 @@ impl PyPlant {
         patch_side: Option<&Bound<'_, PyAny>>,
         params_json: Option<&Bound<'_, PyAny>>,
         backend: Option<&Bound<'_, PyAny>>,
+        physics: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         guard(|| {
             let kind: PlantKind = args::text(plant, "plant")?.parse().map_err(plant_err)?;
@@ -151,6 +152,7 @@ impl PyPlant {
                 patch_side,
                 params_json,
                 backend,
+                physics,
             )?;
             let env = py.detach(|| LiveEnv::new(&cfg, &opts)).map_err(plant_err)?;
             let s = env.spec();

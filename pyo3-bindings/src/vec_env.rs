@@ -81,6 +81,7 @@ pub(crate) fn config(
     patch_side: Option<&Bound<'_, PyAny>>,
     params_json: Option<&Bound<'_, PyAny>>,
     backend: Option<&Bound<'_, PyAny>>,
+    physics: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<EnvConfig> {
     fn some<'a, 'py>(v: Option<&'a Bound<'py, PyAny>>) -> Option<&'a Bound<'py, PyAny>> {
         v.filter(|v| !v.is_none())
@@ -149,13 +150,23 @@ pub(crate) fn config(
         .map(|b| b.parse::<colcos_sim::field::BackendChoice>())
         .transpose()
         .map_err(|e| Kind::Task.err(format!("backend: {e}")))?;
+    cfg.physics = match args::opt_text(physics, "physics")?.as_deref() {
+        None => None,
+        Some("rapier") => Some(colcos_sim::robot::PhysicsBackend::Rapier),
+        Some("discs") => Some(colcos_sim::robot::PhysicsBackend::Discs),
+        Some(other) => {
+            return Err(Kind::Task.err(format!(
+                "physics = {other:?}: \"rapier\" or \"discs\" (or None: the scenario's)"
+            )));
+        }
+    };
     Ok(cfg)
 }
 
 #[pymethods]
 impl PyVecEnv {
     #[new]
-    #[pyo3(signature = (task, num_envs=None, seed=None, num_threads=None, scenario=None, scenario_text=None, max_cycles=None, action=None, autoreset_mode=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None))]
+    #[pyo3(signature = (task, num_envs=None, seed=None, num_threads=None, scenario=None, scenario_text=None, max_cycles=None, action=None, autoreset_mode=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None, physics=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -173,6 +184,7 @@ impl PyVecEnv {
         patch_side: Option<&Bound<'_, PyAny>>,
         params_json: Option<&Bound<'_, PyAny>>,
         backend: Option<&Bound<'_, PyAny>>,
+        physics: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         guard(|| {
             let cfg = config(
@@ -190,6 +202,7 @@ impl PyVecEnv {
                 patch_side,
                 params_json,
                 backend,
+                physics,
             )?;
             let env = py
                 .detach(|| {

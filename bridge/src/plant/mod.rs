@@ -91,6 +91,9 @@ impl LiveEnv {
         let spec = VecEnv::new(&one)?.spec().clone();
         let (task, mut scenario) = registry::build(&cfg.task, &cfg.scenario, &cfg.params)?;
         scenario.spec.seed = cfg.seed;
+        if let Some(p) = cfg.physics {
+            scenario.spec.physics = p;
+        }
         driver::refuse_onboard(&scenario)?;
         let driver = Self::open(&scenario, plant)?;
         let p = &scenario.spec.robot;

@@ -48,6 +48,7 @@ class VecEnv:
         patch_side: float | None = None,
         params_json: str | None = None,
         backend: str | None = None,
+        physics: str | None = None,
     ) -> None: ...
     @property
     def backend_name(self) -> str: ...
@@ -86,6 +87,7 @@ class Plant:
         patch_side: float | None = None,
         params_json: str | None = None,
         backend: str | None = None,
+        physics: str | None = None,
     ) -> None: ...
     @property
     def backend_name(self) -> str: ...

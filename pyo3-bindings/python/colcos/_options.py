@@ -19,6 +19,7 @@ from colcos._core import ArgumentTypeError, TaskError
 log = logging.getLogger("colcos")
 
 BACKENDS = ("cpu", "gpu", "auto")
+PHYSICS = ("rapier", "discs")
 
 
 def core_kwargs(
@@ -31,6 +32,7 @@ def core_kwargs(
     patch_side: float,
     params: dict[str, Any],
     backend: str | None = None,
+    physics: str | None = None,
 ) -> dict[str, Any]:
     """Keyword arguments of `colcos._core.VecEnv` (all but num_envs, seed, threads, autoreset)."""
     if not isinstance(task, str):
@@ -55,6 +57,10 @@ def core_kwargs(
         if not isinstance(backend, str) or backend.lower() not in BACKENDS:
             raise TaskError(f"backend must be one of {BACKENDS} (or None: the scenario's [field] backend), got {backend!r}")
         kw["backend"] = backend.lower()
+    if physics is not None:
+        if not isinstance(physics, str) or physics.lower() not in PHYSICS:
+            raise TaskError(f"physics must be one of {PHYSICS} (or None: the scenario's), got {physics!r}")
+        kw["physics"] = physics.lower()
     if params:
         kw["params_json"] = json.dumps({k: _checks.plain(v, k) for k, v in params.items()})
     return kw

@@ -51,6 +51,9 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             is one, else the CPU); None: the scenario's `[field] backend` (default `cpu`). What was
             taken is in `backend_name` (`"cpu"` / `"gpu"`) and `backend_info`, and logged (logger
             `colcos`, INFO).
+        physics: the robots' contact solver: `"rapier"` (rigid bodies, the default of the tasks'
+            scenarios) or `"discs"` (a position-based disc solver, faster in large batches; see
+            docs/python.md); None: the scenario's `physics`.
         seed: the base seed, an integer in 0..=2**64-1 (as for `reset(seed=...)`).
         plant: where the arena is: `"sim"` (the simulator), `"twin"` (the digital twin over the rig's
             wire formats: started in this process on loopback, or at `tracker`/`robots`), `"rig"`
@@ -95,6 +98,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         patch_side: float = 0.08,
         seed: int = 0,
         backend: str | None = None,
+        physics: str | None = None,
         plant: str = "sim",
         tracker: str | None = None,
         robots: str | None = None,
@@ -107,11 +111,11 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self._init_kwargs = dict(
             task=task, scenario=scenario, max_cycles=max_cycles, render_mode=render_mode, continuous=continuous,
             global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, backend=backend,
-            plant=plant, tracker=tracker, robots=robots, log=log, goto=goto, goto_timeout=goto_timeout,
+            physics=physics, plant=plant, tracker=tracker, robots=robots, log=log, goto=goto, goto_timeout=goto_timeout,
             twin_scenario=twin_scenario, **params,
         )
         _checks.choice(render_mode, "render_mode", [None, "human", "rgb_array"])
-        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend)
+        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend, physics)
         _checks.choice(plant, "plant", list(PLANTS))
         self.plant = plant
         self._core: _core.VecEnv | _core.Plant

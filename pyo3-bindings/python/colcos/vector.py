@@ -44,6 +44,8 @@ class VecEnv(BackendInfo):
         autoreset_mode: `"next_step"`, `"same_step"` or `"disabled"`.
         backend: field backend of the grid pheromones, `"cpu"`, `"gpu"` or `"auto"` (None: the
             scenario's `[field] backend`), as for `colcos.parallel_env`; see `backend_name`.
+        physics: the contact solver, `"rapier"` or `"discs"` (None: the scenario's), as for
+            `colcos.parallel_env`.
         render_mode: None, `"rgb_array"` or `"human"` (a window showing world 0 with its robots,
             updated by every `reset` and `step`, at the field's rate; `close()` closes it).
     """
@@ -62,6 +64,7 @@ class VecEnv(BackendInfo):
         patch: int | None = None,
         patch_side: float = 0.08,
         backend: str | None = None,
+        physics: str | None = None,
         render_mode: str | None = None,
         **params: Any,
     ) -> None:
@@ -74,9 +77,9 @@ class VecEnv(BackendInfo):
         self._init_kwargs = dict(
             task=task, num_envs=num_envs, seed=seed, num_threads=num_threads, scenario=scenario, max_cycles=max_cycles,
             continuous=continuous, autoreset_mode=autoreset_mode, global_state=global_state, patch=patch,
-            patch_side=patch_side, backend=backend, render_mode=render_mode, **params,
+            patch_side=patch_side, backend=backend, physics=physics, render_mode=render_mode, **params,
         )
-        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend)
+        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend, physics)
         self._core = _core.VecEnv(num_envs=num_envs, seed=seed, num_threads=num_threads, autoreset_mode=autoreset_mode, **kw)
         log_backend(self._core, backend)
         self.spec: dict[str, Any] = self._core.spec()
