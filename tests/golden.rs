@@ -178,14 +178,14 @@ const CASE1_G3: &[(&str, u64)] = &[
     ("fields/SRP.npy", 0xc2747a75adaa7feb),
     ("scenario.toml", 0xd468996410fb0dfb),
     ("screen.png", 0x2ee51d14a5cdd68a),
-    ("trajectory.csv", 0x8e87a102cbb58db6),
+    ("trajectory.csv", 0x879f4ecacc86dd17),
 ];
 const CASE1_B_G2: &[(&str, u64)] = &[
     ("fields/LAP.npy", 0xbe447f50d106e252),
     ("fields/SAP.npy", 0xe8b8112fc4e75cb2),
     ("scenario.toml", 0xbbaf23960a581f0e),
     ("screen.png", 0xb8b059c87c25f51d),
-    ("trajectory.csv", 0x5e44c1b6b4de1d7e),
+    ("trajectory.csv", 0xe485d82eecb9f116),
 ];
 const CASE2: &[(&str, u64)] = &[
     ("fields/AGP.npy", 0x17190009229fb89e),
@@ -196,11 +196,11 @@ const CASE2: &[(&str, u64)] = &[
     ("trajectory.csv", 0x91b0e44b95d9172c),
 ];
 const EXPERIMENTS: &[(&str, u64)] = &[
-    ("case1/arrivals.csv", 0x2fce01f4727a267a),
-    ("case1/fig5_arrivals.png", 0xc3071efa5a319aff),
+    ("case1/arrivals.csv", 0xf6dc22241692aefe),
+    ("case1/fig5_arrivals.png", 0x15ba472f98e26fb0),
     ("case1/fig6_g3_trajectories.png", 0xdb9b6f9cc60c85fc),
-    ("case1/trajectories_all_groups.png", 0x80674eae5193b4ef),
-    ("case1/trials.csv", 0x7009d6a71fdde1eb),
+    ("case1/trajectories_all_groups.png", 0x5a2fe42a38589961),
+    ("case1/trials.csv", 0xdc8d0266aadd370d),
     ("case2/fig7_snapshots.png", 0xe98bfc2cdc3a975a),
     ("case2/fig8_s_t.png", 0xc7e92a7e2518f57a),
     ("case2/s_t.csv", 0x292c5b6fcdc98acd),

@@ -163,7 +163,7 @@ fn baselines_rapier() {
         None,
         [
             (0xb9c5e5b158daa3f7, 0x17641f0e1980a989),
-            (0x0124c94906d4be50, 0x0124c94906d4be50),
+            (0xb78ca687e479dc0f, 0xb78ca687e479dc0f),
             (0x92303b1c29d7da7d, 0x6228a79982175c49),
         ],
     );
@@ -175,7 +175,7 @@ fn baselines_discs() {
         Some(PhysicsBackend::Discs),
         [
             (0xaa4d94bce0cff459, 0x25f99dacd10e76c8),
-            (0xf726478206dde504, 0xf726478206dde504),
+            (0xa43155483782abb3, 0xa43155483782abb3),
             (0x137cf18b419c7b0f, 0x74607472e76cbfa4),
         ],
     );

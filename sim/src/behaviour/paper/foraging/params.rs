@@ -48,7 +48,7 @@ impl Default for ForagingParams {
             turn_angle: 35.0,
             turn_rate: 3.0,
             commit_speed: 0.5,
-            recover_turn: 180.0,
+            recover_turn: 120.0,
             recover_rate: 3.0,
         }
     }
@@ -114,7 +114,7 @@ impl ForagingParams {
         ParamDoc {
             name: "recover_turn",
             ty: "float, degrees, >= 0",
-            default: "180.0",
+            default: "120.0",
             meaning: "on losing the trail, pivot toward the side last seen by up to this angle (0: wander at once)",
         },
         ParamDoc {
