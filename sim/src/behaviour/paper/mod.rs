@@ -25,8 +25,7 @@ pub use aggregation::{
     AggregationDecision, AggregationParams, Follower, FollowerParams, Leader, LeaderParams,
 };
 pub use foraging::{
-    Recovery,
-    BifurcationKind, Foraging, ForagingDecision, ForagingParams, Side, Trail, TrailClass,
+    BifurcationKind, Foraging, ForagingDecision, ForagingParams, Recovery, Side, Trail, TrailClass,
     detect_bifurcation,
 };
 
