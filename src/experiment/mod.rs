@@ -225,6 +225,14 @@ pub fn run(opts: &Options) -> Result<Report> {
     }
     let wall = started.elapsed().as_secs_f64();
     files.extend(summary::write(out, r1.as_ref(), r2.as_ref(), wall)?);
+    if let Some(r) = &rr {
+        // The random maps' table also goes into the top-level summary that a reader opens first.
+        let md = out.join("summary.md");
+        let mut text =
+            std::fs::read_to_string(&md).with_context(|| format!("reading {}", md.display()))?;
+        text += &format!("\n{}", random_run::markdown(r).replacen("# ", "## ", 1));
+        std::fs::write(&md, text).with_context(|| format!("writing {}", md.display()))?;
+    }
     Ok(Report {
         case1: r1,
         case1_random: rr,
