@@ -4,7 +4,7 @@
 //! robot chose come back in its telemetry; they stand for the command in the host's dead reckoning,
 //! the shield's look-ahead and the log.
 use super::stopper::stop_packet;
-use crate::colias::{CommandPacket, HostCommand, OnboardStatus, PolicyMode, Telemetry};
+use crate::colias::{CommandPacket, HostCommand, PolicyMode, Telemetry};
 use crate::onboard::{OnboardManifest, robot_params, upload_packets};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::{Firmware, Scenario};
@@ -18,8 +18,6 @@ struct Robot {
     started: bool,
     /// When the last `PRN` or stop went out, s.
     last_frame: f64,
-    /// The robot's last report.
-    status: Option<OnboardStatus>,
     /// The wheel speeds its policy last chose while running (stop until it has run).
     chosen: WheelCommand,
     /// It runs another policy, or none: held stopped, said once.
@@ -53,7 +51,6 @@ impl OnboardHost {
                 uploaded: false,
                 started: false,
                 last_frame: f64::NEG_INFINITY,
-                status: None,
                 chosen: WheelCommand::STOP,
                 refused: false,
             })
@@ -69,7 +66,6 @@ impl OnboardHost {
         let hash = self.hash;
         let r = self.robots.get_mut(i)?;
         let status = tm.onboard();
-        r.status = Some(status);
         if status.mode == PolicyMode::Running {
             r.chosen = WheelCommand {
                 left: status.left,
@@ -148,13 +144,5 @@ impl OnboardHost {
             r.last_frame = t;
         }
         true
-    }
-
-    /// Robot `i`'s parameter block as uploaded.
-    pub fn params(&self, i: usize) -> &[f32] {
-        self.robots
-            .get(i)
-            .map(|r| r.params.as_slice())
-            .unwrap_or(&[])
     }
 }

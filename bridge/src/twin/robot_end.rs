@@ -241,7 +241,8 @@ impl RobotEnd {
             }
             if plant.heard_age(i) > FIRMWARE_TIMEOUT {
                 fleet.lose_link(i);
-                plant.hear(Some(i), WheelCommand::STOP);
+                // Its own stop: nothing was heard, so the link timeout is not refreshed.
+                plant.drive(i, WheelCommand::STOP);
                 continue;
             }
             let colour = colour_from_sim(plant.colour_counts(i, frame));
