@@ -157,20 +157,20 @@ fn case_studies_as_experiments() {
 
 const LARGE: &[(&str, u64)] = &[
     ("fields/blue.npy", 0x8d908e5e874be824),
-    ("fields/red.npy", 0xf65ce95708c8a76c),
+    ("fields/red.npy", 0xfd1411c1d4918bc2),
     ("run.gif", 0x21cf3849ecb835b8),
     ("scenario.toml", 0x2dab784f4a77cac8),
-    ("screen.png", 0x746a412740df9e7d),
-    ("trajectory.csv", 0x9a541762d89d6b69),
+    ("screen.png", 0xdc9665d6d7cb7c12),
+    ("trajectory.csv", 0x68923c94eacf076b),
 ];
 const THREE_TRAILS: &[(&str, u64)] = &[
-    ("fields/blue.npy", 0x84f3375c62076cfa),
-    ("fields/green.npy", 0x441ef8aaab1f4688),
+    ("fields/blue.npy", 0xe74c302841f17da4),
+    ("fields/green.npy", 0x89d694ea8364d769),
     ("fields/red.npy", 0x2e0af3a9c1f520c6),
     ("run.gif", 0xc007b5e11957ec9c),
     ("scenario.toml", 0x74f711f92dc9113d),
-    ("screen.png", 0xe56a857e55daf0dc),
-    ("trajectory.csv", 0x271f7d04f28e7b5e),
+    ("screen.png", 0x72ad292a752be460),
+    ("trajectory.csv", 0xc6a99e37cc59fa9c),
 ];
 const CASE1_G3: &[(&str, u64)] = &[
     ("fields/LAP.npy", 0xc952b4dfdfe5505b),
@@ -178,31 +178,31 @@ const CASE1_G3: &[(&str, u64)] = &[
     ("fields/SRP.npy", 0xc2747a75adaa7feb),
     ("scenario.toml", 0xd468996410fb0dfb),
     ("screen.png", 0x2ee51d14a5cdd68a),
-    ("trajectory.csv", 0x879f4ecacc86dd17),
+    ("trajectory.csv", 0xf9437d682ea6874b),
 ];
 const CASE1_B_G2: &[(&str, u64)] = &[
     ("fields/LAP.npy", 0xbe447f50d106e252),
     ("fields/SAP.npy", 0xe8b8112fc4e75cb2),
     ("scenario.toml", 0xbbaf23960a581f0e),
     ("screen.png", 0xb8b059c87c25f51d),
-    ("trajectory.csv", 0xe485d82eecb9f116),
+    ("trajectory.csv", 0xde1ead4e65acaf5b),
 ];
 const CASE2: &[(&str, u64)] = &[
-    ("fields/AGP.npy", 0x17190009229fb89e),
+    ("fields/AGP.npy", 0xef092f407a2741f0),
     ("fields/ALP.npy", 0x38f58f51f25a8a7d),
-    ("run.gif", 0x3b1d1cf7031c1055),
+    ("run.gif", 0x67fd5a657f6a8bdc),
     ("scenario.toml", 0xa5510f9a43eda2bf),
-    ("screen.png", 0xbbf28eb896d3b7f8),
-    ("trajectory.csv", 0x91b0e44b95d9172c),
+    ("screen.png", 0xac4299743f8b4e06),
+    ("trajectory.csv", 0x7722042f27594126),
 ];
 const EXPERIMENTS: &[(&str, u64)] = &[
     ("case1/arrivals.csv", 0xf6dc22241692aefe),
     ("case1/fig5_arrivals.png", 0x15ba472f98e26fb0),
     ("case1/fig6_g3_trajectories.png", 0xdb9b6f9cc60c85fc),
-    ("case1/trajectories_all_groups.png", 0x5a2fe42a38589961),
-    ("case1/trials.csv", 0xdc8d0266aadd370d),
-    ("case2/fig7_snapshots.png", 0xe98bfc2cdc3a975a),
-    ("case2/fig8_s_t.png", 0xc7e92a7e2518f57a),
-    ("case2/s_t.csv", 0x292c5b6fcdc98acd),
-    ("case2/trajectories.png", 0x043f59ed69eb4dd8),
+    ("case1/trajectories_all_groups.png", 0x72876237a72b54c5),
+    ("case1/trials.csv", 0x61d7146b94214dfe),
+    ("case2/fig7_snapshots.png", 0x90f5c41f4bbc408f),
+    ("case2/fig8_s_t.png", 0x9621ee8de0848569),
+    ("case2/s_t.csv", 0xd9aa738430940183),
+    ("case2/trajectories.png", 0x3325c03b2286fab9),
 ];

@@ -138,7 +138,7 @@ fn every_task_under_fixed_actions() {
     fixed_actions(
         None,
         [
-            ("aggregation", 0xaee3d71bb9491d34, 0x8fd6d284b1219559),
+            ("aggregation", 0x53fbc1887adb4eca, 0x83973a958c296381),
             ("foraging", 0x44a08f13ea024f94, 0x44a08f13ea024f94),
             ("trail", 0xc4f22a3d0cc98d4b, 0x454368c6991fa6d3),
         ],
@@ -162,9 +162,9 @@ fn baselines_rapier() {
     baselines(
         None,
         [
-            (0xb9c5e5b158daa3f7, 0x17641f0e1980a989),
-            (0xb78ca687e479dc0f, 0xb78ca687e479dc0f),
-            (0x92303b1c29d7da7d, 0x6228a79982175c49),
+            (0xe969ff49b0e81d20, 0x7a0ba747f35b7c02),
+            (0xb32eb24480774581, 0xb32eb24480774581),
+            (0xb51d54da9c6d30e4, 0x65abd118bdcbbebf),
         ],
     );
 }
