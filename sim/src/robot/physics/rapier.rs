@@ -5,8 +5,9 @@ use crate::robot::{ColiasParams, Pose};
 use glam::Vec2;
 use rapier2d::math::Pose as Pose2;
 use rapier2d::prelude::{
-    ColliderBuilder, IntegrationParameters, PhysicsPipeline, PhysicsWorld, RigidBodyBuilder,
-    RigidBodyHandle, Rotation, SpringCoefficients, Vector,
+    CCDSolver, ColliderBuilder, ImpulseJointSet, IntegrationParameters, MultibodyJointSet,
+    PhysicsPipeline, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, Rotation, SoftBodySet,
+    SpringCoefficients, Vector,
 };
 use std::cell::RefCell;
 
@@ -36,15 +37,28 @@ const FREE_MAX_ROBOTS: usize = 64;
 /// rapier's cap on a body's rotation per step, rad (its solver's `MAX_ROTATION`).
 const MAX_ROTATION: f32 = std::f32::consts::FRAC_PI_4;
 
+/// What every arena stepped on a thread can share: rapier's pipeline (only scratch buffers between
+/// steps) and the sets an arena of discs leaves empty (joints, soft bodies, CCD), which the pipeline
+/// still reads every step. One of each per thread keeps a batch of many small arenas from pulling
+/// each arena's own copies into cache: 4-5 % more steps per second at 1,024 arenas.
+#[derive(Default)]
+struct SharedSets {
+    pipeline: PhysicsPipeline,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd_solver: CCDSolver,
+}
+
 thread_local! {
-    /// rapier's pipeline holds only scratch buffers between steps: one per thread serves every
-    /// arena stepped on it, so a batch of many small arenas keeps one set of them in cache.
-    static PIPELINE: RefCell<PhysicsPipeline> = RefCell::new(PhysicsPipeline::new());
+    static SHARED: RefCell<SharedSets> = RefCell::default();
 }
 
 /// The rapier solver's state. What a free step reads is kept in this small struct, held inline by
 /// the arena; the rapier world (several KB of its own) is touched only by full steps.
 pub(super) struct RapierState {
+    /// Its bodies, colliders, broad and narrow phase and islands; its joint, soft-body and CCD sets
+    /// stay empty (steps pass the thread's [`SharedSets`] instead).
     pub(super) world: Box<PhysicsWorld>,
     pub(super) bodies: Vec<RigidBodyHandle>,
     /// Each body's pose as rapier holds it (rotation as a unit complex), mirrored here so that a
@@ -251,8 +265,8 @@ impl RapierState {
         }
         self.stale = false;
         let w = &mut self.world;
-        PIPELINE.with_borrow_mut(|pipeline| {
-            pipeline.step(
+        SHARED.with_borrow_mut(|shared| {
+            shared.pipeline.step(
                 w.gravity,
                 &w.integration_parameters,
                 &mut w.islands,
@@ -260,10 +274,10 @@ impl RapierState {
                 &mut w.narrow_phase,
                 &mut w.bodies,
                 &mut w.colliders,
-                &mut w.impulse_joints,
-                &mut w.multibody_joints,
-                &mut w.soft_bodies,
-                &mut w.ccd_solver,
+                &mut shared.impulse_joints,
+                &mut shared.multibody_joints,
+                &mut shared.soft_bodies,
+                &mut shared.ccd_solver,
                 &(),
                 &(),
             )
