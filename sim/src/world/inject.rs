@@ -1,7 +1,7 @@
 //! Injection: the rules by which robots lay trails on grid pheromones along their path and move their
 //! Gaussian sources, at their tracked poses (as the real host does) or their true ones. Stage `inject`.
 use super::FieldSet;
-use crate::field::{FieldModel, GridBand, GridSpec, Kernel, Pheromone};
+use crate::field::{FieldModel, GridSpec, Kernel, Pheromone};
 use crate::robot::Pose;
 use crate::scenario::InjectAt;
 use crate::tracker::TrackedPose;
@@ -87,6 +87,8 @@ pub struct Injection {
     /// Scratch: for each band of rows of each grid field (in field order), the indices of the segments
     /// that may reach it.
     band_segments: Vec<Vec<u32>>,
+    /// Scratch: for each pheromone, its first list in `band_segments` and how many it has.
+    band_lists: Vec<(usize, usize)>,
 }
 
 impl Injection {
@@ -103,6 +105,7 @@ impl Injection {
             last_injection: vec![None; robots],
             segments: Vec::new(),
             band_segments: Vec::new(),
+            band_lists: Vec::new(),
         }
     }
 
@@ -183,12 +186,15 @@ fn deposit_segments(injection: &mut Injection, pheromones: &mut [Pheromone]) {
         // First the lists of segments per band (reading the grids' geometry only) ...
         let lists = &mut injection.band_segments;
         lists.iter_mut().for_each(Vec::clear);
+        injection.band_lists.clear();
+        injection.band_lists.resize(pheromones.len(), (0, 0));
         let mut first_list = 0;
         for (index, ph) in pheromones.iter().enumerate() {
             if let FieldModel::Grid(grid) = &ph.model {
                 let spec = *grid.spec();
                 let rows = band_rows(&spec);
                 let count = spec.ny.div_ceil(rows).max(1);
+                injection.band_lists[index] = (first_list, count);
                 if lists.len() < first_list + count {
                     lists.resize_with(first_list + count, Vec::new);
                 }
@@ -204,22 +210,24 @@ fn deposit_segments(injection: &mut Injection, pheromones: &mut [Pheromone]) {
                 first_list += count;
             }
         }
-        // ... then the bands themselves, in the same order, each with its list.
-        let mut lists = injection.band_segments.iter();
-        let mut bands: Vec<(GridBand, &[u32])> = Vec::new();
-        for ph in pheromones.iter_mut() {
-            if let FieldModel::Grid(grid) = &mut ph.model {
-                let rows = band_rows(grid.spec());
-                let with_lists = grid.bands_mut(rows).zip(&mut lists);
-                bands.extend(with_lists.map(|(band, list)| (band, list.as_slice())));
-            }
-        }
-        bands.par_iter_mut().for_each(|(band, list)| {
-            for &k in *list {
-                let s = &segments[k as usize];
-                band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
-            }
-        });
+        // ... then the bands themselves, each with its list (iterators only: nothing allocated).
+        let lists = &injection.band_segments;
+        pheromones
+            .par_iter_mut()
+            .zip(injection.band_lists.par_iter())
+            .for_each(|(ph, &(first, count))| {
+                if let FieldModel::Grid(grid) = &mut ph.model {
+                    let rows = band_rows(grid.spec());
+                    grid.par_bands_mut(rows)
+                        .zip(lists[first..first + count].par_iter())
+                        .for_each(|(mut band, list)| {
+                            for &k in list {
+                                let s = &segments[k as usize];
+                                band.deposit_segment(&s.kernel, s.from, s.to, s.amount);
+                            }
+                        });
+                }
+            });
     } else {
         // A small world (a batched environment's): the whole grid as one band, nothing allocated.
         for (index, ph) in pheromones.iter_mut().enumerate() {

@@ -2,6 +2,7 @@
 use super::{GridField, GridSpec};
 use crate::field::Kernel;
 use glam::Vec2;
+use rayon::prelude::*;
 
 impl GridField {
     /// Adds `amount * kernel.weight(distance to segment a-b)` to every cell near the segment.
@@ -33,6 +34,23 @@ impl GridField {
         let rows = rows.max(1);
         self.values
             .chunks_mut((rows * spec.nx).max(1))
+            .enumerate()
+            .map(move |(k, values)| GridBand {
+                spec,
+                first_row: k * rows,
+                values,
+            })
+    }
+
+    /// [`GridField::bands_mut`] as a parallel iterator.
+    pub fn par_bands_mut(
+        &mut self,
+        rows: usize,
+    ) -> impl IndexedParallelIterator<Item = GridBand<'_>> {
+        let spec = self.spec;
+        let rows = rows.max(1);
+        self.values
+            .par_chunks_mut((rows * spec.nx).max(1))
             .enumerate()
             .map(move |(k, values)| GridBand {
                 spec,

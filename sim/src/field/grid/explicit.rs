@@ -13,7 +13,17 @@ impl GridField {
                 None
             };
             let (a, b) = if k == 0 { (a, b) } else { (1.0, 0.0) };
-            explicit_pass(&mut self.values, inj, nx, ny, a, b, r, parallel);
+            explicit_pass(
+                &mut self.values,
+                &mut self.explicit_rows,
+                inj,
+                nx,
+                ny,
+                a,
+                b,
+                r,
+                parallel,
+            );
         }
     }
 }
@@ -125,6 +135,7 @@ fn stencil_row_fused(
 #[allow(clippy::too_many_arguments)]
 fn explicit_pass(
     values: &mut [f32],
+    rows: &mut ExplicitRows,
     inj: Option<&[f32]>,
     nx: usize,
     ny: usize,
@@ -138,7 +149,8 @@ fn explicit_pass(
     } else {
         1
     };
-    let starts: Vec<usize> = (0..=nb).map(|k| k * ny / nb).collect();
+    let band_rows = ny.div_ceil(nb).max(1);
+    let nb = ny.div_ceil(band_rows).max(1);
     let psi_into = |src: &[f32], j: usize, buf: &mut Vec<f32>| {
         buf.clear();
         let s = &src[j * nx..(j + 1) * nx];
@@ -150,52 +162,65 @@ fn explicit_pass(
             None => buf.extend(s.iter().map(|&v| a * v)),
         }
     };
-    // Halo rows (psi of the old values) just outside each band: (below, above).
-    let halos: Vec<Halo> = (0..nb)
-        .map(|k| {
-            let (j0, j1) = (starts[k], starts[k + 1]);
-            let below = (j0 > 0).then(|| {
-                let mut v = Vec::with_capacity(nx);
-                psi_into(values, j0 - 1, &mut v);
-                v
-            });
-            let above = (j1 < ny).then(|| {
-                let mut v = Vec::with_capacity(nx);
-                psi_into(values, j1, &mut v);
-                v
-            });
-            (below, above)
-        })
-        .collect();
-    let mut bands: Vec<(usize, &mut [f32])> = Vec::with_capacity(nb);
-    let mut rest = values;
-    for k in 0..nb {
-        let (band, tail) = rest.split_at_mut((starts[k + 1] - starts[k]) * nx);
-        bands.push((starts[k], band));
-        rest = tail;
+    // Halo rows (psi of the old values) just outside each band, and each band's three working rows:
+    // buffers kept between passes, so a running field allocates nothing.
+    rows.bands.resize_with(nb, BandRows::default);
+    for (k, band) in rows.bands.iter_mut().enumerate() {
+        let (j0, j1) = (k * band_rows, ((k + 1) * band_rows).min(ny));
+        band.has_below = j0 > 0;
+        if band.has_below {
+            psi_into(values, j0 - 1, &mut band.below);
+        }
+        band.has_above = j1 < ny;
+        if band.has_above {
+            psi_into(values, j1, &mut band.above);
+        }
     }
-    let run = |((j0, band), (below, above)): ((usize, &mut [f32]), &Halo)| {
+    let run = |(k, (band, work)): (usize, (&mut [f32], &mut BandRows))| {
         let args = BandArgs {
-            j0,
-            below: below.as_deref(),
-            above: above.as_deref(),
+            j0: k * band_rows,
+            below: work.has_below.then_some(&work.below[..]),
+            above: work.has_above.then_some(&work.above[..]),
             inj,
             nx,
             a,
             b,
             r,
         };
-        explicit_band_dispatch(band, &args);
+        explicit_band_dispatch(band, &args, &mut work.rows);
     };
+    let bands = &mut rows.bands[..nb];
     if parallel {
-        bands.into_par_iter().zip(halos.par_iter()).for_each(run);
+        values
+            .par_chunks_mut(band_rows * nx)
+            .zip(bands.par_iter_mut())
+            .enumerate()
+            .for_each(run);
     } else {
-        bands.into_iter().zip(halos.iter()).for_each(run);
+        values
+            .chunks_mut(band_rows * nx)
+            .zip(bands.iter_mut())
+            .enumerate()
+            .for_each(run);
     }
 }
 
-/// psi rows just below and just above a band (None at a wall).
-type Halo = (Option<Vec<f32>>, Option<Vec<f32>>);
+/// The row buffers of [`explicit_pass`], kept by the field between passes.
+#[derive(Default)]
+pub(super) struct ExplicitRows {
+    bands: Vec<BandRows>,
+}
+
+/// One band's buffers: psi of the rows just below and above it (when it has them) and the three rows
+/// [`explicit_band`] works in.
+#[derive(Default)]
+struct BandRows {
+    below: Vec<f32>,
+    above: Vec<f32>,
+    has_below: bool,
+    has_above: bool,
+    rows: [Vec<f32>; 3],
+}
 
 /// What one band of [`explicit_pass`] needs besides its rows.
 struct BandArgs<'a> {
@@ -215,29 +240,29 @@ struct BandArgs<'a> {
 /// Runs [`explicit_band`] compiled for AVX2 where the CPU has it (twice the vector width of the
 /// baseline SSE2). Both versions do the same IEEE operations per cell (no FMA contraction), so the
 /// results are bit-identical.
-fn explicit_band_dispatch(band: &mut [f32], args: &BandArgs<'_>) {
+fn explicit_band_dispatch(band: &mut [f32], args: &BandArgs<'_>, work: &mut [Vec<f32>; 3]) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { explicit_band_avx2(band, args) };
+            unsafe { explicit_band_avx2(band, args, work) };
             return;
         }
     }
-    explicit_band(band, args);
+    explicit_band(band, args, work);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 /// # Safety
 /// The CPU must support AVX2.
-unsafe fn explicit_band_avx2(band: &mut [f32], args: &BandArgs<'_>) {
-    explicit_band(band, args);
+unsafe fn explicit_band_avx2(band: &mut [f32], args: &BandArgs<'_>, work: &mut [Vec<f32>; 3]) {
+    explicit_band(band, args, work);
 }
 
-/// One band of rows of [`explicit_pass`], in place.
+/// One band of rows of [`explicit_pass`], in place, with `work` as its three row buffers.
 #[inline(always)]
-fn explicit_band(band: &mut [f32], args: &BandArgs<'_>) {
+fn explicit_band(band: &mut [f32], args: &BandArgs<'_>, work: &mut [Vec<f32>; 3]) {
     let BandArgs {
         j0,
         below,
@@ -264,13 +289,10 @@ fn explicit_band(band: &mut [f32], args: &BandArgs<'_>) {
             None => buf.extend(s.iter().map(|&v| a * v)),
         }
     };
-    let mut cur = Vec::with_capacity(nx);
-    let mut next = Vec::with_capacity(nx);
-    psi_local(band, 0, &mut cur);
-    let mut prev = match below {
-        Some(v) => v.to_vec(),
-        None => cur.clone(),
-    };
+    let [mut prev, mut cur, mut next] = work.each_mut();
+    psi_local(band, 0, cur);
+    prev.clear();
+    prev.extend_from_slice(below.unwrap_or(cur));
     for jl in 0..rows {
         if jl + 1 < rows {
             // psi of the row above is formed in the same loop as the stencil of this row.
@@ -329,9 +351,9 @@ mod tests {
                 r: 0.23,
             };
             let mut base = band0.clone();
-            explicit_band(&mut base, &args);
+            explicit_band(&mut base, &args, &mut Default::default());
             let mut fast = band0.clone();
-            explicit_band_dispatch(&mut fast, &args);
+            explicit_band_dispatch(&mut fast, &args, &mut Default::default());
             assert!(
                 base.iter()
                     .zip(&fast)

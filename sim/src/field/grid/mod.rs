@@ -49,6 +49,8 @@ pub struct GridField {
     injection: Option<Vec<f32>>,
     /// Second buffer of the one-sided passes (swapped with `values`).
     scratch: CellBuffer,
+    /// Row buffers of the explicit passes.
+    explicit_rows: explicit::ExplicitRows,
     thomas_x: Option<Box<Thomas>>,
     thomas_y: Option<Box<Thomas>>,
     /// Log of (exact cumulative decay / applied cumulative decay): error feedback that keeps the product
@@ -64,6 +66,7 @@ impl GridField {
             values: CellBuffer::zeros(spec.len()),
             injection: None,
             scratch: CellBuffer::default(),
+            explicit_rows: Default::default(),
             thomas_x: None,
             thomas_y: None,
             decay_carry: 0.0,
