@@ -299,28 +299,11 @@ fn explicit_band(band: &mut [f32], args: &BandArgs<'_>, work: &mut [Vec<f32>; 3]
             let (lo, hi) = band.split_at_mut((jl + 1) * nx);
             let q = inj.map(|jm| &jm[(j0 + jl + 1) * nx..(j0 + jl + 2) * nx]);
             next.resize(nx, 0.0);
-            stencil_row_fused(
-                &cur,
-                &prev,
-                &hi[..nx],
-                q,
-                a,
-                b,
-                &mut next,
-                &mut lo[jl * nx..],
-                r,
-            );
+            stencil_row_fused(cur, prev, &hi[..nx], q, a, b, next, &mut lo[jl * nx..], r);
         } else {
             next.clear();
-            next.extend_from_slice(above.unwrap_or(&cur));
-            stencil_row(
-                &cur,
-                &next,
-                &prev,
-                &mut band[jl * nx..(jl + 1) * nx],
-                1.0,
-                r,
-            );
+            next.extend_from_slice(above.unwrap_or(cur));
+            stencil_row(cur, next, prev, &mut band[jl * nx..(jl + 1) * nx], 1.0, r);
         }
         std::mem::swap(&mut prev, &mut cur);
         std::mem::swap(&mut cur, &mut next);
