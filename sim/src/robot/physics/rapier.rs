@@ -104,11 +104,13 @@ impl RapierState {
             (Vec2::new(0.5 * w, h + t), Vec2::new(0.5 * w + 2.0 * t, t)),
         ];
         for (centre, half) in walls {
-            world.insert(
-                RigidBodyBuilder::fixed().translation(centre),
+            // A collider without a body, like the obstacles': it never moves.
+            world.insert_collider(
                 ColliderBuilder::cuboid(half.x, half.y)
+                    .translation(centre)
                     .friction(FRICTION)
                     .restitution(0.0),
+                None,
             );
         }
         let mut bodies = Vec::with_capacity(poses.len());
