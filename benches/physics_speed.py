@@ -109,22 +109,30 @@ def main() -> None:
         f"| whole step (dt 20 ms) | {s_r:.2f} ({20 / s_r:.2f}x real time) | {s_d:.2f} ({20 / s_d:.2f}x) | {s_r / s_d:.2f} |"
     )
 
-    r1024, d1024, d32 = med[(1024, "rapier")], med[(1024, "discs")], med[(32, "discs")]
+    # The ratios of each repeat's back-to-back runs, then their median: steadier than a ratio of
+    # medians when the machine changes speed between repeats.
+    def paired(a: list[float], b: list[float]) -> float:
+        return statistics.median(x / y for x, y in zip(a, b))
+
+    ratio_1024 = paired(rates[(1024, "discs")], rates[(1024, "rapier")])
+    ratio_swarm = paired(swarm_ms["rapier"], swarm_ms["discs"])
+    ratio_worlds = paired(rates[(1024, "discs")], rates[(32, "discs")])
+    r1024 = med[(1024, "rapier")]
     print("\nbars:")
     print(
         f"  rapier, 1,024 worlds >= {TARGET_BATCHED:,} agent-steps/s: {r1024:,.0f} ({r1024 / TARGET_BATCHED:.2f}x): {verdict(r1024 >= TARGET_BATCHED)}"
     )
     print(
-        f"  rapier within {TARGET_RATIO}x of discs at 1,024 worlds: {d1024 / r1024:.2f}x: {verdict(d1024 / r1024 <= TARGET_RATIO)}"
+        f"  rapier within {TARGET_RATIO}x of discs at 1,024 worlds (median of the repeats' ratios): {ratio_1024:.2f}x: {verdict(ratio_1024 <= TARGET_RATIO)}"
     )
     print(
-        f"  discs at 1,024 worlds at least as fast as at 32: {d1024 / d32:.2f}x: {verdict(d1024 >= d32)}"
+        f"  discs at 1,024 worlds at least as fast as at 32 (same): {ratio_worlds:.2f}x: {verdict(ratio_worlds >= 1.0)}"
     )
     print(
         f"  10,000 robots on rapier <= {TARGET_SWARM_MS} ms a step: {s_r:.2f} ms: {verdict(s_r <= TARGET_SWARM_MS)}"
     )
     print(
-        f"  10,000 robots on rapier within {TARGET_RATIO}x of discs: {s_r / s_d:.2f}x: {verdict(s_r / s_d <= TARGET_RATIO)}"
+        f"  10,000 robots on rapier within {TARGET_RATIO}x of discs (same): {ratio_swarm:.2f}x: {verdict(ratio_swarm <= TARGET_RATIO)}"
     )
 
 
