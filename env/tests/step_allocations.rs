@@ -4,29 +4,9 @@
 //! in a step with contacts.
 use colcos_env::{Actions, EnvConfig, VecEnv};
 use colcos_sim::robot::PhysicsBackend;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
-
-/// Counts allocations and reallocations, on every thread.
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Relaxed);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Relaxed);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
+#[path = "../../sim/tests/support/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
 
 /// Allocations per world and step over 100 steps of 64 worlds, after 100 steps to warm up; episodes
 /// are longer than the 200 steps, so no world is rebuilt.
@@ -46,11 +26,11 @@ fn allocations_per_world_step(task: &str, physics: PhysicsBackend) -> f64 {
     for _ in 0..100 {
         env.step(Actions::Continuous(&actions)).unwrap();
     }
-    let before = ALLOCATIONS.load(Relaxed);
+    let before = allocations();
     for _ in 0..100 {
         env.step(Actions::Continuous(&actions)).unwrap();
     }
-    (ALLOCATIONS.load(Relaxed) - before) as f64 / (100.0 * 64.0)
+    (allocations() - before) as f64 / (100.0 * 64.0)
 }
 
 /// One test, as the counter counts every thread's allocations. Measured: discs 0.001-0.007 a world

@@ -3,29 +3,9 @@
 //! few small blocks in each step with contacts (its solver's stage sync, its lists of modified bodies).
 use colcos_sim::prelude::*;
 use colcos_sim::robot::PhysicsBackend;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
-
-/// Counts allocations and reallocations, on every thread.
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Relaxed);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Relaxed);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
+#[path = "support/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
 
 const SCENARIOS: [&str; 6] = [
     "three_trails.toml",
@@ -52,12 +32,12 @@ fn allocations_per_step(file: &str, physics: PhysicsBackend) -> f64 {
         for _ in 0..300 {
             w.step();
         }
-        let before = ALLOCATIONS.load(Relaxed);
+        let before = allocations();
         let steps = 300;
         for _ in 0..steps {
             w.step();
         }
-        (ALLOCATIONS.load(Relaxed) - before) as f64 / steps as f64
+        (allocations() - before) as f64 / steps as f64
     })
 }
 

@@ -35,11 +35,7 @@ impl GridField {
         self.values
             .chunks_mut((rows * spec.nx).max(1))
             .enumerate()
-            .map(move |(k, values)| GridBand {
-                spec,
-                first_row: k * rows,
-                values,
-            })
+            .map(move |(k, values)| GridBand::number(spec, rows, k, values))
     }
 
     /// [`GridField::bands_mut`] as a parallel iterator.
@@ -52,11 +48,7 @@ impl GridField {
         self.values
             .par_chunks_mut((rows * spec.nx).max(1))
             .enumerate()
-            .map(move |(k, values)| GridBand {
-                spec,
-                first_row: k * rows,
-                values,
-            })
+            .map(move |(k, values)| GridBand::number(spec, rows, k, values))
     }
 
     /// Adds `amount * kernel.weight(distance to p)` to every cell near `p`.
@@ -71,6 +63,17 @@ pub struct GridBand<'a> {
     spec: GridSpec,
     first_row: usize,
     values: &'a mut [f32],
+}
+
+impl<'a> GridBand<'a> {
+    /// Band `k` of bands of `rows` rows, holding that band's `values`.
+    fn number(spec: GridSpec, rows: usize, k: usize, values: &'a mut [f32]) -> Self {
+        GridBand {
+            spec,
+            first_row: k * rows,
+            values,
+        }
+    }
 }
 
 impl GridBand<'_> {
