@@ -192,13 +192,13 @@ fn explicit_pass(
     let bands = &mut rows.bands[..nb];
     if parallel {
         values
-            .par_chunks_mut(band_rows * nx)
+            .par_chunks_mut((band_rows * nx).max(1))
             .zip(bands.par_iter_mut())
             .enumerate()
             .for_each(run);
     } else {
         values
-            .chunks_mut(band_rows * nx)
+            .chunks_mut((band_rows * nx).max(1))
             .zip(bands.iter_mut())
             .enumerate()
             .for_each(run);
