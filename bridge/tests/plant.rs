@@ -5,6 +5,14 @@ use colcos_bridge::plant::{LiveEnv, PlantKind, PlantOptions, TwinScenario};
 use colcos_env::{EnvConfig, VecEnv};
 use colcos_sim::world::ArenaView;
 
+/// The twins of these tests run in real time, and one of them measures a latency in ticks: one test
+/// at a time, so that the others do not take its cores.
+static REAL_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+    REAL_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn config() -> EnvConfig {
     let mut cfg = EnvConfig::new("aggregation");
     cfg.max_cycles = 120;
@@ -18,6 +26,7 @@ fn full_ahead(n: usize) -> Vec<f32> {
 
 #[test]
 fn the_twin_plant_keeps_a_wall_seeking_policy_inside_and_replays_its_log() {
+    let _alone = one_at_a_time();
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("rig.mcap");
     let cfg = config();
@@ -90,6 +99,7 @@ fn the_twin_plant_keeps_a_wall_seeking_policy_inside_and_replays_its_log() {
 
 #[test]
 fn a_plant_without_what_it_needs_names_it() {
+    let _alone = one_at_a_time();
     let cfg = config();
     let err = |opts: PlantOptions| LiveEnv::new(&cfg, &opts).err().unwrap().to_string();
     assert!(err(PlantOptions::new(PlantKind::Replay)).contains("`replay`"));
@@ -157,6 +167,7 @@ fn steps_until_seen_moving(twin: Option<TwinScenario>) -> usize {
 
 #[test]
 fn a_twin_with_its_own_tracker_latency_is_seen_later_by_the_host() {
+    let _alone = one_at_a_time();
     let own = steps_until_seen_moving(None);
     let late = steps_until_seen_moving(Some(TwinScenario::Overrides(vec![(
         "tracker.latency".into(),
@@ -171,6 +182,7 @@ fn a_twin_with_its_own_tracker_latency_is_seen_later_by_the_host() {
 
 #[test]
 fn a_twin_scenario_of_another_arena_or_with_urls_is_refused() {
+    let _alone = one_at_a_time();
     let cfg = config();
     let mut opts = PlantOptions::new(PlantKind::Twin);
     opts.twin_scenario = Some(TwinScenario::Overrides(vec![(
