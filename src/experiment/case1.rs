@@ -109,10 +109,7 @@ pub fn freeze_steady_state(world: &mut World, scenario: &Scenario) {
             continue;
         }
         if let FieldModel::Grid(g) = &mut p.model {
-            let mut params = *g.params();
-            g.clear_static_injection();
-            params.evaporation = f32::INFINITY;
-            g.set_params(params);
+            g.freeze();
         }
     }
 }

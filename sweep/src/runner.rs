@@ -154,20 +154,10 @@ pub fn run_ids(plan: &Plan, ids: &[u64]) -> Result<Vec<RunRow>> {
 pub fn preload_steady_state(world: &mut World) {
     for p in world.pheromones_mut() {
         if let FieldModel::Grid(g) = &mut p.model {
-            let mut params = *g.params();
-            let e = params.evaporation;
-            if params.diffusion != 0.0 || params.wind != Vec2::ZERO || !(e.is_finite() && e > 0.0) {
-                continue;
+            let params = g.params();
+            if params.diffusion == 0.0 && params.wind == Vec2::ZERO && g.fill_steady_state() {
+                g.freeze();
             }
-            let Some(j) = g.static_injection().map(|j| j.to_vec()) else {
-                continue;
-            };
-            for (v, j) in g.values_mut().iter_mut().zip(j) {
-                *v = e * j;
-            }
-            g.clear_static_injection();
-            params.evaporation = f32::INFINITY;
-            g.set_params(params);
         }
     }
 }

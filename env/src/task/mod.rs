@@ -94,18 +94,7 @@ pub fn prefill_static_maps(pheromones: &mut [Pheromone]) -> bool {
     let mut changed = false;
     for p in pheromones {
         if let colcos_sim::field::FieldModel::Grid(g) = &mut p.model {
-            let e = g.params().evaporation;
-            if !(e.is_finite() && e > 0.0) {
-                continue;
-            }
-            let Some(j) = g.static_injection().map(|j| j.to_vec()) else {
-                continue;
-            };
-            g.values_mut()
-                .iter_mut()
-                .zip(&j)
-                .for_each(|(v, j)| *v = e * j);
-            changed = true;
+            changed |= g.fill_steady_state();
         }
     }
     changed

@@ -216,14 +216,11 @@ fn build_pheromone(
                     )?;
                     j.iter_mut().zip(layer).for_each(|(a, b)| *a += b);
                 }
+                field.set_static_injection(j);
                 if p.preload {
                     // Validation allows it only with evaporation set and no diffusion or wind.
-                    let e = params.evaporation;
-                    for (v, j) in field.values_mut().iter_mut().zip(&j) {
-                        *v = e * j;
-                    }
+                    field.fill_steady_state();
                 }
-                field.set_static_injection(j);
             }
             FieldModel::Grid(field)
         }

@@ -105,6 +105,28 @@ impl GridField {
     pub fn clear_static_injection(&mut self) {
         self.injection = None;
     }
+    /// Keeps the values as they are for ever: no static injection, no evaporation (a field at its
+    /// steady state without diffusion or wind stays there exactly, and stepping it costs nothing new).
+    pub fn freeze(&mut self) {
+        self.injection = None;
+        self.params.evaporation = f32::INFINITY;
+    }
+    /// Sets every cell to `e J`, the level a static injection `J` under evaporation `e` settles at
+    /// without diffusion or wind, where the field has a static injection and a finite positive
+    /// evaporation; returns whether it did.
+    pub fn fill_steady_state(&mut self) -> bool {
+        let e = self.params.evaporation;
+        let Some(j) = self.injection.as_deref() else {
+            return false;
+        };
+        if !(e.is_finite() && e > 0.0) {
+            return false;
+        }
+        for (v, j) in self.values.iter_mut().zip(j) {
+            *v = e * j;
+        }
+        true
+    }
 
     /// Integral of the field, sum of values times cell area.
     pub fn total_mass(&self) -> f64 {
