@@ -12,6 +12,7 @@
 
 pub mod backend;
 pub mod baseline;
+mod batch_step;
 pub mod config;
 pub mod encoding;
 pub mod error;

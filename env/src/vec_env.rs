@@ -5,6 +5,7 @@
 //! binding may hand out views of them that stay valid for the environment's lifetime. Each `step` and
 //! `reset` overwrites them in place.
 use crate::backend::EnvBackend;
+use crate::batch_step::{Buffers, CHUNK, Lengths, attach_all, new_hosts, step_batch};
 use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
 use crate::encoding::{self, OBS_DIM};
 use crate::error::{EnvError, Result};
@@ -15,6 +16,7 @@ use crate::world_output::{write_obs, write_patch, write_state};
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
 use crate::world_step::{Ctx, Out, step_world};
+use colcos_sim::robot::RapierHost;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::shield::Shield;
 use colcos_sim::world::World;
@@ -39,6 +41,8 @@ pub struct VecEnv {
     patch_cfg: Option<PatchConfig>,
     pool: rayon::ThreadPool,
     slots: Vec<WorldSlot>,
+    /// One rapier host per chunk of worlds, where they share one (see `batch_step`).
+    hosts: Vec<Option<RapierHost>>,
     obs: Vec<f32>,
     rewards: Vec<f32>,
     terminated: Vec<bool>,
@@ -147,9 +151,12 @@ impl VecEnv {
         let slots = pool.install(|| {
             (0..e)
                 .into_par_iter()
-                .map(|w| WorldSlot::build(&scenario, task.as_ref(), &backend, w, 0))
+                .map(|w| WorldSlot::build(&scenario, task.as_ref(), &backend, w, 0, None))
                 .collect::<Result<Vec<_>>>()
         })?;
+        let mut slots = slots;
+        let mut hosts = new_hosts(&scenario, e, &slots);
+        pool.install(|| attach_all(&mut slots, &mut hosts));
         backend.settle(&slots[0].world);
         let mut env = VecEnv {
             spec,
@@ -160,6 +167,7 @@ impl VecEnv {
             patch_cfg: cfg.patch,
             pool,
             slots,
+            hosts,
             obs: vec![0.0; e * n * OBS_DIM],
             rewards: vec![0.0; e * n],
             terminated: vec![false; e * n],
@@ -293,21 +301,26 @@ impl VecEnv {
         // A seed restarts the episode count; the first reset after construction replays episode 0.
         let restart = seed.is_some();
         let first = self.needs_reset;
-        let slots = &mut self.slots;
+        let (slots, hosts) = (&mut self.slots, &mut self.hosts);
         self.pool.install(|| {
             slots
-                .par_iter_mut()
+                .par_chunks_mut(CHUNK)
+                .zip(hosts.par_iter_mut())
                 .enumerate()
-                .try_for_each(|(w, slot)| -> Result<()> {
-                    if mask.is_none_or(|m| m[w]) {
-                        let episode = if restart {
-                            0
-                        } else if first {
-                            slot.episode
-                        } else {
-                            slot.episode + 1
-                        };
-                        *slot = WorldSlot::build(scenario, task, backend, w, episode)?;
+                .try_for_each(|(k, (slots, host))| -> Result<()> {
+                    for (i, slot) in slots.iter_mut().enumerate() {
+                        let w = k * CHUNK + i;
+                        if mask.is_none_or(|m| m[w]) {
+                            let episode = if restart {
+                                0
+                            } else if first {
+                                slot.episode
+                            } else {
+                                slot.episode + 1
+                            };
+                            let host = host.as_mut().map(|h| (h, i));
+                            *slot = WorldSlot::build(scenario, task, backend, w, episode, host)?;
+                        }
                     }
                     Ok(())
                 })
@@ -362,49 +375,26 @@ impl VecEnv {
             };
             return step_world(&ctx, 0, slot, &self.commands, &mut out);
         }
-        let (sd, pl) = (self.state_dim.max(1), self.patch_len.max(1));
-        let slots = &mut self.slots;
-        let commands = &self.commands;
-        let outs = self
-            .obs
-            .par_chunks_mut(n * OBS_DIM)
-            .zip(self.rewards.par_chunks_mut(n))
-            .zip(self.terminated.par_chunks_mut(n))
-            .zip(self.truncated.par_chunks_mut(n))
-            .zip(self.state.par_chunks_mut(sd))
-            .zip(self.patch.par_chunks_mut(n * pl))
-            .zip(self.final_obs.par_chunks_mut(n * OBS_DIM))
-            .zip(self.final_mask.par_iter_mut())
-            .zip(self.shield_flags.par_chunks_mut(n))
-            .map(
-                |(
-                    (
-                        ((((((obs, rewards), terminated), truncated), state), patch), final_obs),
-                        final_mask,
-                    ),
-                    shield,
-                )| Out {
-                    obs,
-                    rewards,
-                    terminated,
-                    truncated,
-                    state,
-                    patch,
-                    final_obs,
-                    final_mask,
-                    shield,
-                },
-            );
-        self.pool.install(|| {
-            slots
-                .par_iter_mut()
-                .zip(commands.par_chunks(n))
-                .zip(outs)
-                .enumerate()
-                .try_for_each(|(w, ((slot, cmds), mut out))| {
-                    step_world(&ctx, w, slot, cmds, &mut out)
-                })
-        })
+        let len = Lengths {
+            agents: n,
+            obs: n * OBS_DIM,
+            state: self.state_dim.max(1),
+            patch: n * self.patch_len.max(1),
+        };
+        let buffers = Buffers {
+            obs: &mut self.obs,
+            rewards: &mut self.rewards,
+            terminated: &mut self.terminated,
+            truncated: &mut self.truncated,
+            state: &mut self.state,
+            patch: &mut self.patch,
+            final_obs: &mut self.final_obs,
+            final_mask: &mut self.final_mask,
+            shield: &mut self.shield_flags,
+        };
+        let (slots, hosts, commands) = (&mut self.slots, &mut self.hosts, &self.commands);
+        self.pool
+            .install(|| step_batch(&ctx, slots, hosts, commands, buffers, len))
     }
 
     /// Checks and decodes the actions into wheel commands.

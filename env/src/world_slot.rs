@@ -4,6 +4,7 @@ use crate::error::Result;
 use crate::task::Task;
 use colcos_sim::behaviour::{Behaviour, WheelCommand, registry};
 use colcos_sim::rng::{self, SimRng, Stream};
+use colcos_sim::robot::RapierHost;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
 
@@ -32,13 +33,15 @@ pub(crate) struct WorldSlot {
 }
 
 impl WorldSlot {
-    /// Builds episode `episode` of batch world `w`.
+    /// Builds episode `episode` of batch world `w`, its rapier steps in `host` (the host and the
+    /// world's slot there) if given.
     pub fn build(
         scenario: &Scenario,
         task: &dyn Task,
         backend: &EnvBackend,
         w: usize,
         episode: u64,
+        host: Option<(&mut RapierHost, usize)>,
     ) -> Result<Self> {
         let index = world_index(w, episode);
         let mut world = World::with_index(scenario, index)?;
@@ -61,6 +64,9 @@ impl WorldSlot {
         if task.on_reset(world.pheromones_mut()) {
             // One still step so that the sensors see what the task changed.
             world.step_with_commands(&vec![WheelCommand::STOP; robots]);
+        }
+        if let Some((host, slot)) = host {
+            world.attach_physics(host, slot);
         }
         Ok(WorldSlot {
             world,

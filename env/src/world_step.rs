@@ -6,6 +6,7 @@ use crate::error::Result;
 use crate::task::Task;
 use crate::world_output::{write_obs, write_patch, write_state};
 use crate::world_slot::WorldSlot;
+use colcos_sim::robot::RapierHost;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::shield::{Intervention, Shield};
 
@@ -35,6 +36,18 @@ pub(crate) struct Ctx<'a> {
     pub(crate) shield: Option<Shield>,
 }
 
+/// How far [`begin_world`] took a world's step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Begun {
+    /// The world only reset (next-step autoreset): its outputs are written.
+    Reset,
+    /// The world stepped alone.
+    Stepped,
+    /// The world waits for its rapier host's step.
+    InHost,
+}
+
+/// One whole step of a world that steps alone.
 pub(crate) fn step_world(
     ctx: &Ctx,
     w: usize,
@@ -42,17 +55,39 @@ pub(crate) fn step_world(
     cmds: &[colcos_sim::behaviour::WheelCommand],
     out: &mut Out,
 ) -> Result<()> {
+    let begun = begin_world(ctx, w, slot, cmds, out, None)?;
+    finish_world(ctx, w, slot, out, begun, None)
+}
+
+/// The first half of a world's step: autoreset, scripted robots, shield, and the motion, which
+/// for a world in a rapier host (`host`: the host and the world's slot in it) waits for the
+/// host's step.
+pub(crate) fn begin_world(
+    ctx: &Ctx,
+    w: usize,
+    slot: &mut WorldSlot,
+    cmds: &[colcos_sim::behaviour::WheelCommand],
+    out: &mut Out,
+    host: Option<(&mut RapierHost, usize)>,
+) -> Result<Begun> {
     let agents = ctx.task.agents();
     *out.final_mask = false;
     out.shield.fill(0);
     if slot.done {
         // Next-step autoreset: this step only resets the world.
-        *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
+        *slot = WorldSlot::build(
+            ctx.scenario,
+            ctx.task,
+            ctx.backend,
+            w,
+            slot.episode + 1,
+            host,
+        )?;
         out.rewards.fill(0.0);
         out.terminated.fill(false);
         out.truncated.fill(false);
         write_world(ctx, slot, out);
-        return Ok(());
+        return Ok(Begun::Reset);
     }
     slot.decide_scripted();
     let poses = slot.world.poses();
@@ -72,7 +107,33 @@ pub(crate) fn step_world(
             *cmd
         };
     }
-    slot.world.step_with_commands(&slot.commands);
+    Ok(match host {
+        Some((host, _)) => {
+            slot.world.begin_step_in(&slot.commands, host);
+            Begun::InHost
+        }
+        None => {
+            slot.world.step_with_commands(&slot.commands);
+            Begun::Stepped
+        }
+    })
+}
+
+/// The second half of a world's step, after its host's step: rewards, ends of episodes, outputs.
+pub(crate) fn finish_world(
+    ctx: &Ctx,
+    w: usize,
+    slot: &mut WorldSlot,
+    out: &mut Out,
+    begun: Begun,
+    mut host: Option<(&mut RapierHost, usize)>,
+) -> Result<()> {
+    match (begun, host.as_mut()) {
+        (Begun::Reset, _) => return Ok(()),
+        (Begun::InHost, Some((host, _))) => slot.world.finish_step_in(host),
+        _ => {}
+    }
+    let agents = ctx.task.agents();
     slot.steps += 1;
     slot.prev_terminated.copy_from_slice(&slot.terminated);
     ctx.task
@@ -95,7 +156,14 @@ pub(crate) fn step_world(
         if ctx.mode == AutoresetMode::SameStep {
             out.final_obs.copy_from_slice(out.obs);
             *out.final_mask = true;
-            *slot = WorldSlot::build(ctx.scenario, ctx.task, ctx.backend, w, slot.episode + 1)?;
+            *slot = WorldSlot::build(
+                ctx.scenario,
+                ctx.task,
+                ctx.backend,
+                w,
+                slot.episode + 1,
+                host,
+            )?;
             write_world(ctx, slot, out);
         }
     }

@@ -1,12 +1,13 @@
 //! The batched environment gives the same observations, rewards, flags and state whatever the
 //! number of worker threads, for both contact solvers: worlds stepped on different threads (which
-//! share a thread's rapier pipeline with different neighbours) and rebuilt by autoreset.
+//! share a thread's rapier pipeline with different neighbours), in several rapier hosts of up to 31
+//! worlds, and rebuilt by autoreset.
 use colcos_env::{Actions, EnvConfig, VecEnv};
 use colcos_sim::robot::PhysicsBackend;
 
 fn run(task: &str, maze: bool, physics: PhysicsBackend, threads: usize) -> Vec<u32> {
     let mut cfg = EnvConfig::new(task);
-    cfg.num_envs = 24;
+    cfg.num_envs = 70;
     cfg.max_cycles = 70;
     cfg.seed = 3;
     cfg.num_threads = Some(threads);

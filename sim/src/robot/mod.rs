@@ -7,7 +7,7 @@ mod physics;
 
 pub use colias::ColiasParams;
 pub use drive::DriveState;
-pub use physics::{ArenaPhysics, PhysicsBackend};
+pub use physics::{ArenaPhysics, MAX_HOSTED_ARENAS, PhysicsBackend, RapierHost};
 
 use glam::Vec2;
 

@@ -4,16 +4,23 @@
 use super::Pose;
 use crate::arena::Obstacles;
 use glam::Vec2;
-use rapier2d::prelude::{ColliderBuilder, PhysicsWorld};
+use rapier2d::prelude::{ColliderBuilder, InteractionGroups, PhysicsWorld};
 
-/// Adds every obstacle part to `world` as a fixed collider (no body: it never moves).
-pub(super) fn add_colliders(world: &mut PhysicsWorld, obstacles: &Obstacles, friction: f32) {
+/// Adds every obstacle part to `world` as a fixed collider (no body: it never moves), in collision
+/// `groups`.
+pub(super) fn add_colliders(
+    world: &mut PhysicsWorld,
+    obstacles: &Obstacles,
+    friction: f32,
+    groups: InteractionGroups,
+) {
     for part in obstacles.parts() {
         world.insert_collider(
             ColliderBuilder::new(part.shape.clone())
                 .position(part.pose)
                 .friction(friction)
-                .restitution(0.0),
+                .restitution(0.0)
+                .collision_groups(groups),
             None,
         );
     }

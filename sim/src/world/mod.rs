@@ -33,7 +33,9 @@ pub use view::ArenaView;
 pub mod stages {
     pub use super::fields::step_fields;
     pub use super::inject::inject;
-    pub use super::robots::{decide, decide_and_drive, drive, physics};
+    pub use super::robots::{
+        decide, decide_and_drive, drive, finish_physics_in, physics, physics_in,
+    };
     pub use super::sensing::{index, sense};
     pub use super::tracking::track;
 }

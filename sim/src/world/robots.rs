@@ -3,7 +3,7 @@
 use super::PARALLEL_ROBOTS;
 use crate::behaviour::{Behaviour, Observation, WheelCommand};
 use crate::rng::SimRng;
-use crate::robot::{ArenaPhysics, ColiasParams, DriveState, Pose};
+use crate::robot::{ArenaPhysics, ColiasParams, DriveState, Pose, RapierHost};
 use rayon::prelude::*;
 
 /// Per-robot state that the world keeps apart from physics.
@@ -130,6 +130,17 @@ pub fn drive(robots: &mut RobotSet, commands: &[WheelCommand], dt: f32) {
 /// Reads the body velocities; writes the bodies (true poses).
 pub fn physics(robots: &mut RobotSet, dt: f32) {
     robots.physics.step(&robots.velocities, dt);
+}
+
+/// Stage `physics` for a world whose rapier steps run in `host`: the arena's own part (see
+/// [`crate::robot::RapierHost`]); [`finish_physics_in`] completes it after the host's step.
+pub fn physics_in(robots: &mut RobotSet, dt: f32, host: &mut RapierHost) {
+    robots.physics.step_in(host, &robots.velocities, dt);
+}
+
+/// The end of stage [`physics_in`], after the host's step: the poses of robots that went through it.
+pub fn finish_physics_in(robots: &mut RobotSet, host: &mut RapierHost) {
+    robots.physics.finish_in(host);
 }
 
 /// Stage `decide` alone, for a host whose robots drive themselves (the rig): every robot's behaviour

@@ -1,8 +1,12 @@
 //! One step of a world, composed from the stages: decide -> drive -> physics -> track -> inject ->
 //! sense, with the field step beside the robots' motion.
-use super::stages::{decide_and_drive, drive, index, inject, physics, sense, step_fields, track};
+use super::stages::{
+    decide_and_drive, drive, finish_physics_in, index, inject, physics, physics_in, sense,
+    step_fields, track,
+};
 use super::{PARALLEL_ROBOTS, World};
 use crate::behaviour::WheelCommand;
+use crate::robot::RapierHost;
 
 impl World {
     /// One step with every robot's own behaviour deciding from its current observation.
@@ -27,11 +31,52 @@ impl World {
         self.advance();
     }
 
+    /// Moves this world's rapier bodies into slot `slot` of `host`, which then takes its contact
+    /// steps together with the other worlds there (see [`RapierHost`]): a batch of small worlds
+    /// steps several times faster so. Returns false, and changes nothing, where the world does not
+    /// fit the host (the disc solver, another arena size, no such slot).
+    pub fn attach_physics(&mut self, host: &mut RapierHost, slot: usize) -> bool {
+        self.robots.physics.attach(host, slot)
+    }
+
+    /// The first half of [`Self::step_with_commands`] for a world attached to `host`: the commands
+    /// and the world's own part of the motion. Once every world of the host began its step, call
+    /// [`RapierHost::step`], then [`Self::finish_step_in`] on each. A world not attached to `host`
+    /// moves alone here.
+    ///
+    /// # Panics
+    /// If `commands.len()` differs from the number of robots.
+    pub fn begin_step_in(&mut self, commands: &[WheelCommand], host: &mut RapierHost) {
+        assert_eq!(
+            commands.len(),
+            self.robots.len(),
+            "one wheel command per robot"
+        );
+        drive(&mut self.robots, commands, self.dt);
+        self.advance_clock();
+        physics_in(&mut self.robots, self.dt, host);
+    }
+
+    /// The second half of a step begun with [`Self::begin_step_in`], after [`RapierHost::step`]:
+    /// the poses, then tracking, fields, injection and sensing as in any step.
+    pub fn finish_step_in(&mut self, host: &mut RapierHost) {
+        finish_physics_in(&mut self.robots, host);
+        let (dt, time) = (self.dt, self.time);
+        track(&mut self.tracking, time, self.robots.poses());
+        index(&mut self.sensing, self.robots.poses());
+        step_fields(&mut self.fields, dt, self.robots.len() >= PARALLEL_ROBOTS);
+        self.inject_and_sense();
+    }
+
+    fn advance_clock(&mut self) {
+        self.tick += 1;
+        self.time = self.tick as f32 * self.dt;
+    }
+
     /// The rest of a step once every robot's drive has its command: motion, fields, injection, sensing.
     fn advance(&mut self) {
         let dt = self.dt;
-        self.tick += 1;
-        self.time = self.tick as f32 * dt;
+        self.advance_clock();
         let time = self.time;
         // The fields evolve from the last step's deposits without the robots, and the robots move
         // without the fields: a large world runs the field pass (parallel, bound by memory bandwidth)
@@ -52,6 +97,12 @@ impl World {
             move_robots();
             step_fields();
         }
+        self.inject_and_sense();
+    }
+
+    /// Stages `inject` and `sense`, the end of every step.
+    fn inject_and_sense(&mut self) {
+        let dt = self.dt;
         inject(
             &mut self.injection,
             &mut self.fields,

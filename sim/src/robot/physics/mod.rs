@@ -16,12 +16,14 @@
 //! Both are single-threaded and deterministic: the same inputs give bit-identical poses.
 mod discs;
 mod rapier;
+mod rapier_host;
 
 use super::{ColiasParams, Pose, obstacle_contacts};
 use crate::arena::Obstacles;
 use discs::DiscState;
 use glam::Vec2;
 use rapier::RapierState;
+pub use rapier_host::{MAX_HOSTED_ARENAS, RapierHost};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -49,6 +51,8 @@ pub struct ArenaPhysics {
     poses: Vec<Pose>,
     size: Vec2,
     radius: f32,
+    /// Each robot's mass, kg.
+    mass: f32,
     /// Static obstacles (none unless [`ArenaPhysics::set_obstacles`] gave some).
     obstacles: Arc<Obstacles>,
 }
@@ -73,6 +77,7 @@ impl ArenaPhysics {
             poses: Vec::with_capacity(poses.len()),
             size,
             radius,
+            mass: params.mass,
             obstacles: Arc::default(),
         };
         for pose in poses {
@@ -83,7 +88,13 @@ impl ArenaPhysics {
             });
         }
         if backend == PhysicsBackend::Rapier {
-            physics.solver = Solver::Rapier(RapierState::new(size, params, radius, &physics.poses));
+            physics.solver = Solver::Rapier(RapierState::new(
+                size,
+                params.mass,
+                radius,
+                &physics.poses,
+                &Obstacles::default(),
+            ));
         }
         physics
     }
@@ -92,8 +103,10 @@ impl ArenaPhysics {
     /// disc solver's push-out). Call once, before the first step.
     pub fn set_obstacles(&mut self, obstacles: Arc<Obstacles>) {
         if let Solver::Rapier(state) = &mut self.solver {
-            obstacle_contacts::add_colliders(&mut state.world, &obstacles, FRICTION);
-            state.has_obstacles = !obstacles.is_empty();
+            // Rebuilt, so that the obstacles come before the robots in rapier's order.
+            let free_steps = state.free_steps;
+            *state = RapierState::new(self.size, self.mass, self.radius, &self.poses, &obstacles);
+            state.free_steps = free_steps;
         }
         self.obstacles = obstacles;
     }
@@ -122,13 +135,7 @@ impl ArenaPhysics {
         if dt.is_nan() || dt <= 0.0 {
             return;
         }
-        let velocity = |i: usize| {
-            let (forward, yaw) = velocities.get(i).copied().unwrap_or((0.0, 0.0));
-            (
-                if forward.is_finite() { forward } else { 0.0 },
-                if yaw.is_finite() { yaw } else { 0.0 },
-            )
-        };
+        let velocity = |i: usize| velocity_of(velocities, i);
         let (lo, hi) = self.bounds();
         match &mut self.solver {
             Solver::Rapier(state) => state.step(
@@ -152,6 +159,53 @@ impl ArenaPhysics {
                 );
                 obstacle_contacts::push_out(&mut self.poses, self.radius, &self.obstacles, lo, hi);
             }
+        }
+    }
+
+    /// Moves this arena's rapier steps into slot `slot` of `host` (see [`RapierHost`]); the arena
+    /// must have the host's size and obstacles. Returns false, and changes nothing, for the disc
+    /// solver, another size or a slot the host does not have.
+    pub fn attach(&mut self, host: &mut RapierHost, slot: usize) -> bool {
+        if self.size != host.size() {
+            return false;
+        }
+        match &mut self.solver {
+            Solver::Rapier(state) => state.attach(host, slot, self.radius, self.mass),
+            Solver::Discs(_) => false,
+        }
+    }
+
+    /// The first half of a step in `host`: like [`Self::step`] for an arena that is not attached to
+    /// it (or uses the disc solver); else the arena's poses are final only after
+    /// [`RapierHost::step`] and [`Self::finish_in`].
+    pub fn step_in(&mut self, host: &mut RapierHost, velocities: &[(f32, f32)], dt: f32) {
+        if !matches!(self.solver, Solver::Rapier(_)) {
+            return self.step(velocities, dt);
+        }
+        if dt.is_nan() || dt <= 0.0 {
+            return;
+        }
+        let (lo, hi) = self.bounds();
+        let Solver::Rapier(state) = &mut self.solver else {
+            return;
+        };
+        state.step_in(
+            host,
+            &mut self.poses,
+            |i| velocity_of(velocities, i),
+            dt,
+            lo,
+            hi,
+            self.radius,
+            &self.obstacles,
+        );
+    }
+
+    /// The second half of a step in `host` (after [`RapierHost::step`]).
+    pub fn finish_in(&mut self, host: &mut RapierHost) {
+        let (lo, hi) = self.bounds();
+        if let Solver::Rapier(state) = &mut self.solver {
+            state.finish_in(host, &mut self.poses, lo, hi);
         }
     }
 
@@ -210,4 +264,13 @@ impl ArenaPhysics {
             0.5 * (lo + hi)
         }
     }
+}
+
+/// Robot `i`'s body velocity (forward, yaw rate): a stop when missing or not finite.
+fn velocity_of(velocities: &[(f32, f32)], i: usize) -> (f32, f32) {
+    let (forward, yaw) = velocities.get(i).copied().unwrap_or((0.0, 0.0));
+    (
+        if forward.is_finite() { forward } else { 0.0 },
+        if yaw.is_finite() { yaw } else { 0.0 },
+    )
 }

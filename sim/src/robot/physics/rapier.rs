@@ -1,13 +1,14 @@
 //! The rapier2d solver: dynamic discs driven by velocity in four thick static wall boxes.
 use super::FRICTION;
+use super::rapier_host::HostedArena;
 use crate::arena::Obstacles;
-use crate::robot::{ColiasParams, Pose};
+use crate::robot::Pose;
 use glam::Vec2;
 use rapier2d::math::Pose as Pose2;
 use rapier2d::prelude::{
-    CCDSolver, ColliderBuilder, ImpulseJointSet, IntegrationParameters, MultibodyJointSet,
-    PhysicsPipeline, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, Rotation, SoftBodySet,
-    SpringCoefficients, Vector,
+    CCDSolver, ColliderBuilder, ImpulseJointSet, IntegrationParameters, InteractionGroups,
+    MultibodyJointSet, PhysicsPipeline, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, Rotation,
+    SoftBodySet, SpringCoefficients, Vector,
 };
 use std::cell::RefCell;
 
@@ -61,12 +62,14 @@ pub(super) struct RapierState {
     /// stay empty (steps pass the thread's [`SharedSets`] instead).
     pub(super) world: Box<PhysicsWorld>,
     pub(super) bodies: Vec<RigidBodyHandle>,
+    /// Where the arena's full steps run while it lives in a [`RapierHost`] (`world` is then idle).
+    pub(super) hosted: Option<HostedArena>,
     /// Each body's pose as rapier holds it (rotation as a unit complex), mirrored here so that a
     /// step in which no contact is possible moves the bodies without a rapier call.
-    rotations: Vec<Rotation>,
-    translations: Vec<Vec2>,
-    /// Free steps moved the mirror since rapier's bodies were last written.
-    stale: bool,
+    pub(super) rotations: Vec<Rotation>,
+    pub(super) translations: Vec<Vec2>,
+    /// Free steps (or a host) moved the mirror since `world`'s bodies were last written.
+    pub(super) stale: bool,
     /// Whether free steps are taken (off: every step goes through rapier's pipeline).
     pub(super) free_steps: bool,
     /// Whether the arena has obstacles (set with them).
@@ -76,57 +79,116 @@ pub(super) struct RapierState {
     max_lin: f32,
 }
 
+/// A rapier world with this solver's integration parameters, empty.
+pub(super) fn empty_world() -> PhysicsWorld {
+    let mut world = PhysicsWorld::new();
+    world.gravity = Vector::ZERO;
+    world.integration_parameters = IntegrationParameters {
+        length_unit: LENGTH_UNIT,
+        num_solver_iterations: SUBSTEPS,
+        normalized_prediction_distance: PREDICTION_DISTANCE / LENGTH_UNIT,
+        contact_softness: SpringCoefficients::new(CONTACT_FREQUENCY, 10.0),
+        static_contact_softness: SpringCoefficients::new(CONTACT_FREQUENCY, 10.0),
+        // Recycling keeps a pair's old contact points until the pair moved 1 cm (rapier's
+        // 0.05 length units): half a robot radius of stale contact, and a history that free
+        // steps would change. Every pair is recomputed every step instead.
+        contact_recycling: false,
+        // No CCD: a robot moves at most 7 mm a step, well within the prediction distance.
+        max_ccd_substeps: 0,
+        ..IntegrationParameters::default()
+    };
+    world
+}
+
+/// Adds the four walls around an arena of `size` to `world`, in collision `groups`.
+pub(super) fn add_walls(world: &mut PhysicsWorld, size: Vec2, groups: InteractionGroups) {
+    let (w, h) = (size.x, size.y);
+    let t = WALL_HALF_THICKNESS;
+    // Left, right, bottom, top; the horizontal ones span the corners too.
+    let walls = [
+        (Vec2::new(-t, 0.5 * h), Vec2::new(t, 0.5 * h + 2.0 * t)),
+        (Vec2::new(w + t, 0.5 * h), Vec2::new(t, 0.5 * h + 2.0 * t)),
+        (Vec2::new(0.5 * w, -t), Vec2::new(0.5 * w + 2.0 * t, t)),
+        (Vec2::new(0.5 * w, h + t), Vec2::new(0.5 * w + 2.0 * t, t)),
+    ];
+    for (centre, half) in walls {
+        // A collider without a body, like the obstacles': it never moves.
+        world.insert_collider(
+            ColliderBuilder::cuboid(half.x, half.y)
+                .translation(centre)
+                .friction(FRICTION)
+                .restitution(0.0)
+                .collision_groups(groups),
+            None,
+        );
+    }
+}
+
+/// Adds one robot disc at `pose` to `world`, in collision `groups`.
+pub(super) fn add_robot(
+    world: &mut PhysicsWorld,
+    pose: &Pose,
+    radius: f32,
+    mass: f32,
+    groups: InteractionGroups,
+) -> RigidBodyHandle {
+    let (body, _) = world.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(pose.pos)
+            .rotation(pose.heading)
+            .can_sleep(false),
+        ColliderBuilder::ball(radius)
+            .mass(mass.max(1e-6))
+            .friction(FRICTION)
+            .restitution(0.0)
+            .collision_groups(groups),
+    );
+    body
+}
+
+/// One pipeline step of `world` by its `integration_parameters.dt`, with this thread's shared sets.
+pub(super) fn step_pipeline(w: &mut PhysicsWorld) {
+    SHARED.with_borrow_mut(|shared| {
+        shared.pipeline.step(
+            w.gravity,
+            &w.integration_parameters,
+            &mut w.islands,
+            &mut w.broad_phase,
+            &mut w.narrow_phase,
+            &mut w.bodies,
+            &mut w.colliders,
+            &mut shared.impulse_joints,
+            &mut shared.multibody_joints,
+            &mut shared.soft_bodies,
+            &mut shared.ccd_solver,
+            &(),
+            &(),
+        )
+    });
+}
+
 impl RapierState {
-    pub(super) fn new(size: Vec2, params: &ColiasParams, radius: f32, poses: &[Pose]) -> Self {
-        let mut world = PhysicsWorld::new();
-        world.gravity = Vector::ZERO;
-        world.integration_parameters = IntegrationParameters {
-            length_unit: LENGTH_UNIT,
-            num_solver_iterations: SUBSTEPS,
-            normalized_prediction_distance: PREDICTION_DISTANCE / LENGTH_UNIT,
-            contact_softness: SpringCoefficients::new(CONTACT_FREQUENCY, 10.0),
-            static_contact_softness: SpringCoefficients::new(CONTACT_FREQUENCY, 10.0),
-            // Recycling keeps a pair's old contact points until the pair moved 1 cm (rapier's
-            // 0.05 length units): half a robot radius of stale contact, and a history that free
-            // steps would change. Every pair is recomputed every step instead.
-            contact_recycling: false,
-            // No CCD: a robot moves at most 7 mm a step, well within the prediction distance.
-            max_ccd_substeps: 0,
-            ..IntegrationParameters::default()
-        };
-        let (w, h) = (size.x, size.y);
-        let t = WALL_HALF_THICKNESS;
-        // Left, right, bottom, top; the horizontal ones span the corners too.
-        let walls = [
-            (Vec2::new(-t, 0.5 * h), Vec2::new(t, 0.5 * h + 2.0 * t)),
-            (Vec2::new(w + t, 0.5 * h), Vec2::new(t, 0.5 * h + 2.0 * t)),
-            (Vec2::new(0.5 * w, -t), Vec2::new(0.5 * w + 2.0 * t, t)),
-            (Vec2::new(0.5 * w, h + t), Vec2::new(0.5 * w + 2.0 * t, t)),
-        ];
-        for (centre, half) in walls {
-            // A collider without a body, like the obstacles': it never moves.
-            world.insert_collider(
-                ColliderBuilder::cuboid(half.x, half.y)
-                    .translation(centre)
-                    .friction(FRICTION)
-                    .restitution(0.0),
-                None,
-            );
-        }
-        let mut bodies = Vec::with_capacity(poses.len());
-        for pose in poses {
-            let (body, _) = world.insert(
-                RigidBodyBuilder::dynamic()
-                    .translation(pose.pos)
-                    .rotation(pose.heading)
-                    .can_sleep(false),
-                ColliderBuilder::ball(radius)
-                    .mass(params.mass.max(1e-6))
-                    .friction(FRICTION)
-                    .restitution(0.0),
-            );
-            bodies.push(body);
-        }
+    /// The walls of an arena of `size`, its obstacles, then one robot disc at each pose, inserted in
+    /// the order a [`RapierHost`](super::RapierHost) has them, so that an arena steps alike in both.
+    pub(super) fn new(
+        size: Vec2,
+        mass: f32,
+        radius: f32,
+        poses: &[Pose],
+        obstacles: &Obstacles,
+    ) -> Self {
+        let mut world = empty_world();
+        add_walls(&mut world, size, InteractionGroups::all());
+        super::obstacle_contacts::add_colliders(
+            &mut world,
+            obstacles,
+            FRICTION,
+            InteractionGroups::all(),
+        );
+        let bodies: Vec<_> = poses
+            .iter()
+            .map(|pose| add_robot(&mut world, pose, radius, mass, InteractionGroups::all()))
+            .collect();
         let rotations = bodies
             .iter()
             .map(|&b| *world.bodies[b].rotation())
@@ -144,9 +206,10 @@ impl RapierState {
             translations,
             stale: false,
             free_steps: true,
-            has_obstacles: false,
+            has_obstacles: !obstacles.is_empty(),
             substeps,
             max_lin,
+            hosted: None,
         }
     }
 
@@ -163,34 +226,41 @@ impl RapierState {
         radius: f32,
         obstacles: &Obstacles,
     ) {
+        if let Some(hosted) = &mut self.hosted {
+            // Stepped alone: the host's copy falls behind.
+            hosted.stale = true;
+        }
         if self.free_steps && self.free_of_contacts(radius, lo, hi, obstacles) {
             self.free_step(velocity, dt);
         } else {
             self.rapier_step(velocity, dt);
         }
-        for (i, pose) in poses.iter_mut().enumerate() {
-            let p = self.translations[i];
-            let heading = self.rotations[i].angle();
-            let q = p.clamp(lo, hi);
-            if q != p || !q.is_finite() {
-                // The last guard: put it back inside and stop it.
-                let q = if q.is_finite() { q } else { pose.pos };
-                let body = &mut self.world.bodies[self.bodies[i]];
+        let world = &mut self.world;
+        settle(
+            &mut self.translations,
+            &self.rotations,
+            poses,
+            lo,
+            hi,
+            |i, q| {
+                let body = &mut world.bodies[self.bodies[i]];
                 body.set_translation(q, false);
                 body.set_linvel(Vec2::ZERO, false);
-                self.translations[i] = q;
-                *pose = Pose { pos: q, heading };
-            } else {
-                *pose = Pose { pos: p, heading };
-            }
-        }
+            },
+        );
     }
 
     /// True when rapier would find no contact at the start of this step: every robot is farther
     /// than its prediction distance (plus a margin) from the walls, the obstacles and every other
     /// robot. rapier builds its contacts from the poses at the start of a step only, so such a step
     /// has no constraint and moves every body freely.
-    fn free_of_contacts(&self, radius: f32, lo: Vec2, hi: Vec2, obstacles: &Obstacles) -> bool {
+    pub(super) fn free_of_contacts(
+        &self,
+        radius: f32,
+        lo: Vec2,
+        hi: Vec2,
+        obstacles: &Obstacles,
+    ) -> bool {
         let n = self.translations.len();
         if n > FREE_MAX_ROBOTS {
             return false;
@@ -219,7 +289,7 @@ impl RapierState {
     /// A step with no contact, integrated exactly as rapier's solver integrates a free body: the
     /// same speed caps and, per substep, the same linearised rotation and translation update, in
     /// the same f32 operations (a test compares the two bit for bit).
-    fn free_step(&mut self, velocity: impl Fn(usize) -> (f32, f32), dt: f32) {
+    pub(super) fn free_step(&mut self, velocity: impl Fn(usize) -> (f32, f32), dt: f32) {
         let (substeps, max_lin) = (self.substeps, self.max_lin);
         let sub_dt = dt / substeps as f32;
         let max_ang = MAX_ROTATION * (1.0 / dt);
@@ -266,24 +336,7 @@ impl RapierState {
             body.set_angvel(yaw, true);
         }
         self.stale = false;
-        let w = &mut self.world;
-        SHARED.with_borrow_mut(|shared| {
-            shared.pipeline.step(
-                w.gravity,
-                &w.integration_parameters,
-                &mut w.islands,
-                &mut w.broad_phase,
-                &mut w.narrow_phase,
-                &mut w.bodies,
-                &mut w.colliders,
-                &mut shared.impulse_joints,
-                &mut shared.multibody_joints,
-                &mut shared.soft_bodies,
-                &mut shared.ccd_solver,
-                &(),
-                &(),
-            )
-        });
+        step_pipeline(&mut self.world);
         for (i, &handle) in self.bodies.iter().enumerate() {
             let body = &self.world.bodies[handle];
             self.rotations[i] = *body.rotation();
@@ -293,6 +346,9 @@ impl RapierState {
 
     /// Teleports body `i` to `p`, `heading` at rest.
     pub(super) fn set_pose(&mut self, i: usize, p: Vec2, heading: f32) {
+        if let Some(hosted) = &mut self.hosted {
+            hosted.stale = true;
+        }
         if self.stale {
             // Write the other bodies' free moves first: this one's alone would be kept.
             for (k, &handle) in self.bodies.iter().enumerate() {
@@ -311,8 +367,33 @@ impl RapierState {
     }
 }
 
+/// The last guard after a step: every mirrored position outside `lo..hi` (or not finite) is put back
+/// inside (`fix` is told, to put its body back and stop it), and `poses` take the mirror's values.
+pub(super) fn settle(
+    translations: &mut [Vec2],
+    rotations: &[Rotation],
+    poses: &mut [Pose],
+    lo: Vec2,
+    hi: Vec2,
+    mut fix: impl FnMut(usize, Vec2),
+) {
+    for (i, pose) in poses.iter_mut().enumerate() {
+        let p = translations[i];
+        let heading = rotations[i].angle();
+        let q = p.clamp(lo, hi);
+        if q != p || !q.is_finite() {
+            let q = if q.is_finite() { q } else { pose.pos };
+            fix(i, q);
+            translations[i] = q;
+            *pose = Pose { pos: q, heading };
+        } else {
+            *pose = Pose { pos: p, heading };
+        }
+    }
+}
+
 /// The unit vector along a body's heading: its rotation's own cosine and sine (rapier keeps the
 /// rotation normalised), without the round trip through an angle.
-fn heading_vector(rotation: Rotation) -> Vec2 {
+pub(super) fn heading_vector(rotation: Rotation) -> Vec2 {
     Vec2::new(rotation.re, rotation.im)
 }

@@ -1,0 +1,200 @@
+//! A step of many worlds, in fixed chunks of [`CHUNK`] worlds stepped one after the other by one
+//! task. The worlds of a chunk that use rapier take their contact steps together in the chunk's
+//! [`RapierHost`]: one rapier step for the chunk instead of one per world, with each world's results
+//! unchanged (see `colcos_sim::robot::RapierHost`). Chunks are fixed by world index, so results do
+//! not depend on the number of threads.
+use crate::error::Result;
+use crate::world_slot::WorldSlot;
+use crate::world_step::{Begun, Ctx, Out, begin_world, finish_world};
+use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::robot::{PhysicsBackend, RapierHost};
+use colcos_sim::scenario::Scenario;
+use rayon::prelude::*;
+
+/// Worlds per chunk, and per rapier host (its most arenas: one collision group each).
+pub(crate) const CHUNK: usize = 31;
+/// Most robots a world may have to join a host: larger worlds always have contacts, so their
+/// steps go through rapier anyway and gain nothing from sharing it.
+const HOST_MAX_ROBOTS: usize = 64;
+
+/// One rapier host per chunk of `worlds` (`None` where the worlds step alone: the disc solver,
+/// large worlds, a single world).
+pub(crate) fn new_hosts(
+    scenario: &Scenario,
+    worlds: usize,
+    slots: &[WorldSlot],
+) -> Vec<Option<RapierHost>> {
+    let chunks = worlds.div_ceil(CHUNK);
+    let hosted = worlds > 1
+        && scenario.spec.physics == PhysicsBackend::Rapier
+        && scenario.robot_count() <= HOST_MAX_ROBOTS;
+    (0..chunks)
+        .map(|_| {
+            let world = &slots.first()?.world;
+            hosted.then(|| RapierHost::new(world.arena(), world.obstacles(), CHUNK))
+        })
+        .collect()
+}
+
+/// Moves every world's rapier steps into its chunk's host.
+pub(crate) fn attach_all(slots: &mut [WorldSlot], hosts: &mut [Option<RapierHost>]) {
+    slots
+        .par_chunks_mut(CHUNK)
+        .zip(hosts.par_iter_mut())
+        .for_each(|(slots, host)| {
+            if let Some(host) = host {
+                for (i, slot) in slots.iter_mut().enumerate() {
+                    slot.world.attach_physics(host, i);
+                }
+            }
+        });
+}
+
+/// The environment's output buffers, whole.
+pub(crate) struct Buffers<'a> {
+    pub(crate) obs: &'a mut [f32],
+    pub(crate) rewards: &'a mut [f32],
+    pub(crate) terminated: &'a mut [bool],
+    pub(crate) truncated: &'a mut [bool],
+    pub(crate) state: &'a mut [f32],
+    pub(crate) patch: &'a mut [u8],
+    pub(crate) final_obs: &'a mut [f32],
+    pub(crate) final_mask: &'a mut [bool],
+    pub(crate) shield: &'a mut [u8],
+}
+
+/// Per-world lengths of the buffers: agents, observation values, state values, patch bytes.
+#[derive(Clone, Copy)]
+pub(crate) struct Lengths {
+    pub(crate) agents: usize,
+    pub(crate) obs: usize,
+    pub(crate) state: usize,
+    pub(crate) patch: usize,
+}
+
+impl Buffers<'_> {
+    /// World `i`'s slices.
+    fn world(&mut self, i: usize, len: Lengths) -> Out<'_> {
+        let part = |n: usize| i * n..(i + 1) * n;
+        Out {
+            obs: &mut self.obs[part(len.obs)],
+            rewards: &mut self.rewards[part(len.agents)],
+            terminated: &mut self.terminated[part(len.agents)],
+            truncated: &mut self.truncated[part(len.agents)],
+            state: &mut self.state[part(len.state)],
+            patch: &mut self.patch[part(len.patch)],
+            final_obs: &mut self.final_obs[part(len.obs)],
+            final_mask: &mut self.final_mask[i],
+            shield: &mut self.shield[part(len.agents)],
+        }
+    }
+}
+
+/// One step of every world, chunk by chunk on the current rayon pool.
+pub(crate) fn step_batch(
+    ctx: &Ctx,
+    slots: &mut [WorldSlot],
+    hosts: &mut [Option<RapierHost>],
+    commands: &[WheelCommand],
+    buffers: Buffers,
+    len: Lengths,
+) -> Result<()> {
+    let c = CHUNK;
+    let Buffers {
+        obs,
+        rewards,
+        terminated,
+        truncated,
+        state,
+        patch,
+        final_obs,
+        final_mask,
+        shield,
+    } = buffers;
+    let chunks = obs
+        .par_chunks_mut(c * len.obs)
+        .zip(rewards.par_chunks_mut(c * len.agents))
+        .zip(terminated.par_chunks_mut(c * len.agents))
+        .zip(truncated.par_chunks_mut(c * len.agents))
+        .zip(state.par_chunks_mut(c * len.state))
+        .zip(patch.par_chunks_mut(c * len.patch))
+        .zip(final_obs.par_chunks_mut(c * len.obs))
+        .zip(final_mask.par_chunks_mut(c))
+        .zip(shield.par_chunks_mut(c * len.agents))
+        .map(
+            |(
+                (
+                    ((((((obs, rewards), terminated), truncated), state), patch), final_obs),
+                    final_mask,
+                ),
+                shield,
+            )| {
+                Buffers {
+                    obs,
+                    rewards,
+                    terminated,
+                    truncated,
+                    state,
+                    patch,
+                    final_obs,
+                    final_mask,
+                    shield,
+                }
+            },
+        );
+    slots
+        .par_chunks_mut(c)
+        .zip(hosts.par_iter_mut())
+        .zip(commands.par_chunks(c * len.agents))
+        .zip(chunks)
+        .enumerate()
+        .try_for_each(|(k, (((slots, host), commands), mut buffers))| {
+            step_chunk(
+                ctx,
+                k * c,
+                slots,
+                host.as_mut(),
+                commands,
+                &mut buffers,
+                len,
+            )
+        })
+}
+
+/// One step of the worlds of a chunk (the first is world `first`): each begins its step, the host
+/// steps, each finishes. A world whose step fails leaves the others' steps whole; the first error
+/// is returned.
+fn step_chunk(
+    ctx: &Ctx,
+    first: usize,
+    slots: &mut [WorldSlot],
+    mut host: Option<&mut RapierHost>,
+    commands: &[WheelCommand],
+    buffers: &mut Buffers,
+    len: Lengths,
+) -> Result<()> {
+    let mut begun = [Begun::Reset; CHUNK];
+    let mut result = Ok(());
+    for (i, slot) in slots.iter_mut().enumerate() {
+        let cmds = &commands[i * len.agents..(i + 1) * len.agents];
+        let mut out = buffers.world(i, len);
+        let in_host = host.as_deref_mut().map(|h| (h, i));
+        match begin_world(ctx, first + i, slot, cmds, &mut out, in_host) {
+            Ok(b) => begun[i] = b,
+            Err(err) if result.is_ok() => result = Err(err),
+            Err(_) => {}
+        }
+    }
+    if let Some(host) = host.as_deref_mut() {
+        host.step(ctx.scenario.spec.dt);
+    }
+    for (i, slot) in slots.iter_mut().enumerate() {
+        let mut out = buffers.world(i, len);
+        let in_host = host.as_deref_mut().map(|h| (h, i));
+        let finished = finish_world(ctx, first + i, slot, &mut out, begun[i], in_host);
+        if result.is_ok() {
+            result = finished;
+        }
+    }
+    result
+}
