@@ -1,53 +1,74 @@
-//! A step of many worlds, in fixed chunks of [`CHUNK`] worlds stepped one after the other by one
-//! task. The worlds of a chunk that use rapier take their contact steps together in the chunk's
+//! A step of many worlds, in fixed chunks of worlds stepped one after the other by one task. The
+//! worlds of a chunk that use rapier take their contact steps together in the chunk's
 //! [`RapierHost`]: one rapier step for the chunk instead of one per world, with each world's results
-//! unchanged (see `colcos_sim::robot::RapierHost`). Chunks are fixed by world index, so results do
-//! not depend on the number of threads.
+//! unchanged (see `colcos_sim::robot::RapierHost`). Chunks are fixed by world index and count, so
+//! results do not depend on the number of threads.
 use crate::error::Result;
 use crate::world_slot::WorldSlot;
 use crate::world_step::{Begun, Ctx, Out, begin_world, finish_world};
 use colcos_sim::behaviour::WheelCommand;
-use colcos_sim::robot::{PhysicsBackend, RapierHost};
+use colcos_sim::robot::{MAX_HOSTED_ARENAS, PhysicsBackend, RapierHost};
 use colcos_sim::scenario::Scenario;
 use rayon::prelude::*;
 
-/// Worlds per chunk, and per rapier host (its most arenas: one collision group each).
-pub(crate) const CHUNK: usize = 31;
+/// Fewest chunks a batch is cut into where worlds share hosts, so that threads share the work
+/// evenly (up to 31 worlds a chunk from 1,024 worlds on).
+const MIN_CHUNKS: usize = 32;
 /// Most robots a world may have to join a host: larger worlds always have contacts, so their
 /// steps go through rapier anyway and gain nothing from sharing it.
 const HOST_MAX_ROBOTS: usize = 64;
 
-/// One rapier host per chunk of `worlds` (`None` where the worlds step alone: the disc solver,
-/// large worlds, a single world).
-pub(crate) fn new_hosts(
-    scenario: &Scenario,
-    worlds: usize,
-    slots: &[WorldSlot],
-) -> Vec<Option<RapierHost>> {
-    let chunks = worlds.div_ceil(CHUNK);
-    let hosted = worlds > 1
-        && scenario.spec.physics == PhysicsBackend::Rapier
-        && scenario.robot_count() <= HOST_MAX_ROBOTS;
-    (0..chunks)
-        .map(|_| {
-            let world = &slots.first()?.world;
-            hosted.then(|| RapierHost::new(world.arena(), world.obstacles(), CHUNK))
-        })
-        .collect()
+/// How a batch is cut into chunks, and each chunk's rapier host (`None` where its worlds step
+/// alone: the disc solver, large worlds, batches too small to share).
+pub(crate) struct Chunks {
+    size: usize,
+    hosts: Vec<Option<RapierHost>>,
 }
 
-/// Moves every world's rapier steps into its chunk's host.
-pub(crate) fn attach_all(slots: &mut [WorldSlot], hosts: &mut [Option<RapierHost>]) {
-    slots
-        .par_chunks_mut(CHUNK)
-        .zip(hosts.par_iter_mut())
-        .for_each(|(slots, host)| {
+impl Chunks {
+    /// The chunks of a batch of `slots` of `scenario`.
+    pub(crate) fn new(scenario: &Scenario, slots: &[WorldSlot]) -> Self {
+        let worlds = slots.len();
+        let size = (worlds / MIN_CHUNKS).clamp(1, MAX_HOSTED_ARENAS);
+        let hosted = size > 1
+            && scenario.spec.physics == PhysicsBackend::Rapier
+            && scenario.robot_count() <= HOST_MAX_ROBOTS;
+        let size = if hosted { size } else { 1 };
+        let hosts = (0..worlds.div_ceil(size))
+            .map(|_| {
+                let world = &slots.first()?.world;
+                hosted.then(|| RapierHost::new(world.arena(), world.obstacles(), size))
+            })
+            .collect();
+        Chunks { size, hosts }
+    }
+
+    /// Worlds per chunk (the last may have fewer).
+    pub(crate) fn size(&self) -> usize {
+        self.size
+    }
+
+    /// Each chunk of `slots` with its host.
+    pub(crate) fn par_iter_mut<'a>(
+        &'a mut self,
+        slots: &'a mut [WorldSlot],
+    ) -> impl IndexedParallelIterator<Item = (&'a mut [WorldSlot], Option<&'a mut RapierHost>)>
+    {
+        slots
+            .par_chunks_mut(self.size)
+            .zip(self.hosts.par_iter_mut().map(Option::as_mut))
+    }
+
+    /// Moves every world's rapier steps into its chunk's host.
+    pub(crate) fn attach_all(&mut self, slots: &mut [WorldSlot]) {
+        self.par_iter_mut(slots).for_each(|(slots, host)| {
             if let Some(host) = host {
                 for (i, slot) in slots.iter_mut().enumerate() {
                     slot.world.attach_physics(host, i);
                 }
             }
         });
+    }
 }
 
 /// The environment's output buffers, whole.
@@ -94,12 +115,12 @@ impl Buffers<'_> {
 pub(crate) fn step_batch(
     ctx: &Ctx,
     slots: &mut [WorldSlot],
-    hosts: &mut [Option<RapierHost>],
+    chunks: &mut Chunks,
     commands: &[WheelCommand],
     buffers: Buffers,
     len: Lengths,
 ) -> Result<()> {
-    let c = CHUNK;
+    let c = chunks.size();
     let Buffers {
         obs,
         rewards,
@@ -111,7 +132,7 @@ pub(crate) fn step_batch(
         final_mask,
         shield,
     } = buffers;
-    let chunks = obs
+    let outs = obs
         .par_chunks_mut(c * len.obs)
         .zip(rewards.par_chunks_mut(c * len.agents))
         .zip(terminated.par_chunks_mut(c * len.agents))
@@ -142,22 +163,13 @@ pub(crate) fn step_batch(
                 }
             },
         );
-    slots
-        .par_chunks_mut(c)
-        .zip(hosts.par_iter_mut())
+    chunks
+        .par_iter_mut(slots)
         .zip(commands.par_chunks(c * len.agents))
-        .zip(chunks)
+        .zip(outs)
         .enumerate()
         .try_for_each(|(k, (((slots, host), commands), mut buffers))| {
-            step_chunk(
-                ctx,
-                k * c,
-                slots,
-                host.as_mut(),
-                commands,
-                &mut buffers,
-                len,
-            )
+            step_chunk(ctx, k * c, slots, host, commands, &mut buffers, len)
         })
 }
 
@@ -173,7 +185,7 @@ fn step_chunk(
     buffers: &mut Buffers,
     len: Lengths,
 ) -> Result<()> {
-    let mut begun = [Begun::Reset; CHUNK];
+    let mut begun = [Begun::Reset; MAX_HOSTED_ARENAS];
     let mut result = Ok(());
     for (i, slot) in slots.iter_mut().enumerate() {
         let cmds = &commands[i * len.agents..(i + 1) * len.agents];

@@ -5,7 +5,7 @@
 //! binding may hand out views of them that stay valid for the environment's lifetime. Each `step` and
 //! `reset` overwrites them in place.
 use crate::backend::EnvBackend;
-use crate::batch_step::{Buffers, CHUNK, Lengths, attach_all, new_hosts, step_batch};
+use crate::batch_step::{Buffers, Chunks, Lengths, step_batch};
 use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
 use crate::encoding::{self, OBS_DIM};
 use crate::error::{EnvError, Result};
@@ -16,7 +16,6 @@ use crate::world_output::{write_obs, write_patch, write_state};
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
 use crate::world_step::{Ctx, Out, step_world};
-use colcos_sim::robot::RapierHost;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::shield::Shield;
 use colcos_sim::world::World;
@@ -41,8 +40,8 @@ pub struct VecEnv {
     patch_cfg: Option<PatchConfig>,
     pool: rayon::ThreadPool,
     slots: Vec<WorldSlot>,
-    /// One rapier host per chunk of worlds, where they share one (see `batch_step`).
-    hosts: Vec<Option<RapierHost>>,
+    /// The chunks the worlds are stepped in, with their rapier hosts (see `batch_step`).
+    chunks: Chunks,
     obs: Vec<f32>,
     rewards: Vec<f32>,
     terminated: Vec<bool>,
@@ -155,8 +154,8 @@ impl VecEnv {
                 .collect::<Result<Vec<_>>>()
         })?;
         let mut slots = slots;
-        let mut hosts = new_hosts(&scenario, e, &slots);
-        pool.install(|| attach_all(&mut slots, &mut hosts));
+        let mut chunks = Chunks::new(&scenario, &slots);
+        pool.install(|| chunks.attach_all(&mut slots));
         backend.settle(&slots[0].world);
         let mut env = VecEnv {
             spec,
@@ -167,7 +166,7 @@ impl VecEnv {
             patch_cfg: cfg.patch,
             pool,
             slots,
-            hosts,
+            chunks,
             obs: vec![0.0; e * n * OBS_DIM],
             rewards: vec![0.0; e * n],
             terminated: vec![false; e * n],
@@ -301,15 +300,13 @@ impl VecEnv {
         // A seed restarts the episode count; the first reset after construction replays episode 0.
         let restart = seed.is_some();
         let first = self.needs_reset;
-        let (slots, hosts) = (&mut self.slots, &mut self.hosts);
+        let (slots, chunks) = (&mut self.slots, &mut self.chunks);
+        let size = chunks.size();
         self.pool.install(|| {
-            slots
-                .par_chunks_mut(CHUNK)
-                .zip(hosts.par_iter_mut())
-                .enumerate()
-                .try_for_each(|(k, (slots, host))| -> Result<()> {
+            chunks.par_iter_mut(slots).enumerate().try_for_each(
+                |(k, (slots, mut host))| -> Result<()> {
                     for (i, slot) in slots.iter_mut().enumerate() {
-                        let w = k * CHUNK + i;
+                        let w = k * size + i;
                         if mask.is_none_or(|m| m[w]) {
                             let episode = if restart {
                                 0
@@ -318,12 +315,13 @@ impl VecEnv {
                             } else {
                                 slot.episode + 1
                             };
-                            let host = host.as_mut().map(|h| (h, i));
+                            let host = host.as_deref_mut().map(|h| (h, i));
                             *slot = WorldSlot::build(scenario, task, backend, w, episode, host)?;
                         }
                     }
                     Ok(())
-                })
+                },
+            )
         })?;
         if mask.is_none() {
             self.needs_reset = false;
@@ -392,9 +390,9 @@ impl VecEnv {
             final_mask: &mut self.final_mask,
             shield: &mut self.shield_flags,
         };
-        let (slots, hosts, commands) = (&mut self.slots, &mut self.hosts, &self.commands);
+        let (slots, chunks, commands) = (&mut self.slots, &mut self.chunks, &self.commands);
         self.pool
-            .install(|| step_batch(&ctx, slots, hosts, commands, buffers, len))
+            .install(|| step_batch(&ctx, slots, chunks, commands, buffers, len))
     }
 
     /// Checks and decodes the actions into wheel commands.

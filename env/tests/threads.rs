@@ -1,13 +1,13 @@
 //! The batched environment gives the same observations, rewards, flags and state whatever the
 //! number of worker threads, for both contact solvers: worlds stepped on different threads (which
-//! share a thread's rapier pipeline with different neighbours), in several rapier hosts of up to 31
-//! worlds, and rebuilt by autoreset.
+//! share a thread's rapier pipeline with different neighbours), 31 worlds to a shared rapier host in
+//! 32 hosts, and rebuilt by autoreset.
 use colcos_env::{Actions, EnvConfig, VecEnv};
 use colcos_sim::robot::PhysicsBackend;
 
 fn run(task: &str, maze: bool, physics: PhysicsBackend, threads: usize) -> Vec<u32> {
     let mut cfg = EnvConfig::new(task);
-    cfg.num_envs = 70;
+    cfg.num_envs = 992;
     cfg.max_cycles = 70;
     cfg.seed = 3;
     cfg.num_threads = Some(threads);
@@ -19,7 +19,7 @@ fn run(task: &str, maze: bool, physics: PhysicsBackend, threads: usize) -> Vec<u
     env.reset(Some(3), None).unwrap();
     let len = env.spec().num_envs * env.spec().num_agents * 2;
     let mut out = Vec::new();
-    for t in 0..160 {
+    for t in 0..80 {
         // Full-speed pushes into each other and the walls, changing every few steps.
         let a: Vec<f32> = (0..len)
             .map(|k| ((k * 13 + (t / 7) * 5) as f32 * 0.61).sin().signum())
