@@ -13,7 +13,8 @@
 //!   walls. Several times faster than rapier for large swarms (10,000 robots), with the same
 //!   guarantees (inside the arena, small overlaps) but no momentum exchange.
 //!
-//! Both are single-threaded and deterministic: the same inputs give bit-identical poses.
+//! Both are single-threaded and deterministic: the same inputs give bit-identical poses. Many small
+//! rapier arenas can share one rapier world, a [`RapierHost`], and take their contact steps together.
 mod discs;
 mod rapier;
 mod rapier_host;
