@@ -62,7 +62,8 @@ pub(super) struct RapierState {
     /// stay empty (steps pass the thread's [`SharedSets`] instead).
     pub(super) world: Box<PhysicsWorld>,
     pub(super) bodies: Vec<RigidBodyHandle>,
-    /// Where the arena's full steps run while it lives in a [`RapierHost`] (`world` is then idle).
+    /// Where the arena's full steps run while it lives in a [`RapierHost`](super::RapierHost)
+    /// (`world` is then idle).
     pub(super) hosted: Option<HostedArena>,
     /// Each body's pose as rapier holds it (rotation as a unit complex), mirrored here so that a
     /// step in which no contact is possible moves the bodies without a rapier call.
