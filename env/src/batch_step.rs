@@ -95,7 +95,7 @@ pub(crate) struct Lengths {
 
 impl Buffers<'_> {
     /// World `i`'s slices.
-    fn world(&mut self, i: usize, len: Lengths) -> Out<'_> {
+    pub(crate) fn world(&mut self, i: usize, len: Lengths) -> Out<'_> {
         let part = |n: usize| i * n..(i + 1) * n;
         Out {
             obs: &mut self.obs[part(len.obs)],

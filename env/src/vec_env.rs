@@ -15,7 +15,7 @@ pub use crate::world_output::render_world;
 use crate::world_output::{write_obs, write_patch, write_state};
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
-use crate::world_step::{Ctx, Out, step_world};
+use crate::world_step::{Ctx, step_world};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::shield::Shield;
 use colcos_sim::world::World;
@@ -357,29 +357,13 @@ impl VecEnv {
             patch: self.patch_cfg,
             shield: self.shield,
         };
-        if let [slot] = self.slots.as_mut_slice() {
-            // One world (a PettingZoo `parallel_env`): step it on the calling thread. Handing a single
-            // world to the pool costs two thread wake-ups per step, a third of the step at this size.
-            let mut out = Out {
-                obs: &mut self.obs,
-                rewards: &mut self.rewards,
-                terminated: &mut self.terminated,
-                truncated: &mut self.truncated,
-                state: &mut self.state,
-                patch: &mut self.patch,
-                final_obs: &mut self.final_obs,
-                final_mask: &mut self.final_mask[0],
-                shield: &mut self.shield_flags,
-            };
-            return step_world(&ctx, 0, slot, &self.commands, &mut out);
-        }
         let len = Lengths {
             agents: n,
             obs: n * OBS_DIM,
             state: self.state_dim.max(1),
             patch: n * self.patch_len.max(1),
         };
-        let buffers = Buffers {
+        let mut buffers = Buffers {
             obs: &mut self.obs,
             rewards: &mut self.rewards,
             terminated: &mut self.terminated,
@@ -390,6 +374,11 @@ impl VecEnv {
             final_mask: &mut self.final_mask,
             shield: &mut self.shield_flags,
         };
+        if let [slot] = self.slots.as_mut_slice() {
+            // One world (a PettingZoo `parallel_env`): step it on the calling thread. Handing a single
+            // world to the pool costs two thread wake-ups per step, a third of the step at this size.
+            return step_world(&ctx, 0, slot, &self.commands, &mut buffers.world(0, len));
+        }
         let (slots, chunks, commands) = (&mut self.slots, &mut self.chunks, &self.commands);
         self.pool
             .install(|| step_batch(&ctx, slots, chunks, commands, buffers, len))

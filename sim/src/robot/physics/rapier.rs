@@ -7,8 +7,8 @@ use glam::Vec2;
 use rapier2d::math::Pose as Pose2;
 use rapier2d::prelude::{
     CCDSolver, ColliderBuilder, ImpulseJointSet, IntegrationParameters, InteractionGroups,
-    MultibodyJointSet, PhysicsPipeline, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, Rotation,
-    SoftBodySet, SpringCoefficients, Vector,
+    MultibodyJointSet, PhysicsPipeline, PhysicsWorld, RigidBody, RigidBodyBuilder, RigidBodyHandle,
+    RigidBodySet, Rotation, SoftBodySet, SpringCoefficients, Vector,
 };
 use std::cell::RefCell;
 
@@ -243,11 +243,7 @@ impl RapierState {
             poses,
             lo,
             hi,
-            |i, q| {
-                let body = &mut world.bodies[self.bodies[i]];
-                body.set_translation(q, false);
-                body.set_linvel(Vec2::ZERO, false);
-            },
+            |i, q| put_back(&mut world.bodies[self.bodies[i]], q),
         );
     }
 
@@ -324,25 +320,18 @@ impl RapierState {
     /// A full rapier step (after writing the poses free steps moved into rapier's bodies).
     fn rapier_step(&mut self, velocity: impl Fn(usize) -> (f32, f32), dt: f32) {
         self.world.integration_parameters.dt = dt;
-        for (i, &handle) in self.bodies.iter().enumerate() {
-            let (forward, yaw) = velocity(i);
-            let body = &mut self.world.bodies[handle];
-            if self.stale {
-                body.set_position(
-                    Pose2::from_parts(self.translations[i], self.rotations[i]),
-                    true,
-                );
-            }
-            body.set_linvel(heading_vector(self.rotations[i]) * forward, true);
-            body.set_angvel(yaw, true);
-        }
+        let (translations, rotations) = (&mut self.translations, &mut self.rotations);
+        drive_bodies(
+            &mut self.world.bodies,
+            &self.bodies,
+            translations,
+            rotations,
+            velocity,
+            self.stale,
+        );
         self.stale = false;
         step_pipeline(&mut self.world);
-        for (i, &handle) in self.bodies.iter().enumerate() {
-            let body = &self.world.bodies[handle];
-            self.rotations[i] = *body.rotation();
-            self.translations[i] = body.translation();
-        }
+        read_bodies(&self.world.bodies, &self.bodies, translations, rotations);
     }
 
     /// Teleports body `i` to `p`, `heading` at rest.
@@ -366,6 +355,48 @@ impl RapierState {
         body.set_linvel(Vec2::ZERO, true);
         body.set_angvel(0.0, true);
     }
+}
+
+/// Writes every robot's body velocity (forward, yaw rate) into its body, and with `write_poses` its
+/// mirrored pose too, and wakes the body.
+pub(super) fn drive_bodies(
+    bodies: &mut RigidBodySet,
+    handles: &[RigidBodyHandle],
+    translations: &[Vec2],
+    rotations: &[Rotation],
+    velocity: impl Fn(usize) -> (f32, f32),
+    write_poses: bool,
+) {
+    for (i, &handle) in handles.iter().enumerate() {
+        let (forward, yaw) = velocity(i);
+        let body = &mut bodies[handle];
+        if write_poses {
+            body.set_position(Pose2::from_parts(translations[i], rotations[i]), true);
+        }
+        body.set_linvel(heading_vector(rotations[i]) * forward, true);
+        body.set_angvel(yaw, true);
+        body.wake_up(true);
+    }
+}
+
+/// Every body's pose, read back into the mirror.
+pub(super) fn read_bodies(
+    bodies: &RigidBodySet,
+    handles: &[RigidBodyHandle],
+    translations: &mut [Vec2],
+    rotations: &mut [Rotation],
+) {
+    for (i, &handle) in handles.iter().enumerate() {
+        let body = &bodies[handle];
+        rotations[i] = *body.rotation();
+        translations[i] = body.translation();
+    }
+}
+
+/// Puts a body the last guard caught back at `q`, stopped.
+pub(super) fn put_back(body: &mut RigidBody, q: Vec2) {
+    body.set_translation(q, false);
+    body.set_linvel(Vec2::ZERO, false);
 }
 
 /// The last guard after a step: every mirrored position outside `lo..hi` (or not finite) is put back

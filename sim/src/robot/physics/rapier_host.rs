@@ -190,20 +190,14 @@ impl RapierState {
             );
             return;
         }
-        let stale = hosted.stale;
-        for (i, &handle) in slot.bodies.iter().enumerate() {
-            let (forward, yaw) = velocity(i);
-            let body = &mut host.world.bodies[handle];
-            if stale {
-                body.set_position(
-                    rapier2d::math::Pose::from_parts(self.translations[i], self.rotations[i]),
-                    true,
-                );
-            }
-            body.set_linvel(rapier::heading_vector(self.rotations[i]) * forward, true);
-            body.set_angvel(yaw, true);
-            body.wake_up(true);
-        }
+        rapier::drive_bodies(
+            &mut host.world.bodies,
+            &slot.bodies,
+            &self.translations,
+            &self.rotations,
+            velocity,
+            hosted.stale,
+        );
         slot.awake = true;
         host.pending += 1;
         // The arena's own world no longer holds its poses.
@@ -229,22 +223,14 @@ impl RapierState {
         hosted.pending = false;
         let bodies = &mut host.world.bodies;
         let handles = &host.slots[hosted.slot].bodies;
-        for (i, &handle) in handles.iter().enumerate() {
-            let body = &bodies[handle];
-            self.rotations[i] = *body.rotation();
-            self.translations[i] = body.translation();
-        }
+        rapier::read_bodies(bodies, handles, &mut self.translations, &mut self.rotations);
         settle(
             &mut self.translations,
             &self.rotations,
             poses,
             lo,
             hi,
-            |i, q| {
-                let body = &mut bodies[handles[i]];
-                body.set_translation(q, false);
-                body.set_linvel(Vec2::ZERO, false);
-            },
+            |i, q| rapier::put_back(&mut bodies[handles[i]], q),
         );
     }
 }
