@@ -1,8 +1,9 @@
 //! A step of many worlds, in fixed chunks of worlds stepped one after the other by one task. The
 //! worlds of a chunk that use rapier take their contact steps together in the chunk's
-//! [`RapierHost`]: one rapier step for the chunk instead of one per world, with each world's results
-//! unchanged (see `colcos_sim::robot::RapierHost`). Chunks are fixed by world index and count, so
-//! results do not depend on the number of threads.
+//! [`RapierHost`]: one rapier step for the chunk instead of one per world, each world moving as it
+//! would alone while none of its robots touches two things at once (see
+//! `colcos_sim::robot::RapierHost`). Chunks are fixed by world index and count, so results do not
+//! depend on the number of threads.
 use crate::error::Result;
 use crate::world_slot::WorldSlot;
 use crate::world_step::{Begun, Ctx, Out, begin_world, finish_world};
@@ -12,7 +13,7 @@ use colcos_sim::scenario::Scenario;
 use rayon::prelude::*;
 
 /// Fewest chunks a batch is cut into where worlds share hosts, so that threads share the work
-/// evenly (up to 31 worlds a chunk from 1,024 worlds on).
+/// evenly (31 worlds a chunk from 992 worlds on).
 const MIN_CHUNKS: usize = 32;
 /// Most robots a world may have to join a host: larger worlds always have contacts, so their
 /// steps go through rapier anyway and gain nothing from sharing it.

@@ -160,6 +160,14 @@ fn arenas_that_do_not_fit_the_host_are_not_attached() {
     assert!(!other_size.attach(&mut host, 0));
     let mut discs = ArenaPhysics::with_backend(size, &params, &poses, PhysicsBackend::Discs);
     assert!(!discs.attach(&mut host, 0));
+    let mut other_obstacles = ArenaPhysics::new(size, &params, &poses);
+    let spec = colcos_sim::scenario::parse_spec(
+        "duration = 1.0\n[[obstacles]]\nshape = \"box\"\ncentre = [0.2, 0.2]\nsize = [0.05, 0.05]\n",
+    )
+    .unwrap();
+    let boxes = Obstacles::build(&spec.obstacles, size, std::path::Path::new(".")).unwrap();
+    other_obstacles.set_obstacles(std::sync::Arc::new(boxes));
+    assert!(!other_obstacles.attach(&mut host, 0));
     let mut rapier = ArenaPhysics::new(size, &params, &poses);
     assert!(!rapier.attach(&mut host, 2), "slot 2 of 2");
     assert!(rapier.attach(&mut host, 1));

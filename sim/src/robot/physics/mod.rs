@@ -163,11 +163,12 @@ impl ArenaPhysics {
         }
     }
 
-    /// Moves this arena's rapier steps into slot `slot` of `host` (see [`RapierHost`]); the arena
-    /// must have the host's size and obstacles. Returns false, and changes nothing, for the disc
-    /// solver, another size or a slot the host does not have.
+    /// Moves this arena's rapier steps into slot `slot` of `host` (see [`RapierHost`]). Returns
+    /// false, and changes nothing, for the disc solver, an arena of another size or with other
+    /// obstacles than the host's, or a slot the host does not have.
     pub fn attach(&mut self, host: &mut RapierHost, slot: usize) -> bool {
-        if self.size != host.size() {
+        let size = self.size.max(Vec2::ZERO);
+        if !host.fits(size, &self.obstacles) {
             return false;
         }
         match &mut self.solver {

@@ -33,6 +33,8 @@ pub const MAX_HOSTED_ARENAS: usize = 31;
 pub struct RapierHost {
     world: Box<PhysicsWorld>,
     size: Vec2,
+    /// The bounds of every obstacle part, to recognise arenas with the same obstacles.
+    obstacle_bounds: Vec<(Vec2, Vec2)>,
     slots: Vec<HostSlot>,
     /// Arenas whose bodies wait for the next pipeline step.
     pending: usize,
@@ -52,6 +54,10 @@ pub(super) struct HostedArena {
     pub(super) stale: bool,
     /// Its velocities are in the host and its poses will be read back after the host's step.
     pending: bool,
+}
+
+fn bounds(obstacles: &Obstacles) -> Vec<(Vec2, Vec2)> {
+    obstacles.parts().iter().map(|p| (p.lo, p.hi)).collect()
 }
 
 fn static_groups() -> InteractionGroups {
@@ -82,6 +88,7 @@ impl RapierHost {
         RapierHost {
             world: Box::new(world),
             size,
+            obstacle_bounds: bounds(obstacles),
             slots,
             pending: 0,
         }
@@ -92,9 +99,10 @@ impl RapierHost {
         self.slots.len()
     }
 
-    /// Arena size, m (every hosted arena has it).
-    pub fn size(&self) -> Vec2 {
-        self.size
+    /// Whether an arena of `size` with these obstacles may live in this host: the host's walls and
+    /// obstacles are the ones its arenas meet.
+    pub fn fits(&self, size: Vec2, obstacles: &Obstacles) -> bool {
+        size == self.size && bounds(obstacles) == self.obstacle_bounds
     }
 
     /// Bodies rapier simulates now: those of arenas whose last step had a possible contact (the
