@@ -75,18 +75,10 @@ pub(crate) fn begin_world(
     out.shield.fill(0);
     if slot.done {
         // Next-step autoreset: this step only resets the world.
-        *slot = WorldSlot::build(
-            ctx.scenario,
-            ctx.task,
-            ctx.backend,
-            w,
-            slot.episode + 1,
-            host,
-        )?;
         out.rewards.fill(0.0);
         out.terminated.fill(false);
         out.truncated.fill(false);
-        write_world(ctx, slot, out);
+        next_episode(ctx, w, slot, out, host)?;
         return Ok(Begun::Reset);
     }
     slot.decide_scripted();
@@ -156,17 +148,29 @@ pub(crate) fn finish_world(
         if ctx.mode == AutoresetMode::SameStep {
             out.final_obs.copy_from_slice(out.obs);
             *out.final_mask = true;
-            *slot = WorldSlot::build(
-                ctx.scenario,
-                ctx.task,
-                ctx.backend,
-                w,
-                slot.episode + 1,
-                host,
-            )?;
-            write_world(ctx, slot, out);
+            next_episode(ctx, w, slot, out, host)?;
         }
     }
+    Ok(())
+}
+
+/// Replaces world `w` by its next episode (in its rapier host's slot, if any) and writes its outputs.
+fn next_episode(
+    ctx: &Ctx,
+    w: usize,
+    slot: &mut WorldSlot,
+    out: &mut Out,
+    host: Option<(&mut RapierHost, usize)>,
+) -> Result<()> {
+    *slot = WorldSlot::build(
+        ctx.scenario,
+        ctx.task,
+        ctx.backend,
+        w,
+        slot.episode + 1,
+        host,
+    )?;
+    write_world(ctx, slot, out);
     Ok(())
 }
 

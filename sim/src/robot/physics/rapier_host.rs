@@ -94,11 +94,6 @@ impl RapierHost {
         }
     }
 
-    /// Number of arena slots.
-    pub fn slots(&self) -> usize {
-        self.slots.len()
-    }
-
     /// Whether an arena of `size` with these obstacles may live in this host: the host's walls and
     /// obstacles are the ones its arenas meet.
     pub fn fits(&self, size: Vec2, obstacles: &Obstacles) -> bool {
