@@ -1,14 +1,17 @@
 //! `colcos sweep SWEEP.toml`: a batch of scenario runs over axes of parameters and seeds (the
 //! `colcos-sweep` library), with a progress bar, the results table, pictures and `summary.md`.
-//! Ctrl-C stops starting runs; a rerun (or `--resume`) into the same directory finishes the sweep.
+//! Ctrl-C (or SIGTERM) stops starting runs and exits with status 130, saying how many runs are in and
+//! how to resume; a rerun (or `--resume`) into the same directory finishes the sweep.
 pub mod data;
 pub mod plots;
 pub mod summary;
 
 use anyhow::{Context, Result};
-use colcos_sweep::{Plan, SweepOptions, run_sweep};
+use colcos_sweep::effects::{Effect, axis_effects};
+use colcos_sweep::{Plan, RunRow, SweepOptions, run_sweep};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::path::PathBuf;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -35,10 +38,7 @@ pub struct SweepArgs {
 /// Runs the sweep and writes its pictures and summary.
 pub fn main(args: SweepArgs) -> Result<()> {
     let plan = Plan::from_file(&args.sweep)?;
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("runs/sweeps").join(&plan.name));
+    let out = args.out.clone().unwrap_or_else(|| default_out(&plan));
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
@@ -80,6 +80,7 @@ pub fn main(args: SweepArgs) -> Result<()> {
     )?;
     bar.finish_and_clear();
     let table = data::Table::read(&report.table)?;
+    let effects = axis_effects(&plan, &rows_of(&table, &plan));
     let axes: Vec<plots::AxisInfo> = plan
         .axes
         .iter()
@@ -100,6 +101,7 @@ pub fn main(args: SweepArgs) -> Result<()> {
         &table,
         &axis_names,
         &plan.metrics.columns,
+        &effects,
         plan.total(),
         plan.seeds.len(),
         &names,
@@ -107,28 +109,79 @@ pub fn main(args: SweepArgs) -> Result<()> {
     let md_path = out.join("summary.md");
     std::fs::write(&md_path, md).with_context(|| format!("writing {}", md_path.display()))?;
     let rate = report.ran as f64 / report.wall_s.max(1e-9);
-    println!(
-        "sweep {}: {} runs ({} ran now at {:.1} runs/s, {} from an earlier run) in {:.1} s -> {}",
-        plan.name,
-        report.total,
-        report.ran,
-        rate,
-        report.skipped,
-        report.wall_s,
-        report.table.display()
-    );
-    println!(
-        "summary: {}, {} pictures in {}",
+    // Written, not println!: a reader that closed the pipe (`| head`) must not turn into a panic.
+    let mut text = String::new();
+    if report.interrupted {
+        text += &format!(
+            "sweep {} interrupted: {} of {} runs are in {} ({} ran now); resume with: colcos sweep {} --out {} --resume\n",
+            plan.name,
+            table.rows.len(),
+            report.total,
+            report.table.display(),
+            report.ran,
+            args.sweep.display(),
+            out.display()
+        );
+    } else {
+        text += &format!(
+            "sweep {}: {} runs ({} ran now at {:.1} runs/s, {} from an earlier run) in {:.1} s -> {}\n",
+            plan.name,
+            report.total,
+            report.ran,
+            rate,
+            report.skipped,
+            report.wall_s,
+            report.table.display()
+        );
+    }
+    text += &format!(
+        "summary: {}, {} pictures in {}\n",
         md_path.display(),
         pictures.len(),
         out.join("plots").display()
     );
+    for (axis, e) in plan.axes.iter().zip(&effects) {
+        if !e.is_empty() && e.iter().all(|x| *x == Effect::None) {
+            text += &format!(
+                "note: axis `{}` changed no metric (identical results at every value): the model does not answer this question\n",
+                axis.name
+            );
+        }
+    }
+    let mut stdout = std::io::stdout().lock();
+    let _ = stdout.write_all(text.as_bytes());
+    let _ = stdout.flush();
     if report.interrupted {
-        println!(
-            "interrupted: {} of {} runs done; rerun the same command (or add --resume) to finish",
-            table.rows.len(),
-            report.total
-        );
+        // 130: the shell's code for a command ended by Ctrl-C; the table is resumable.
+        std::process::exit(130);
     }
     Ok(())
+}
+
+/// The table's rows as the library's run rows (metric cells only), for the effects of the axes.
+fn rows_of(t: &data::Table, plan: &Plan) -> Vec<RunRow> {
+    let col = |name: &str| t.col(name);
+    let (Some(id), Some(combo), Some(seed)) = (col("run_id"), col("combo"), col("seed")) else {
+        return Vec::new();
+    };
+    let metrics: Vec<Option<usize>> = plan.metrics.columns.iter().map(|m| col(m)).collect();
+    t.rows
+        .iter()
+        .filter(|r| (r[combo] as usize) < plan.combos.len())
+        .map(|r| RunRow {
+            id: r[id] as u64,
+            combo: r[combo] as usize,
+            seed: r[seed] as u64,
+            metrics: metrics
+                .iter()
+                .map(|c| c.map(|c| r[c]).filter(|v| v.is_finite()))
+                .collect(),
+            wall_s: 0.0,
+        })
+        .collect()
+}
+
+/// The default output directory of a sweep.
+pub fn default_out(plan: &Plan) -> PathBuf {
+    Path::new("runs/sweeps").join(&plan.name)
 }

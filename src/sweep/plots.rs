@@ -95,20 +95,53 @@ fn save(buf: Vec<u8>, path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The x ticks: one at each group (a swept value, a bin's centre, a category) with its label, so a log
+/// axis reads 2.5, 5, 10 rather than the evenly spaced 2.5119, 3.9811 of its logarithm.
+pub fn ticks(a: &AxisInfo, g: &Groups) -> Vec<(f64, String)> {
+    xs(a, g).into_iter().zip(g.labels.iter().cloned()).collect()
+}
+
+/// A linear x axis whose ticks are given, not chosen by plotters (its own key-point wrapper loses
+/// the formatting the mesh needs).
+struct Ticked {
+    inner: plotters::coord::types::RangedCoordf64,
+    at: Vec<f64>,
+}
+
+impl Ranged for Ticked {
+    type FormatOption = plotters::coord::ranged1d::DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+
+    fn key_points<H: plotters::coord::ranged1d::KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        // The light mesh lines between ticks are not wanted; the ticks are all bold.
+        if hint.weight().allow_light_points() || hint.max_num_points() == 0 {
+            Vec::new()
+        } else {
+            self.at.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+}
+
 /// X positions: the values themselves, their log10 on a log axis, the index of a category.
-fn xs(a: &AxisInfo, g: &Groups) -> (Vec<f64>, bool) {
+fn xs(a: &AxisInfo, g: &Groups) -> Vec<f64> {
     let categorical = g
         .labels
         .iter()
         .zip(&g.centres)
         .any(|(l, c)| l.parse::<f64>().is_err() && *c == c.floor());
-    let log = a.log && g.centres.iter().all(|c| *c > 0.0);
-    let xs = g
-        .centres
+    let log = a.log && !categorical && g.centres.iter().all(|c| *c > 0.0);
+    g.centres
         .iter()
         .map(|c| if log { c.log10() } else { *c })
-        .collect();
-    (xs, log && !categorical)
+        .collect()
 }
 
 fn padded(lo: f64, hi: f64) -> (f64, f64) {
@@ -126,7 +159,8 @@ fn line(
     g: &Groups,
     stats: &[Option<(f64, f64, usize)>],
 ) -> Result<()> {
-    let (x, log) = xs(a, g);
+    let x = xs(a, g);
+    let ticks = ticks(a, g);
     let pts: Vec<(f64, f64, f64)> = x
         .iter()
         .zip(stats)
@@ -151,14 +185,21 @@ fn line(
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
+            .build_cartesian_2d(
+                Ticked {
+                    inner: (x0..x1).into(),
+                    at: ticks.iter().map(|t| t.0).collect(),
+                },
+                y0..y1,
+            )
             .map_err(err)?;
+        // Key points are the ticks' own positions: the label of the nearest one.
         let fmt = |v: &f64| {
-            if log {
-                short(10f64.powf(*v))
-            } else {
-                short(*v)
-            }
+            ticks
+                .iter()
+                .min_by(|p, q| (p.0 - v).abs().total_cmp(&(q.0 - v).abs()))
+                .map(|t| t.1.clone())
+                .unwrap_or_default()
         };
         let suffix = if g.discrete { "" } else { " (binned)" };
         chart
@@ -306,4 +347,27 @@ fn heat(
         root.present().map_err(err)?;
     }
     save(buf, path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_log_axis_is_ticked_at_its_swept_values() {
+        let g = Groups {
+            centres: vec![2.5, 5.0, 10.0, 20.0, 40.0],
+            labels: ["2.5", "5", "10", "20", "40"].map(String::from).to_vec(),
+            of_row: Vec::new(),
+            discrete: true,
+        };
+        let a = AxisInfo {
+            name: "e".into(),
+            log: true,
+        };
+        let t = ticks(&a, &g);
+        let labels: Vec<&str> = t.iter().map(|t| t.1.as_str()).collect();
+        assert_eq!(labels, ["2.5", "5", "10", "20", "40"]);
+        assert!((t[1].0 - 5f64.log10()).abs() < 1e-12, "{t:?}");
+    }
 }

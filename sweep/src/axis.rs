@@ -199,7 +199,7 @@ impl Axis {
                         } else {
                             k as f64 / (steps - 1) as f64
                         };
-                        self.number(interpolate(*from, *to, u, *log))
+                        self.number(round_generated(interpolate(*from, *to, u, *log)))
                     })
                     .collect()
             }
@@ -222,7 +222,9 @@ impl Axis {
         let u = u.clamp(0.0, 1.0 - 1e-12);
         match &self.kind {
             AxisKind::List(v) => v[((u * v.len() as f64) as usize).min(v.len() - 1)].clone(),
-            AxisKind::Range { from, to, log, .. } => self.number(interpolate(*from, *to, u, *log)),
+            AxisKind::Range { from, to, log, .. } => {
+                self.number(round_generated(interpolate(*from, *to, u, *log)))
+            }
             AxisKind::Draw { dist, a, b, .. } => {
                 let u = u.max(1e-12);
                 self.number(match dist {
@@ -247,6 +249,15 @@ impl Axis {
 /// A uniform draw in [0, 1) from the top 53 bits of one 64-bit draw.
 pub fn unit(rng: &mut SimRng) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// A computed range value to 12 significant digits: `exp(ln 2.5 + ...)` gives 5.000000000000001 where
+/// the user meant 5, and 12 digits are far finer than any simulated parameter.
+pub fn round_generated(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    format!("{x:.11e}").parse().unwrap_or(x)
 }
 
 fn interpolate(from: f64, to: f64, u: f64, log: bool) -> f64 {
@@ -387,8 +398,32 @@ mod tests {
             .grid_values(0, &mut colcos_sim::rng::stream(0, 0, 0))
             .unwrap();
         let v: Vec<f64> = v.iter().map(|x| x.as_float().unwrap()).collect();
-        assert!(
-            (v[0] - 1.0).abs() < 1e-12 && (v[1] - 10.0).abs() < 1e-9 && (v[2] - 100.0).abs() < 1e-9
+        assert_eq!(v, [1.0, 10.0, 100.0]);
+    }
+
+    #[test]
+    fn range_values_are_written_as_the_user_would() {
+        let values = |range: &str| {
+            let spec: AxisSpec = toml::from_str(&format!("key = \"a\"\nrange = {range}")).unwrap();
+            let axis = Axis::from_spec(0, &spec).unwrap();
+            let v = axis
+                .grid_values(0, &mut colcos_sim::rng::stream(0, 0, 0))
+                .unwrap();
+            v.iter().map(crate::runner::value_text).collect::<Vec<_>>()
+        };
+        // exp/ln alone gives 5.000000000000001, 10.000000000000002, 19.999999999999996.
+        assert_eq!(
+            values("{ from = 2.5, to = 40.0, steps = 5, scale = \"log\" }"),
+            ["2.5", "5", "10", "20", "40"]
         );
+        assert_eq!(
+            values("{ from = 0.05, to = 0.8, steps = 5, scale = \"log\" }"),
+            ["0.05", "0.1", "0.2", "0.4", "0.8"]
+        );
+        assert_eq!(
+            values("{ from = 0.1, to = 0.3, steps = 5 }"),
+            ["0.1", "0.15", "0.2", "0.25", "0.3"]
+        );
+        assert_eq!(round_generated(4.308869380063766), 4.30886938006);
     }
 }

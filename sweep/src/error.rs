@@ -15,14 +15,32 @@ pub enum SweepError {
         value: String,
         reason: String,
     },
-    /// The scenario of one combination fails the scenario checks.
-    #[error("combination {combo} ({params}), seed {seed}: {source}")]
+    /// A key of the sweep file has a bad value; `file` names the sweep file.
+    #[error("invalid sweep {file}: `{key}` = {value}: {reason}")]
+    InvalidIn {
+        file: String,
+        key: String,
+        value: String,
+        reason: String,
+    },
+    /// An axis sets a scenario key to a value the scenario refuses (or a key it does not have).
+    #[error("invalid sweep {file}: {setting} (combination {combo}): {reason}")]
+    Axis {
+        file: String,
+        /// `axes[i] (name) sets key = value`: the axis (its name when it has its own), key and value.
+        setting: String,
+        combo: usize,
+        reason: String,
+    },
+    /// The scenario of one combination fails the scenario checks, for no single axis.
+    #[error("invalid sweep {file}: combination {combo} ({params}), seed {seed}: {source}")]
     Combination {
+        file: String,
         combo: usize,
         params: String,
         seed: u64,
         #[source]
-        source: SimError,
+        source: Box<SimError>,
     },
     /// The base scenario cannot be read or parsed.
     #[error("base scenario {path}: {source}")]
@@ -80,6 +98,29 @@ impl SweepError {
             value,
             reason: reason.into(),
         }
+    }
+
+    /// The same error naming the sweep file it is about.
+    pub(crate) fn in_file(self, file: &str) -> Self {
+        match self {
+            SweepError::Invalid { key, value, reason } => SweepError::InvalidIn {
+                file: file.to_string(),
+                key,
+                value,
+                reason,
+            },
+            other => other,
+        }
+    }
+
+    /// `axes[i] (name) sets key = value`, the name only where it is not the key.
+    pub(crate) fn setting(index: usize, name: &str, key: &str, value: &toml::Value) -> String {
+        let first = if name == key {
+            format!("axes[{index}]")
+        } else {
+            format!("axes[{index}] ({name})")
+        };
+        format!("{first} sets {key} = {value}")
     }
 
     pub(crate) fn io(context: impl Into<String>, source: std::io::Error) -> Self {

@@ -85,6 +85,9 @@ impl KeyPath {
             let slot: &mut toml::Value = match (here, seg) {
                 (Place::Table(t), Segment::Key(k)) => {
                     if n == last {
+                        if let Some(old) = t.get(k) {
+                            same_shape(&shown, old, &value)?;
+                        }
                         t.insert(k.clone(), value);
                         return Ok(());
                     }
@@ -105,6 +108,7 @@ impl KeyPath {
                         ));
                     }
                     if n == last {
+                        same_shape(&shown, &a[*i], &value)?;
                         a[*i] = value;
                         return Ok(());
                     }
@@ -143,6 +147,26 @@ impl KeyPath {
             value?;
         }
         value
+    }
+}
+
+/// A table or array of the scenario is replaced only by another: an axis on `robots[1]` with
+/// `values = [3]` means `robots[1].count`, and saying so beats the parser's complaint about a type.
+fn same_shape(at: &KeyPath, old: &toml::Value, new: &toml::Value) -> Result<(), String> {
+    match (old, new) {
+        (toml::Value::Table(t), v) if !v.is_table() => {
+            let keys: Vec<String> = t.keys().take(6).map(|k| format!("`{at}.{k}`")).collect();
+            Err(format!(
+                "`{at}` is a table in the scenario, not a single value: set one of its keys ({}{})",
+                keys.join(", "),
+                if t.len() > keys.len() { ", ..." } else { "" }
+            ))
+        }
+        (toml::Value::Array(a), v) if !v.is_array() => Err(format!(
+            "`{at}` is an array of {} in the scenario: set one entry (`{at}[0]`) or give arrays as values",
+            a.len()
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -192,5 +216,13 @@ mod tests {
             .set(&mut t, toml::Value::Float(2.0))
             .unwrap_err();
         assert!(e.contains("`pheromones` is not in the scenario"), "{e}");
+        let e = KeyPath::parse("robots[0]")
+            .unwrap()
+            .set(&mut t, toml::Value::Integer(3))
+            .unwrap_err();
+        assert!(
+            e.contains("`robots[0]` is a table") && e.contains("`robots[0].count`"),
+            "{e}"
+        );
     }
 }

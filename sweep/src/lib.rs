@@ -15,7 +15,9 @@
 //! ```
 
 pub mod axis;
+pub mod effects;
 pub mod error;
+mod explain;
 pub mod keypath;
 pub mod metrics;
 pub mod parquet_table;

@@ -1,7 +1,8 @@
 //! A sweep file turned into runs: the combinations of axis values (a grid, a Latin hypercube or random
 //! points), times the seeds. Run `id = combo * seeds + seed index`. Each run's scenario is the base
 //! scenario's TOML with the axis values set at their key paths, the seed and the duration, parsed and
-//! validated by the scenario code, so every scenario check applies to every combination.
+//! validated by the scenario code, so every scenario check applies to every combination; a failure names
+//! the sweep file, the axis, its key and value ([`crate::explain`]).
 use crate::axis::{Axis, unit};
 use crate::error::{Result, SweepError};
 use crate::metrics::MetricSet;
@@ -33,6 +34,8 @@ pub struct Plan {
     pub fingerprint: String,
     /// Metric columns computed outside this crate (Python callables), after the built-in ones.
     pub extra_metrics: Vec<String>,
+    /// The sweep file, as errors name it.
+    pub file: String,
     base: toml::Table,
     scenario_dir: PathBuf,
 }
@@ -49,6 +52,10 @@ impl Plan {
 
     /// Parses sweep text; `dir` resolves the base scenario's path (`file` names it in errors).
     pub fn from_toml_str(text: &str, file: &str, dir: &Path) -> Result<Plan> {
+        Self::checked(text, file, dir).map_err(|e| e.in_file(file))
+    }
+
+    fn checked(text: &str, file: &str, dir: &Path) -> Result<Plan> {
         let spec = parse(text, file)?;
         let (base, scenario_dir, base_text) = match &spec.scenario {
             ScenarioRef::Path(p) => {
@@ -114,6 +121,7 @@ impl Plan {
                 ));
             }
         }
+        check_distinct_keys(&axes)?;
         for (i, a) in axes.iter().enumerate() {
             let metric = crate::metrics::METRICS.iter().any(|(m, _)| *m == a.name);
             let fixed = ID_COLUMNS.contains(&a.name.as_str())
@@ -147,6 +155,7 @@ impl Plan {
             columns: Vec::new(),
             fingerprint: String::new(),
             extra_metrics: Vec::new(),
+            file: file.to_string(),
             base,
             scenario_dir,
         };
@@ -263,7 +272,7 @@ impl Plan {
         let (combo, seed) = self.locate(id)?;
         let mut table = self.base.clone();
         for (i, (axis, value)) in self.axes.iter().zip(&self.combos[combo]).enumerate() {
-            for (k, key) in axis.keys.iter().enumerate() {
+            for key in &axis.keys {
                 let mut value = value.clone();
                 // An integral float into an integer key (a count from a range) becomes an integer.
                 if let (Some(toml::Value::Integer(_)), toml::Value::Float(f)) =
@@ -273,14 +282,13 @@ impl Plan {
                 {
                     value = toml::Value::Integer(*f as i64);
                 }
-                key.set(&mut table, value).map_err(|reason| {
-                    let at = if axis.keys.len() == 1 {
-                        format!("axes[{i}].key")
-                    } else {
-                        format!("axes[{i}].keys[{k}]")
-                    };
-                    SweepError::invalid(at, format!("\"{key}\""), reason)
-                })?;
+                key.set(&mut table, value.clone())
+                    .map_err(|reason| SweepError::Axis {
+                        file: self.file.clone(),
+                        setting: SweepError::setting(i, &axis.name, &key.to_string(), &value),
+                        combo,
+                        reason,
+                    })?;
             }
         }
         table.insert("seed".into(), toml::Value::Integer(seed as i64));
@@ -289,17 +297,13 @@ impl Plan {
         }
         let text = toml::to_string(&table)
             .map_err(|e| SweepError::invalid("scenario", "(table)", e.to_string()))?;
-        let fail = |source| SweepError::Combination {
-            combo,
-            params: self.describe(combo),
-            seed,
-            source,
-        };
-        let scenario = Scenario::from_toml_str(&text, self.scenario_dir.clone()).map_err(fail)?;
+        let scenario = Scenario::from_toml_str(&text, self.scenario_dir.clone())
+            .map_err(|e| crate::explain::combination_error(self, combo, seed, &table, e))?;
         if check_metrics {
-            self.metrics
-                .check_scenario(&scenario)
-                .map_err(|m| fail(SimError::invalid("metrics", self.describe(combo), m)))?;
+            self.metrics.check_scenario(&scenario).map_err(|m| {
+                let source = SimError::invalid("metrics", self.describe(combo), m);
+                crate::explain::combination_error(self, combo, seed, &table, source)
+            })?;
         }
         Ok(scenario)
     }
@@ -313,6 +317,52 @@ impl Plan {
             .collect();
         all.into_iter().collect()
     }
+}
+
+/// Two axes setting one key (or one a key inside the other's) would each overwrite the other, and one
+/// column would record values that were never run.
+fn check_distinct_keys(axes: &[Axis]) -> Result<()> {
+    let overlap = |a: &str, b: &str| {
+        let under = |x: &str, y: &str| {
+            x.strip_prefix(y)
+                .is_some_and(|r| r.starts_with('.') || r.starts_with('['))
+        };
+        a == b || under(a, b) || under(b, a)
+    };
+    let named = |i: usize| match &axes[i].name {
+        n if *n == axes[i].keys[0].to_string() => format!("axes[{i}]"),
+        n => format!("axes[{i}] ({n})"),
+    };
+    for (i, a) in axes.iter().enumerate() {
+        for (k, key) in a.keys.iter().enumerate() {
+            let key = key.to_string();
+            let at = if a.keys.len() == 1 {
+                format!("axes[{i}].key")
+            } else {
+                format!("axes[{i}].keys[{k}]")
+            };
+            for (j, b) in axes[..=i].iter().enumerate() {
+                let before = if j == i { &b.keys[..k] } else { &b.keys[..] };
+                if let Some(other) = before.iter().find(|o| overlap(&key, &o.to_string())) {
+                    let whom = if j == i {
+                        "the same axis".to_string()
+                    } else {
+                        named(j)
+                    };
+                    return Err(SweepError::invalid(
+                        at,
+                        format!("\"{key}\""),
+                        format!(
+                            "{} and {whom} both set `{other}`: one would overwrite the other, and a column \
+                             would record values never run; sweep it on one axis",
+                            named(i)
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn combinations(spec: &SweepSpec, axes: &[Axis]) -> Result<Vec<Vec<toml::Value>>> {

@@ -67,7 +67,10 @@ fn file_format_errors() {
 
 #[test]
 fn bad_top_level_values() {
-    refused("metrics = [\"s_mean\"]\nseeds = 0\n", &["`seeds` = 0"]);
+    refused(
+        "metrics = [\"s_mean\"]\nseeds = 0\n",
+        &["invalid sweep bad.toml: `seeds` = 0"],
+    );
     refused("metrics = [\"s_mean\"]\nseeds = []\n", &["`seeds` = []"]);
     refused(
         "metrics = [\"s_mean\"]\nseeds = [1, 2, 1]\n",
@@ -188,46 +191,110 @@ fn bad_axes() {
     );
 }
 
+/// An error about a combination's scenario: one line, naming the sweep file, the axis, its key and
+/// value, never a line of the generated scenario or a Rust type name.
+#[track_caller]
+fn axis_error(body: &str, expect: &[&str]) {
+    refused(body, &["invalid sweep bad.toml: "]);
+    let e = plan(body).err().unwrap();
+    assert!(!e.contains('\n'), "more than one line:\n{e}");
+    for bad in [
+        "TOML parse error",
+        "line ",
+        "Spec",
+        "usize",
+        "f32",
+        "<text>",
+        " | ",
+    ] {
+        assert!(!e.contains(bad), "{e}\nshows {bad:?}");
+    }
+    refused(body, expect);
+}
+
 #[test]
 fn keys_the_scenario_does_not_have() {
-    refused(
+    axis_error(
         "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"robots[7].count\"\nvalues = [1]\n",
-        &["`axes[0].key` = \"robots[7].count\"", "3 entries"],
+        &["axes[0] sets robots[7].count = 1", "3 entries"],
     );
-    refused(
+    axis_error(
         "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"robots.count\"\nvalues = [1]\n",
-        &["`axes[0].key` = \"robots.count\"", "index it"],
+        &["axes[0] sets robots.count = 1", "index it"],
     );
-    refused(
+    axis_error(
         "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"duration.x\"\nvalues = [1]\n",
-        &["`axes[0].key` = \"duration.x\"", "not a table"],
+        &["axes[0] sets duration.x = 1", "not a table"],
     );
-    // A key the scenario format does not know is refused by the scenario parser, naming it.
-    refused(
-        "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"tracker.latncy\"\nvalues = [0.1]\n",
-        &["combination 0", "tracker.latncy = 0.1", "latncy"],
+    // A key the scenario format does not know: the keys its table takes, not the generated file's line.
+    axis_error(
+        "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"tracker.latencyy\"\nvalues = [0.1]\n",
+        &[
+            "axes[0] sets tracker.latencyy = 0.1",
+            "no key `tracker.latencyy`",
+            "`latency`",
+        ],
+    );
+    axis_error(
+        "metrics = [\"s_mean\"]\n[[axes]]\nname = \"speed\"\nkey = \"robots[1].params.speedd\"\nvalues = [0.1]\n",
+        &[
+            "axes[0] (speed) sets robots[1].params.speedd = 0.1",
+            "speedd",
+        ],
+    );
+    // A whole table set to a number: which keys are inside it.
+    axis_error(
+        "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"robots[1]\"\nvalues = [3]\n",
+        &["axes[0] sets robots[1] = 3", "a table", "`robots[1].count`"],
     );
 }
 
 #[test]
-fn a_bad_value_deep_in_the_grid_names_its_combination() {
-    refused(
+fn a_bad_value_deep_in_the_grid_names_its_axis() {
+    axis_error(
         "metrics = [\"s_mean\"]\nseeds = 2\n[[axes]]\nkey = \"tracker.latency\"\nvalues = [0.02, 0.04]\n[[axes]]\nname = \"agp_e\"\nkey = \"pheromones[0].evaporation\"\nvalues = [5.0, 10.0, -1.0]\n",
         &[
-            "combination 2",
-            "tracker.latency = 0.02, agp_e = -1.0",
-            "pheromones[0].evaporation",
-            "-1",
+            "axes[1] (agp_e) sets pheromones[0].evaporation = -1.0 (combination 2)",
+            "must be a finite number > 0",
         ],
     );
-    // A wrong type for the scenario key.
-    refused(
+    // A wrong type for the scenario key, and a value out of an integer key's range.
+    axis_error(
         "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"robots[1].count\"\nvalues = [2, \"many\"]\n",
         &[
-            "combination 1",
-            "robots[1].count = \"many\"",
-            "robots[1].count",
+            "axes[0] sets robots[1].count = \"many\" (combination 1)",
+            "string",
         ],
+    );
+    axis_error(
+        "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"robots[1].count\"\nvalues = [1, -3]\n",
+        &["combination 1", "robots[1].count = -3", "an integer >= 0"],
+    );
+    // Several keys: the one the scenario refuses.
+    axis_error(
+        "metrics = [\"s_mean\"]\n[[axes]]\nname = \"agp_e\"\nkeys = [\"pheromones[0].evaporation\", \"robots[0].emits[0].evaporation\"]\nvalues = [0.0]\n",
+        &["axes[0] (agp_e) sets pheromones[0].evaporation = 0.0"],
+    );
+}
+
+#[test]
+fn two_axes_on_one_key_are_refused_naming_both() {
+    refused(
+        "metrics = [\"s_mean\"]\n[[axes]]\nkey = \"tracker.latency\"\nvalues = [0.02]\n[[axes]]\nname = \"lag\"\nkey = \"tracker.latency\"\nvalues = [0.1]\n",
+        &[
+            "invalid sweep bad.toml",
+            "`axes[1].key` = \"tracker.latency\"",
+            "axes[1] (lag) and axes[0] both set `tracker.latency`",
+        ],
+    );
+    // One key inside the other's table, and one key twice in one axis's `keys`.
+    refused(
+        "metrics = [\"s_mean\"]\n[[axes]]\nname = \"e\"\nkeys = [\"pheromones[0].evaporation\", \"robots[0].emits[0].evaporation\"]\nvalues = [5.0]\n[[axes]]\nname = \"agp\"\nkey = \"robots[0].emits[0]\"\nvalues = [{ pheromone = \"AGP\", k = 0.5, sigma = [0.4, 0.4], evaporation = 10.0 }]\n",
+        &["`axes[1].key`", "axes[1] (agp) and axes[0] (e) both set"],
+    );
+    refused(
+        "metrics = [\"s_mean\"]\n[[axes]]\nname = \"e\"\nkeys = [\"tracker.latency\", \"tracker.latency\"]\nvalues = [0.1]\n",
+        &["`axes[0].keys[1]`", "the same axis"],
     );
 }
 
@@ -263,6 +330,6 @@ fn bad_metric_options() {
     );
     refused(
         "metrics = [\"s_mean\"]\n[metric_options]\nleader_role = \"queen\"\n",
-        &["combination 0", "role \"queen\""],
+        &["invalid sweep bad.toml: combination 0", "role \"queen\""],
     );
 }

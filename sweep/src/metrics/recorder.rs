@@ -129,11 +129,12 @@ impl<'a> Recorder<'a> {
     }
 
     fn sample(&mut self, world: &World) {
-        let t = world.time() as f64;
+        // The tick count times dt as written (0.02, not its f32), so that times read 5.4, not 5.399...
+        let t = crate::axis::round_generated(world.tick() as f64 * widen(world.dt()));
         self.times.push(t);
         if let Some(l) = self.leader {
             self.s
-                .push(sum_distance_of(&self.positions, l, &self.followers) as f64);
+                .push(widen(sum_distance_of(&self.positions, l, &self.followers)));
         }
         let wants_nn = self.set.has(Metric::NnDistance)
             || self.set.has(Metric::NnDistanceFinal)
@@ -227,6 +228,12 @@ impl<'a> Recorder<'a> {
         }
         out
     }
+}
+
+/// An f32 as the f64 it reads as (`5.4f32` -> `5.4`, not `5.400000095367432`): the table shows the
+/// simulator's own figure, not the binary noise of widening it.
+pub fn widen(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(x as f64)
 }
 
 fn mean(v: &[f64]) -> Option<f64> {
