@@ -180,6 +180,19 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
     if gif.exists() {
         writeln!(text, "  wrote {}", gif.display())?;
     }
+    if report.pose_blocks == 0 {
+        // What ran is still reported (and written) before the failure.
+        print!("{}", std::mem::take(text));
+        anyhow::bail!(
+            "no pose arrived from the tracker {} in {:.1} s{}",
+            args.tracker,
+            report.seconds,
+            report
+                .tracker_problem
+                .as_ref()
+                .map_or(String::new(), |p| format!(" ({p})"))
+        );
+    }
     Ok(())
 }
 

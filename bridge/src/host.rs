@@ -118,6 +118,11 @@ impl Host {
         self.parts.fields.pheromones_mut()
     }
     /// Installs a field backend (`None`: the CPU).
+    /// Chooses how much robot `i` lays of each of its deposit actions from the next tick on, as
+    /// `World::set_deposit_actions`: injected at its tracked pose like any trail.
+    pub fn set_deposit_actions(&mut self, i: usize, fractions: impl IntoIterator<Item = f32>) {
+        self.parts.injection.set_deposit_actions(i, fractions);
+    }
     pub fn set_field_backend(&mut self, backend: Option<Box<dyn colcos_sim::field::FieldBackend>>) {
         self.parts.fields.set_backend(backend);
     }

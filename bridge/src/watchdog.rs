@@ -61,6 +61,26 @@ impl StopReason {
     }
 }
 
+/// A plain sentence for the operator (the log's `detail` keeps it too).
+impl std::fmt::Display for StopReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StopReason::TrackerSilent { for_s } => {
+                write!(f, "no pose from the tracker for {for_s:.2} s")
+            }
+            StopReason::TrackerClosed => write!(f, "the tracker closed its stream"),
+            StopReason::PoseStale { robot, age_s } => {
+                write!(f, "robot {robot}'s newest pose is {age_s:.2} s old")
+            }
+            StopReason::PolicyStalled { for_s } => {
+                write!(f, "no command from the policy for {for_s:.2} s")
+            }
+            StopReason::LinkError(e) => write!(f, "{e}"),
+            StopReason::Shutdown(why) => write!(f, "{why}"),
+        }
+    }
+}
+
 /// What the loop tells the watchdog, lock-free: microseconds since the watchdog's start (0: never).
 pub struct Heartbeats {
     start: Instant,

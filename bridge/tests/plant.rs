@@ -2,7 +2,7 @@
 //! the spaces and outputs of the simulated environment, and the shield keeping a policy that drives at
 //! the walls inside the arena.
 use colcos_bridge::plant::{LiveEnv, PlantKind, PlantOptions, TwinScenario};
-use colcos_env::{EnvConfig, VecEnv};
+use colcos_env::{Actions, EnvConfig, VecEnv};
 use colcos_sim::world::ArenaView;
 
 /// The twins of these tests run in real time, and one of them measures a latency in ticks: one test
@@ -60,7 +60,7 @@ fn the_twin_plant_keeps_a_wall_seeking_policy_inside_and_replays_its_log() {
     let r = env.scenario().spec.robot.radius;
     let (mut walled, mut steps) = (0, 0);
     while !env.truncated().iter().any(|t| *t) {
-        env.step(Some(&full_ahead(n)), None).unwrap();
+        env.step(Actions::Continuous(&full_ahead(n))).unwrap();
         steps += 1;
         walled += env.shield_flags().iter().filter(|f| **f & 2 != 0).count();
         assert!(
@@ -91,7 +91,7 @@ fn the_twin_plant_keeps_a_wall_seeking_policy_inside_and_replays_its_log() {
     replay.reset(None).unwrap();
     let mut steps = 0;
     while !replay.truncated().iter().any(|t| *t) {
-        replay.step(Some(&full_ahead(n)), None).unwrap();
+        replay.step(Actions::Continuous(&full_ahead(n))).unwrap();
         steps += 1;
     }
     assert!(steps >= 100, "{steps} replayed steps");
@@ -135,7 +135,7 @@ fn a_plant_without_what_it_needs_names_it() {
     );
 }
 
-/// Steps (20 ms) from the first full-ahead command until the tracker shows the host any robot moved
+/// Steps (20 ms) from the first full-ahead command until the tracker shows the host any agent moved
 /// 8 mm (the tracker's noise is 1 mm), on a twin playing `twin` (none: the host's scenario).
 fn steps_until_seen_moving(twin: Option<TwinScenario>) -> usize {
     let cfg = config();
@@ -147,17 +147,16 @@ fn steps_until_seen_moving(twin: Option<TwinScenario>) -> usize {
     let n = env.spec().num_agents;
     // Still for half a second: every pose the host holds is of robots at rest.
     for _ in 0..25 {
-        env.step(Some(&vec![0.0; 2 * n]), None).unwrap();
+        env.step(Actions::Continuous(&vec![0.0; 2 * n])).unwrap();
     }
     let start: Vec<_> = env.host().tracked().to_vec();
+    // The agents, which the policy drives: a scripted robot wanders on its own.
+    let agents = env.spec().agent_robots.clone();
     for k in 1..=60 {
-        env.step(Some(&full_ahead(n)), None).unwrap();
-        let moved = env
-            .host()
-            .tracked()
-            .iter()
-            .zip(&start)
-            .any(|(p, s)| (p.pose.pos - s.pose.pos).length() > 0.008);
+        env.step(Actions::Continuous(&full_ahead(n))).unwrap();
+        let tracked = env.host().tracked();
+        let moved =
+            (agents.iter()).any(|&i| (tracked[i].pose.pos - start[i].pose.pos).length() > 0.008);
         if moved {
             return k;
         }

@@ -92,6 +92,8 @@ pub(crate) struct Lengths {
     pub(crate) obs: usize,
     pub(crate) state: usize,
     pub(crate) patch: usize,
+    /// Deposit actions per agent.
+    pub(crate) deposits: usize,
 }
 
 impl Buffers<'_> {
@@ -118,6 +120,7 @@ pub(crate) fn step_batch(
     slots: &mut [WorldSlot],
     chunks: &mut Chunks,
     commands: &[WheelCommand],
+    rates: &[f32],
     buffers: Buffers,
     len: Lengths,
 ) -> Result<()> {
@@ -170,29 +173,34 @@ pub(crate) fn step_batch(
         .zip(outs)
         .enumerate()
         .try_for_each(|(k, (((slots, host), commands), mut buffers))| {
-            step_chunk(ctx, k * c, slots, host, commands, &mut buffers, len)
+            step_chunk(ctx, k * c, slots, host, commands, rates, &mut buffers, len)
         })
 }
 
-/// One step of the worlds of a chunk (the first is world `first`): each begins its step, the host
-/// steps, each finishes. A world whose step fails leaves the others' steps whole; an error met is
-/// returned.
+/// One step of the worlds of a chunk (the first is world `first`; `commands` are the chunk's,
+/// `rates` the whole batch's): each begins its step, the host steps, each finishes. A world whose
+/// step fails leaves the others' steps whole; an error met is returned.
+#[allow(clippy::too_many_arguments)]
 fn step_chunk(
     ctx: &Ctx,
     first: usize,
     slots: &mut [WorldSlot],
     mut host: Option<&mut RapierHost>,
     commands: &[WheelCommand],
+    rates: &[f32],
     buffers: &mut Buffers,
     len: Lengths,
 ) -> Result<()> {
+    let per_world = len.agents * len.deposits;
     let mut begun = [Begun::Reset; MAX_HOSTED_ARENAS];
     let mut result = Ok(());
     for (i, slot) in slots.iter_mut().enumerate() {
         let cmds = &commands[i * len.agents..(i + 1) * len.agents];
+        let w = first + i;
+        let lay = &rates[w * per_world..(w + 1) * per_world];
         let mut out = buffers.world(i, len);
         let in_host = host.as_deref_mut().map(|h| (h, i));
-        match begin_world(ctx, first + i, slot, cmds, &mut out, in_host) {
+        match begin_world(ctx, w, slot, (cmds, lay), &mut out, in_host) {
             Ok(b) => begun[i] = b,
             Err(err) if result.is_ok() => result = Err(err),
             Err(_) => {}

@@ -8,13 +8,17 @@
 //! `(seed, world index, episode)`, so results never depend on the number of threads.
 //!
 //! Robots that are not agents (a leader, a predator) keep the behaviour their scenario gives them, with
-//! their own random streams.
+//! their own random streams: one controller per robot, inside the world's step
+//! (`World::step_with_overrides`). [`episode`] and [`actions`] are the episode core every environment
+//! of a task shares, the batch's worlds and the plants' arena alike.
 
+pub mod actions;
 pub mod backend;
 pub mod baseline;
 mod batch_step;
 pub mod config;
 pub mod encoding;
+pub mod episode;
 pub mod error;
 pub mod patch;
 pub mod spaces;
@@ -24,10 +28,12 @@ pub mod world_output;
 mod world_slot;
 mod world_step;
 
+pub use actions::{ActionDecoder, Actions};
 pub use backend::EnvBackend;
 pub use config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource};
+pub use episode::{AgentOut, Episode, StepEnd};
 pub use error::{EnvError, Result};
 pub use spaces::{EnvSpec, Space};
 pub use task::Task;
-pub use vec_env::{Actions, BufferPtrs, VecEnv, shield_bits};
+pub use vec_env::{BufferPtrs, VecEnv, shield_bits};
 pub use world_slot::world_index;

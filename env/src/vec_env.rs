@@ -4,10 +4,11 @@
 //! `[E, N]` rewards and flags, ...); they are allocated at construction and never reallocated, so a
 //! binding may hand out views of them that stay valid for the environment's lifetime. Each `step` and
 //! `reset` overwrites them in place.
+use crate::actions::{ActionDecoder, Actions};
 use crate::backend::EnvBackend;
 use crate::batch_step::{Buffers, Chunks, Lengths, step_batch};
 use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
-use crate::encoding::{self, OBS_DIM};
+use crate::encoding::OBS_DIM;
 use crate::error::{EnvError, Result};
 use crate::spaces::{EnvSpec, Space};
 use crate::task::{Task, registry};
@@ -20,15 +21,6 @@ use colcos_sim::scenario::Scenario;
 use colcos_sim::shield::Shield;
 use colcos_sim::world::World;
 use rayon::prelude::*;
-
-/// Actions for every agent of every world, row-major `[E, N, 2]` or `[E, N]`.
-#[derive(Clone, Copy, Debug)]
-pub enum Actions<'a> {
-    /// Wheel speeds as fractions of the largest, `[E, N, 2]`; clipped to `[-1, 1]`, NaN refused.
-    Continuous(&'a [f32]),
-    /// Indices into [`encoding::DISCRETE_ACTIONS`], `[E, N]`.
-    Discrete(&'a [i64]),
-}
 
 pub struct VecEnv {
     spec: EnvSpec,
@@ -54,7 +46,10 @@ pub struct VecEnv {
     shield_flags: Vec<u8>,
     shield: Option<Shield>,
     /// Scratch: decoded wheel commands of the agents `[E, N]`.
+    decoder: ActionDecoder,
     commands: Vec<colcos_sim::behaviour::WheelCommand>,
+    /// Each agent's deposit rate fractions of this step, `[E, N, D]`.
+    deposit_rates: Vec<f32>,
     state_dim: usize,
     patch_len: usize,
     needs_reset: bool,
@@ -97,6 +92,12 @@ impl VecEnv {
             }
         }
         let state_dim = if cfg.global_state { 4 * robots + 1 } else { 0 };
+        let decoder = ActionDecoder::new(
+            cfg.action == ActionKind::Discrete,
+            n,
+            deposit_actions_per_agent(&scenario, task.agents())?,
+            scenario.spec.robot.max_wheel_speed,
+        );
         let patch_len = cfg.patch.map_or(0, |p| p.pixels * p.pixels * 3);
         let threads = cfg.num_threads.unwrap_or(0);
         let pool = rayon::ThreadPoolBuilder::new()
@@ -122,11 +123,11 @@ impl VecEnv {
                 ActionKind::Continuous => Space::Box {
                     low: -1.0,
                     high: 1.0,
-                    shape: vec![2],
+                    shape: vec![decoder.width()],
                     dtype: "float32",
                 },
                 ActionKind::Discrete => Space::Discrete {
-                    n: encoding::DISCRETE_ACTIONS.len(),
+                    n: decoder.discrete_count(),
                 },
             },
             state: cfg.global_state.then(|| Space::Box {
@@ -179,6 +180,8 @@ impl VecEnv {
             shield_flags: vec![0; e * n],
             shield,
             commands: vec![Default::default(); e * n],
+            deposit_rates: vec![0.0; e * n * decoder.deposits()],
+            decoder,
             state_dim,
             patch_len,
             needs_reset: true,
@@ -189,6 +192,10 @@ impl VecEnv {
 
     pub fn spec(&self) -> &EnvSpec {
         &self.spec
+    }
+    /// How this environment reads actions (the plants decode theirs with the same).
+    pub fn action_decoder(&self) -> &ActionDecoder {
+        &self.decoder
     }
     pub fn task(&self) -> &dyn Task {
         self.task.as_ref()
@@ -213,15 +220,15 @@ impl VecEnv {
     }
     /// Steps taken in the current episode of each world.
     pub fn episode_steps(&self, e: usize) -> u64 {
-        self.slots[e].steps
+        self.slots[e].episode.steps
     }
     /// Number of the current episode of world `e` since the seed was last set.
     pub fn episode(&self, e: usize) -> u64 {
-        self.slots[e].episode
+        self.slots[e].episode.index
     }
     /// Whether world `e` has finished its episode (and awaits a reset).
     pub fn is_done(&self, e: usize) -> bool {
-        self.slots[e].done
+        self.slots[e].episode.done
     }
 
     /// Observations `[E, N, OBS_DIM]`.
@@ -311,9 +318,9 @@ impl VecEnv {
                             let episode = if restart {
                                 0
                             } else if first {
-                                slot.episode
+                                slot.episode.index
                             } else {
-                                slot.episode + 1
+                                slot.episode.index + 1
                             };
                             let host = host.as_deref_mut().map(|h| (h, i));
                             *slot = WorldSlot::build(scenario, task, backend, w, episode, host)?;
@@ -337,7 +344,7 @@ impl VecEnv {
         }
         self.decode(actions)?;
         let blocked = match self.mode {
-            AutoresetMode::Disabled => self.slots.iter().position(|s| s.done),
+            AutoresetMode::Disabled => self.slots.iter().position(|s| s.episode.done),
             _ => None,
         };
         if let Some(w) = blocked {
@@ -356,12 +363,14 @@ impl VecEnv {
             state_dim: self.state_dim,
             patch: self.patch_cfg,
             shield: self.shield,
+            deposits: self.decoder.deposits(),
         };
         let len = Lengths {
             agents: n,
             obs: n * OBS_DIM,
             state: self.state_dim.max(1),
             patch: n * self.patch_len.max(1),
+            deposits: self.decoder.deposits(),
         };
         let mut buffers = Buffers {
             obs: &mut self.obs,
@@ -377,68 +386,23 @@ impl VecEnv {
         if let [slot] = self.slots.as_mut_slice() {
             // One world (a PettingZoo `parallel_env`): step it on the calling thread. Handing a single
             // world to the pool costs two thread wake-ups per step, a third of the step at this size.
-            return step_world(&ctx, 0, slot, &self.commands, &mut buffers.world(0, len));
+            let actions = (&self.commands[..], &self.deposit_rates[..]);
+            return step_world(&ctx, 0, slot, actions, &mut buffers.world(0, len));
         }
-        let (slots, chunks, commands) = (&mut self.slots, &mut self.chunks, &self.commands);
+        let (slots, chunks) = (&mut self.slots, &mut self.chunks);
+        let (commands, rates) = (&self.commands, &self.deposit_rates);
         self.pool
-            .install(|| step_batch(&ctx, slots, chunks, commands, buffers, len))
+            .install(|| step_batch(&ctx, slots, chunks, commands, rates, buffers, len))
     }
 
     /// Checks and decodes the actions into wheel commands.
     fn decode(&mut self, actions: Actions) -> Result<()> {
-        let (e, n) = (self.spec.num_envs, self.spec.num_agents);
-        let max = self.scenario.spec.robot.max_wheel_speed;
-        match (actions, &self.spec.action) {
-            (Actions::Continuous(a), Space::Box { .. }) => {
-                if a.len() != e * n * 2 {
-                    return Err(EnvError::Action(format!(
-                        "expected {} values (num_envs {e} x agents {n} x 2 wheels), got {}",
-                        e * n * 2,
-                        a.len()
-                    )));
-                }
-                if let Some(k) = a.iter().position(|v| !v.is_finite()) {
-                    let (w, i, c) = (k / (2 * n), (k / 2) % n, k % 2);
-                    return Err(EnvError::Action(format!(
-                        "action of world {w}, agent robot_{i}, wheel {c} is {} (must be finite)",
-                        a[k]
-                    )));
-                }
-                for (cmd, pair) in self.commands.iter_mut().zip(a.chunks_exact(2)) {
-                    *cmd = encoding::continuous_command(pair[0], pair[1], max);
-                }
-            }
-            (Actions::Discrete(a), Space::Discrete { n: count }) => {
-                if a.len() != e * n {
-                    return Err(EnvError::Action(format!(
-                        "expected {} actions (num_envs {e} x agents {n}), got {}",
-                        e * n,
-                        a.len()
-                    )));
-                }
-                for (k, (cmd, &v)) in self.commands.iter_mut().zip(a).enumerate() {
-                    *cmd = encoding::discrete_command(v, max).ok_or_else(|| {
-                        EnvError::Action(format!(
-                            "action of world {}, agent robot_{} is {v}, not in 0..{count}",
-                            k / n,
-                            k % n
-                        ))
-                    })?;
-                }
-            }
-            (Actions::Continuous(_), _) => {
-                return Err(EnvError::Action(
-                    "this environment has discrete actions (integers), got continuous ones".into(),
-                ));
-            }
-            (Actions::Discrete(_), _) => {
-                return Err(EnvError::Action(
-                    "this environment has continuous actions (floats, [.., 2]), got discrete ones"
-                        .into(),
-                ));
-            }
-        }
-        Ok(())
+        self.decoder.decode(
+            actions,
+            self.spec.num_envs,
+            &mut self.commands,
+            &mut self.deposit_rates,
+        )
     }
 
     /// Rewrites observations, state and patches of every world and clears rewards and flags.
@@ -457,7 +421,7 @@ impl VecEnv {
             if sd > 0 {
                 write_state(
                     &slot.world,
-                    slot.steps,
+                    slot.episode.steps,
                     self.spec.max_cycles,
                     &mut self.state[w * sd..(w + 1) * sd],
                 );
@@ -501,4 +465,42 @@ pub struct BufferPtrs {
     pub final_obs: *mut f32,
     pub final_mask: *mut bool,
     pub shield: *mut u8,
+}
+
+/// Deposit actions per agent: every agent's group declares the same number, and only agents'
+/// groups declare any (a scripted robot could not choose its rates).
+fn deposit_actions_per_agent(scenario: &Scenario, agents: &[usize]) -> Result<usize> {
+    let mut first = 0;
+    let mut per_agent: Option<(usize, usize)> = None;
+    for (g, group) in scenario.spec.robots.iter().enumerate() {
+        let d = group.deposit_actions.len();
+        let range = first..first + group.count;
+        first += group.count;
+        let is_agent = agents.iter().any(|i| range.contains(i));
+        let key = format!("robots[{g}].deposit_actions");
+        if !is_agent {
+            if d > 0 {
+                return Err(EnvError::param(
+                    key,
+                    "this group's robots are not agents of the task, so nothing would choose \
+                     their rates (give them `deposits` instead)",
+                ));
+            }
+            continue;
+        }
+        match per_agent {
+            None => per_agent = Some((g, d)),
+            Some((h, e)) if e != d => {
+                return Err(EnvError::param(
+                    key,
+                    format!(
+                        "{d} deposit actions, but the agents of robots[{h}] have {e}: every agent \
+                         of a task takes actions of one width"
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(per_agent.map_or(0, |(_, d)| d))
 }

@@ -1,9 +1,10 @@
-//! One world of a batch: the sim world, the behaviours of its scripted robots, and episode bookkeeping.
+//! One world of a batch: the sim world (whose robots that are not agents decide with their own
+//! behaviours), the agents' commands, and episode bookkeeping.
 use crate::backend::EnvBackend;
+use crate::episode::Episode;
 use crate::error::Result;
 use crate::task::Task;
-use colcos_sim::behaviour::{Behaviour, WheelCommand, registry};
-use colcos_sim::rng::{self, SimRng, Stream};
+use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::RapierHost;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
@@ -16,20 +17,10 @@ pub fn world_index(w: usize, episode: u64) -> u64 {
 
 pub(crate) struct WorldSlot {
     pub world: World,
-    /// Scripted (non-agent) robots: index, behaviour, random stream.
-    scripted: Vec<(usize, Box<dyn Behaviour>, SimRng)>,
-    /// Wheel commands of every robot for the next step.
-    pub commands: Vec<WheelCommand>,
-    /// Episodes started in this world since the seed was set.
-    pub episode: u64,
-    /// Steps taken in this episode.
-    pub steps: u64,
-    /// Agents that have terminated in this episode.
-    pub terminated: Vec<bool>,
-    /// Scratch: `terminated` before the last evaluation.
-    pub prev_terminated: Vec<bool>,
-    /// Every agent is terminated or truncated.
-    pub done: bool,
+    /// Each robot's controller for the next step: the agents' commands (`Some`), the others' own
+    /// behaviours (`None`).
+    pub overrides: Vec<Option<WheelCommand>>,
+    pub episode: Episode,
 }
 
 impl WorldSlot {
@@ -47,20 +38,11 @@ impl WorldSlot {
         let mut world = World::with_index(scenario, index)?;
         backend.install(&mut world)?;
         let agents = task.agents();
-        let mut scripted = Vec::new();
-        let mut first = 0;
-        for (g, group) in scenario.spec.robots.iter().enumerate() {
-            for i in first..first + group.count {
-                if !agents.contains(&i) {
-                    let key = format!("robots[{g}]");
-                    let behaviour = registry::build_for_group(group, &scenario.spec.robot, &key)?;
-                    let rng = rng::stream_of(scenario.spec.seed, index, Stream::Scripted(i));
-                    scripted.push((i, behaviour, rng));
-                }
-            }
-            first += group.count;
-        }
         let robots = world.robot_count();
+        let mut overrides = vec![None; robots];
+        for &i in agents {
+            overrides[i] = Some(WheelCommand::STOP);
+        }
         if task.on_reset(world.pheromones_mut()) {
             // One still step so that the sensors see what the task changed.
             world.step_with_commands(&vec![WheelCommand::STOP; robots]);
@@ -70,21 +52,8 @@ impl WorldSlot {
         }
         Ok(WorldSlot {
             world,
-            scripted,
-            commands: vec![WheelCommand::STOP; robots],
-            episode,
-            steps: 0,
-            terminated: vec![false; agents.len()],
-            prev_terminated: vec![false; agents.len()],
-            done: false,
+            overrides,
+            episode: Episode::new(episode, agents.len()),
         })
-    }
-
-    /// Lets the scripted robots decide their commands from their current observations.
-    pub fn decide_scripted(&mut self) {
-        let obs = self.world.observations();
-        for (i, behaviour, rng) in &mut self.scripted {
-            self.commands[*i] = behaviour.act(&obs[*i], rng);
-        }
     }
 }

@@ -1,7 +1,9 @@
-//! One world's step of the batch: the scripted robots decide, the agents' commands pass the safety
-//! shield, the world steps, the task hands out rewards and ends episodes, and the outputs are written.
+//! One world's step of the batch: the agents' commands pass the safety shield, the world steps (its
+//! other robots deciding with their own behaviours), the task hands out rewards and ends episodes,
+//! and the outputs are written.
 use crate::backend::EnvBackend;
 use crate::config::{AutoresetMode, PatchConfig};
+use crate::episode::{AgentOut, StepEnd};
 use crate::error::Result;
 use crate::task::Task;
 use crate::world_output::{write_obs, write_patch, write_state};
@@ -23,6 +25,9 @@ pub(crate) struct Out<'a> {
     pub(crate) shield: &'a mut [u8],
 }
 
+/// One world's agents' commands `[N]` and deposit rate fractions `[N, D]`.
+pub(crate) type AgentActions<'a> = (&'a [colcos_sim::behaviour::WheelCommand], &'a [f32]);
+
 /// Everything a world's step needs besides its own slot and buffers.
 pub(crate) struct Ctx<'a> {
     pub(crate) task: &'a dyn Task,
@@ -34,6 +39,8 @@ pub(crate) struct Ctx<'a> {
     pub(crate) state_dim: usize,
     pub(crate) patch: Option<PatchConfig>,
     pub(crate) shield: Option<Shield>,
+    /// Deposit actions per agent.
+    pub(crate) deposits: usize,
 }
 
 /// How far [`begin_world`] took a world's step.
@@ -52,10 +59,10 @@ pub(crate) fn step_world(
     ctx: &Ctx,
     w: usize,
     slot: &mut WorldSlot,
-    cmds: &[colcos_sim::behaviour::WheelCommand],
+    actions: AgentActions,
     out: &mut Out,
 ) -> Result<()> {
-    let begun = begin_world(ctx, w, slot, cmds, out, None)?;
+    let begun = begin_world(ctx, w, slot, actions, out, None)?;
     finish_world(ctx, w, slot, out, begun, None)
 }
 
@@ -66,14 +73,14 @@ pub(crate) fn begin_world(
     ctx: &Ctx,
     w: usize,
     slot: &mut WorldSlot,
-    cmds: &[colcos_sim::behaviour::WheelCommand],
+    (cmds, rates): AgentActions,
     out: &mut Out,
     host: Option<(&mut RapierHost, usize)>,
 ) -> Result<Begun> {
     let agents = ctx.task.agents();
     *out.final_mask = false;
     out.shield.fill(0);
-    if slot.done {
+    if slot.episode.done {
         // Next-step autoreset: this step only resets the world.
         out.rewards.fill(0.0);
         out.terminated.fill(false);
@@ -81,15 +88,14 @@ pub(crate) fn begin_world(
         next_episode(ctx, w, slot, out, host)?;
         return Ok(Begun::Reset);
     }
-    slot.decide_scripted();
     let poses = slot.world.poses();
     for (((&i, cmd), &term), flags) in agents
         .iter()
         .zip(cmds)
-        .zip(&slot.terminated)
+        .zip(&slot.episode.terminated)
         .zip(out.shield.iter_mut())
     {
-        slot.commands[i] = if term {
+        slot.overrides[i] = Some(if term {
             colcos_sim::behaviour::WheelCommand::STOP
         } else if let Some(shield) = &ctx.shield {
             let (cmd, intervention) = shield.apply(&poses[i], *cmd);
@@ -97,15 +103,24 @@ pub(crate) fn begin_world(
             cmd
         } else {
             *cmd
-        };
+        });
+    }
+    let d = ctx.deposits;
+    if d > 0 {
+        for (k, (&i, &term)) in agents.iter().zip(&slot.episode.terminated).enumerate() {
+            // A terminated agent is stopped and lays nothing.
+            let lay = rates[k * d..(k + 1) * d].iter();
+            slot.world
+                .set_deposit_actions(i, lay.map(|&f| if term { 0.0 } else { f }));
+        }
     }
     Ok(match host {
         Some((host, _)) => {
-            slot.world.begin_step_in(&slot.commands, host);
+            slot.world.begin_step_in(&slot.overrides, host);
             Begun::InHost
         }
         None => {
-            slot.world.step_with_commands(&slot.commands);
+            slot.world.step_with_overrides(&slot.overrides);
             Begun::Stepped
         }
     })
@@ -125,31 +140,22 @@ pub(crate) fn finish_world(
         (Begun::InHost, Some((host, _))) => slot.world.finish_step_in(host),
         _ => {}
     }
-    let agents = ctx.task.agents();
-    slot.steps += 1;
-    slot.prev_terminated.copy_from_slice(&slot.terminated);
-    ctx.task
-        .evaluate(&slot.world, out.rewards, &mut slot.terminated);
-    for (r, &was) in out.rewards.iter_mut().zip(&slot.prev_terminated) {
-        if was {
-            *r = 0.0;
-        }
-    }
-    let truncate = slot.steps >= ctx.max_cycles;
-    let mut done = true;
-    for k in 0..agents.len() {
-        out.terminated[k] = slot.terminated[k];
-        out.truncated[k] = truncate && !slot.terminated[k];
-        done &= out.terminated[k] || out.truncated[k];
-    }
+    let done = slot.episode.finish_step(
+        ctx.task,
+        &slot.world,
+        ctx.max_cycles,
+        StepEnd::Stepped,
+        AgentOut {
+            rewards: out.rewards,
+            terminated: out.terminated,
+            truncated: out.truncated,
+        },
+    );
     write_world(ctx, slot, out);
-    if done {
-        slot.done = true;
-        if ctx.mode == AutoresetMode::SameStep {
-            out.final_obs.copy_from_slice(out.obs);
-            *out.final_mask = true;
-            next_episode(ctx, w, slot, out, host)?;
-        }
+    if done && ctx.mode == AutoresetMode::SameStep {
+        out.final_obs.copy_from_slice(out.obs);
+        *out.final_mask = true;
+        next_episode(ctx, w, slot, out, host)?;
     }
     Ok(())
 }
@@ -167,7 +173,7 @@ fn next_episode(
         ctx.task,
         ctx.backend,
         w,
-        slot.episode + 1,
+        slot.episode.index + 1,
         host,
     )?;
     write_world(ctx, slot, out);
@@ -178,7 +184,7 @@ pub(crate) fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut Out) {
     let agents = ctx.task.agents();
     write_obs(&slot.world, agents, ctx.max_speed, out.obs);
     if ctx.state_dim > 0 {
-        write_state(&slot.world, slot.steps, ctx.max_cycles, out.state);
+        write_state(&slot.world, slot.episode.steps, ctx.max_cycles, out.state);
     }
     if let Some(p) = &ctx.patch {
         write_patch(&slot.world, agents, p, out.patch);

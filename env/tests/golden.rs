@@ -138,7 +138,7 @@ fn every_task_under_fixed_actions() {
     fixed_actions(
         None,
         [
-            ("aggregation", 0x53fbc1887adb4eca, 0x83973a958c296381),
+            ("aggregation", 0x3776c14bee7d36a5, 0x57f49b90ceccec90),
             ("foraging", 0x44a08f13ea024f94, 0x44a08f13ea024f94),
             ("trail", 0xc4f22a3d0cc98d4b, 0x454368c6991fa6d3),
         ],
@@ -150,7 +150,7 @@ fn every_task_under_fixed_actions_discs() {
     fixed_actions(
         Some(PhysicsBackend::Discs),
         [
-            ("aggregation", 0xadf11341867d8529, 0x246f71c184135465),
+            ("aggregation", 0x6c90e24c4bc67b1a, 0x2edff8da8381b2fe),
             ("foraging", 0xe84fe0d65f7cb0d5, 0xe84fe0d65f7cb0d5),
             ("trail", 0x673dabe31bf0b339, 0x3143367b5283c4a6),
         ],
@@ -162,7 +162,7 @@ fn baselines_rapier() {
     baselines(
         None,
         [
-            (0xe969ff49b0e81d20, 0x7a0ba747f35b7c02),
+            (0xd79355c2a3ff1fe6, 0x7d9bc44a8caa50dc),
             (0xb32eb24480774581, 0xb32eb24480774581),
             (0xb51d54da9c6d30e4, 0x65abd118bdcbbebf),
         ],
@@ -174,7 +174,7 @@ fn baselines_discs() {
     baselines(
         Some(PhysicsBackend::Discs),
         [
-            (0xaa4d94bce0cff459, 0x25f99dacd10e76c8),
+            (0xc00d1dd233e303a8, 0x2b443b8b884dea0d),
             (0xa43155483782abb3, 0xa43155483782abb3),
             (0x137cf18b419c7b0f, 0x74607472e76cbfa4),
         ],

@@ -24,6 +24,7 @@ pub enum Kind {
     ActionType,
     UnknownAgent,
     Internal,
+    Unreachable,
 }
 
 /// (kind, class name, parent colcos class, extra builtin base, docstring).
@@ -36,7 +37,7 @@ type Class = (
 );
 
 /// Every class, parents first, in the order of [`Kind`].
-const CLASSES: [Class; 11] = [
+const CLASSES: [Class; 12] = [
     (
         Kind::Colcos,
         "ColcosError",
@@ -113,6 +114,14 @@ const CLASSES: [Class; 11] = [
         Some(Kind::Colcos),
         Some("RuntimeError"),
         "A bug inside colcos, caught before it could take the interpreter down; please report it.",
+    ),
+    (
+        Kind::Unreachable,
+        "PlantUnreachableError",
+        Some(Kind::State),
+        Some("ConnectionError"),
+        "A twin's or rig's tracker or robot link cannot be reached (the URL and the reason are named; \
+         the robots were told to stop); also a ConnectionError.",
     ),
 ];
 

@@ -3,9 +3,9 @@
 //! unchanged. The GIL is released around every call that waits on the arena (reset, step).
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
-use crate::vec_env::{AgentBuffers, Owned, Ptrs, agent_views, owned_actions};
+use crate::vec_env::{AgentBuffers, Owned, Ptrs, action_width, agent_views, owned_actions};
 use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions, TwinScenario};
-use colcos_env::Space;
+use colcos_env::Actions;
 use colcos_sim::scenario::Scenario;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -16,7 +16,7 @@ use std::sync::{Mutex, MutexGuard};
 pub struct PyPlant {
     inner: Mutex<LiveEnv>,
     num_agents: usize,
-    discrete: bool,
+    width: Option<usize>,
 }
 
 fn plant_err(e: PlantError) -> PyErr {
@@ -25,7 +25,10 @@ fn plant_err(e: PlantError) -> PyErr {
         PlantError::Env(e) => to_py(e),
         PlantError::Sim(_) => Kind::Scenario.err(msg),
         PlantError::Option { .. } => Kind::Task.err(msg),
-        PlantError::Source(_) | PlantError::Link(_) | PlantError::Io(_) => Kind::State.err(msg),
+        PlantError::Source(_) | PlantError::Link(_) | PlantError::Unreachable(_) => {
+            Kind::Unreachable.err(msg)
+        }
+        PlantError::Io(_) => Kind::State.err(msg),
         PlantError::Replay(_) | PlantError::State(_) => Kind::State.err(msg),
     }
 }
@@ -156,11 +159,11 @@ impl PyPlant {
             )?;
             let env = py.detach(|| LiveEnv::new(&cfg, &opts)).map_err(plant_err)?;
             let s = env.spec();
-            let (num_agents, discrete) = (s.num_agents, matches!(s.action, Space::Discrete { .. }));
+            let (num_agents, width) = (s.num_agents, action_width(&s.action));
             Ok(PyPlant {
                 inner: Mutex::new(env),
                 num_agents,
-                discrete,
+                width,
             })
         })
     }
@@ -224,14 +227,14 @@ impl PyPlant {
         })
     }
 
-    /// One step (paced to the screen's rate on the twin and the rig): float32 `[1, N, 2]` or int64
-    /// `[1, N]`.
+    /// One step (paced to the screen's rate on the twin and the rig): float32 `[1, N, 2 + D]` or
+    /// int64 `[1, N]`.
     fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
         guard(|| {
-            let acts = owned_actions(actions, 1, self.num_agents, self.discrete)?;
+            let acts = owned_actions(actions, 1, self.num_agents, self.width)?;
             py.detach(|| match &acts {
-                Owned::Discrete(a) => self.lock().step(None, Some(a)),
-                Owned::Continuous(a) => self.lock().step(Some(a), None),
+                Owned::Discrete(a) => self.lock().step(Actions::Discrete(a)),
+                Owned::Continuous(a) => self.lock().step(Actions::Continuous(a)),
             })
             .map_err(plant_err)
         })
@@ -331,6 +334,19 @@ impl PyPlant {
     #[pyo3(signature = (reason="stopped from Python"))]
     fn stop(&self, py: Python<'_>, reason: &str) {
         py.detach(|| self.lock().stop_all(reason));
+    }
+
+    /// Stops every robot and lets go of the tracker, the link and the twin; `reset` and `step`
+    /// raise from then on. Closing twice is harmless.
+    #[pyo3(signature = (reason="the environment was closed"))]
+    fn close(&self, py: Python<'_>, reason: &str) {
+        py.detach(|| self.lock().close(reason));
+    }
+
+    /// Whether `close` was called.
+    #[getter]
+    fn closed(&self, py: Python<'_>) -> bool {
+        py.detach(|| self.lock().is_closed())
     }
 }
 

@@ -29,7 +29,8 @@ pub struct PyVecEnv {
     /// Fixed at construction, read without the lock.
     num_envs: usize,
     num_agents: usize,
-    discrete: bool,
+    /// None: discrete actions; Some(w): continuous rows of `w` entries (wheels, deposit rates).
+    width: Option<usize>,
 }
 
 impl PyVecEnv {
@@ -212,12 +213,12 @@ impl PyVecEnv {
                 .map_err(to_py)?;
             let s = env.spec();
             let (num_envs, num_agents) = (s.num_envs, s.num_agents);
-            let discrete = matches!(s.action, Space::Discrete { .. });
+            let width = action_width(&s.action);
             Ok(PyVecEnv {
                 inner: Mutex::new(Inner { env }),
                 num_envs,
                 num_agents,
-                discrete,
+                width,
             })
         })
     }
@@ -299,12 +300,12 @@ impl PyVecEnv {
         })
     }
 
-    /// Steps every world. `actions`: float32 `[E, N, 2]` (continuous) or int64 `[E, N]` (discrete),
-    /// C-contiguous or not.
+    /// Steps every world. `actions`: float32 `[E, N, 2 + D]` (continuous: wheels, then a rate per
+    /// deposit action) or int64 `[E, N]` (discrete), C-contiguous or not.
     fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
         guard(|| {
             let (e, n) = (self.num_envs, self.num_agents);
-            let acts = owned_actions(actions, e, n, self.discrete)?;
+            let acts = owned_actions(actions, e, n, self.width)?;
             py.detach(|| {
                 let mut g = self.lock();
                 match &acts {
@@ -488,13 +489,21 @@ pub(crate) enum Owned {
 
 /// `actions` checked and copied: int64 `[e, n]` (discrete) or float32 `[e, n, 2]`, C-contiguous or
 /// not.
+/// The width of a continuous action row, or None for discrete actions.
+pub(crate) fn action_width(space: &Space) -> Option<usize> {
+    match space {
+        Space::Box { shape, .. } => Some(shape.iter().product()),
+        Space::Discrete { .. } => None,
+    }
+}
+
 pub(crate) fn owned_actions(
     actions: &Bound<'_, PyAny>,
     e: usize,
     n: usize,
-    discrete: bool,
+    width: Option<usize>,
 ) -> PyResult<Owned> {
-    Ok(if discrete {
+    let Some(w) = width else {
         let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
             Kind::ActionType.err(format!(
                 "discrete actions must be an int64 numpy array of shape ({e}, {n}) = \
@@ -508,26 +517,30 @@ pub(crate) fn owned_actions(
                 a.shape()
             )));
         }
-        Owned::Discrete(a.as_array().iter().copied().collect())
+        return Ok(Owned::Discrete(a.as_array().iter().copied().collect()));
+    };
+    let row = if w == 2 {
+        "wheels".to_string()
     } else {
-        let a: PyReadonlyArrayDyn<'_, f32> = actions.extract().map_err(|_| {
-            Kind::ActionType.err(format!(
-                "continuous actions must be a float32 numpy array of shape ({e}, {n}, 2) = \
-                 (num_envs, num_agents, wheels), got {}",
-                args::show(actions)
-            ))
-        })?;
-        if a.shape() != [e, n, 2] {
-            return Err(Kind::Action.err(format!(
-                "actions have shape {:?}, expected ({e}, {n}, 2) = (num_envs, num_agents, wheels)",
-                a.shape()
-            )));
-        }
-        Owned::Continuous(match a.as_slice() {
-            Ok(src) => src.to_vec(),
-            Err(_) => a.as_array().iter().copied().collect(),
-        })
-    })
+        format!("2 wheels + {} deposit rates", w - 2)
+    };
+    let a: PyReadonlyArrayDyn<'_, f32> = actions.extract().map_err(|_| {
+        Kind::ActionType.err(format!(
+            "continuous actions must be a float32 numpy array of shape ({e}, {n}, {w}) = \
+             (num_envs, num_agents, {row}), got {}",
+            args::show(actions)
+        ))
+    })?;
+    if a.shape() != [e, n, w] {
+        return Err(Kind::Action.err(format!(
+            "actions have shape {:?}, expected ({e}, {n}, {w}) = (num_envs, num_agents, {row})",
+            a.shape()
+        )));
+    }
+    Ok(Owned::Continuous(match a.as_slice() {
+        Ok(src) => src.to_vec(),
+        Err(_) => a.as_array().iter().copied().collect(),
+    }))
 }
 
 impl PyVecEnv {

@@ -27,8 +27,6 @@ pub enum Stream {
     Tracker,
     /// Robot `i`'s own stream: its sensor noise and its behaviour's choices.
     Robot(usize),
-    /// The behaviour of a scripted (non-agent) robot `i` of a batched environment.
-    Scripted(usize),
     /// The baseline policy of agent `i` of a batched environment.
     Baseline(usize),
     /// The noise of robot `i`'s telemetry readings in a digital twin.
@@ -38,10 +36,7 @@ pub enum Stream {
 }
 
 impl Stream {
-    /// First id of the scripted robots' streams: above every robot stream of a world of up to
-    /// `SCRIPTED0 - 2` robots.
-    const SCRIPTED0: u64 = 1 << 20;
-    /// First id of the baseline policies' streams.
+    /// First id of the baseline policies' streams: above every robot stream of any world.
     const BASELINE0: u64 = 1 << 40;
     /// First id of the twin's telemetry streams.
     const TELEMETRY0: u64 = 1 << 41;
@@ -54,7 +49,6 @@ impl Stream {
             Stream::Placement => 0,
             Stream::Tracker => 1,
             Stream::Robot(i) => 2 + i as u64,
-            Stream::Scripted(i) => Self::SCRIPTED0 + i as u64,
             Stream::Baseline(i) => Self::BASELINE0 + i as u64,
             Stream::Telemetry(i) => Self::TELEMETRY0 + i as u64,
             Stream::Randomize => Self::RANDOMIZE,
@@ -176,9 +170,7 @@ mod tests {
     /// The ranges of the stream table do not overlap for any world a scenario can describe.
     #[test]
     fn stream_ids_do_not_collide() {
-        let last_robot = Stream::Robot(Stream::SCRIPTED0 as usize - 3).id();
-        assert!(last_robot < Stream::Scripted(0).id());
-        assert!(Stream::Scripted(1 << 30).id() < Stream::Baseline(0).id());
+        assert!(Stream::Robot(1 << 30).id() < Stream::Baseline(0).id());
         assert!(Stream::Baseline(1 << 30).id() < Stream::Telemetry(0).id());
         assert!(Stream::Telemetry(1 << 30).id() < Stream::Randomize.id());
         assert_eq!(Stream::Placement.id(), 0);

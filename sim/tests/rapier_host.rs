@@ -45,7 +45,10 @@ fn hosted(sc: &Scenario, worlds: usize, steps: usize) -> Vec<Vec<Vec<Pose>>> {
     let mut trace = vec![Vec::new(); worlds];
     for s in 0..steps {
         for (w, world) in ws.iter_mut().enumerate() {
-            world.begin_step_in(&commands(w, s, world.robot_count()), &mut host);
+            let cmds: Vec<_> = (commands(w, s, world.robot_count()).into_iter())
+                .map(Some)
+                .collect();
+            world.begin_step_in(&cmds, &mut host);
         }
         host.step(ws[0].dt());
         for (world, trace) in ws.iter_mut().zip(&mut trace) {

@@ -22,6 +22,9 @@ pub enum LinkError {
     Serial(#[from] serialport::Error),
     #[error("{0}")]
     Io(#[from] std::io::Error),
+    /// Writing to or reading from an open link failed; `link` is its URL.
+    #[error("robot link {link}: {error}")]
+    Wire { link: String, error: std::io::Error },
 }
 
 /// Running totals of a link.
@@ -68,6 +71,8 @@ pub struct Link<W: Wire> {
     telemetry: Vec<Telemetry>,
     bytes_in: u64,
     received: u64,
+    /// What its errors call it (the URL it was opened from).
+    name: String,
 }
 
 /// Telemetry kept for the live loop if it stops reading: about ten seconds of a full channel.
@@ -83,6 +88,20 @@ impl<W: Wire> Link<W> {
             telemetry: Vec::new(),
             bytes_in: 0,
             received: 0,
+            name: "(unnamed)".into(),
+        }
+    }
+
+    /// The link, its errors naming it `name` (the URL it was opened from).
+    pub fn named(mut self, name: impl Into<String>) -> Self {
+        self.name = name.into();
+        self
+    }
+
+    fn wire_err(&self, error: std::io::Error) -> LinkError {
+        LinkError::Wire {
+            link: self.name.clone(),
+            error,
         }
     }
 
@@ -99,11 +118,16 @@ impl<W: Wire> RobotLink for Link<W> {
     fn pump(&mut self) -> Result<usize, LinkError> {
         let mut written = 0;
         while let Some(p) = self.scheduler.next_due(Instant::now()) {
-            self.wire.write_frame(&p.to_frame())?;
+            let frame = p.to_frame();
+            self.wire
+                .write_frame(&frame)
+                .map_err(|e| self.wire_err(e))?;
             written += 1;
         }
         self.rx.clear();
-        self.wire.read_available(&mut self.rx)?;
+        if let Err(e) = self.wire.read_available(&mut self.rx) {
+            return Err(self.wire_err(e));
+        }
         self.bytes_in += self.rx.len() as u64;
         let mut frames = Vec::new();
         self.decoder.feed_into(&self.rx, &mut frames);
@@ -122,8 +146,8 @@ impl<W: Wire> RobotLink for Link<W> {
 
     fn stop_now(&mut self, packet: CommandPacket) -> Result<(), LinkError> {
         self.scheduler.clear();
-        self.wire.write_frame(&packet.to_frame())?;
-        Ok(())
+        let frame = packet.to_frame();
+        self.wire.write_frame(&frame).map_err(|e| self.wire_err(e))
     }
 
     fn counters(&self) -> LinkCounters {
@@ -139,14 +163,24 @@ impl<W: Wire> RobotLink for Link<W> {
 
 /// Opens the link a URL names.
 pub fn open_robot_link(url: &str) -> Result<Box<dyn RobotLink>, LinkError> {
+    let open_err = |error| LinkError::Wire {
+        link: url.to_string(),
+        error,
+    };
     Ok(match url.parse::<LinkUrl>()? {
-        LinkUrl::Serial { device, baud } => Box::new(Link::new(
-            SerialWire::open(&device, baud)?,
-            AirtimeScheduler::new(baud),
-        )),
-        LinkUrl::Udp { host, port, baud } => Box::new(Link::new(
-            UdpWire::connect(&format!("{host}:{port}"))?,
-            AirtimeScheduler::new(baud),
-        )),
+        LinkUrl::Serial { device, baud } => Box::new(
+            Link::new(
+                SerialWire::open(&device, baud)?,
+                AirtimeScheduler::new(baud),
+            )
+            .named(url),
+        ),
+        LinkUrl::Udp { host, port, baud } => Box::new(
+            Link::new(
+                UdpWire::connect(&format!("{host}:{port}")).map_err(open_err)?,
+                AirtimeScheduler::new(baud),
+            )
+            .named(url),
+        ),
     })
 }

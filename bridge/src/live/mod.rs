@@ -46,5 +46,7 @@ pub fn run(
     if status {
         eprintln!();
     }
-    Ok(session.report())
+    let mut report = session.report();
+    report.interrupted = stop.load(Ordering::Relaxed);
+    Ok(report)
 }

@@ -69,4 +69,10 @@ pub struct LiveReport {
     /// measures them.
     pub rig_latency: f32,
     pub tracker_latency: f32,
+    /// The last reason the tracker gave no poses (its address and the error), if it ever failed.
+    pub tracker_problem: Option<String>,
+    /// Why the robot link was failing when the run ended, if it was.
+    pub link_problem: Option<String>,
+    /// Ended by Ctrl-C or SIGTERM rather than by its duration.
+    pub interrupted: bool,
 }

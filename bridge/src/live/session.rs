@@ -54,6 +54,10 @@ pub struct LiveSession {
     poses: Vec<PoseIn>,
     telemetry: Vec<Telemetry>,
     stopped: Vec<bool>,
+    /// Since when, and why, the link has failed every tick (None: the last pump worked).
+    link_failing: Option<(Instant, String)>,
+    /// The tracker's problem last told to the operator.
+    told_tracker: Option<String>,
     // Last: stops every robot when the session is dropped, after everything above.
     _stop_on_exit: StopOnDrop,
 }
@@ -103,6 +107,7 @@ impl LiveSession {
             radio: core.radio().to_vec(),
             firmware: core.firmware(),
             start,
+            warned: Default::default(),
         };
         let beats = Heartbeats::new(n);
         let limits = SafetyLimits {
@@ -164,6 +169,8 @@ impl LiveSession {
             poses: Vec::with_capacity(n),
             telemetry: Vec::new(),
             stopped: vec![false; n],
+            link_failing: None,
+            told_tracker: None,
         })
     }
 
@@ -179,13 +186,31 @@ impl LiveSession {
         self.core = core;
         self.last_tick = None;
     }
+    /// The core, the rest let go: the robots stopped, the watchdog ended, the logs finished.
+    pub fn into_core(self) -> LoopCore {
+        self.core
+    }
     /// Seconds since the session started.
     pub fn elapsed(&self) -> f64 {
         self.start.elapsed().as_secs_f64()
     }
-    /// Stops every robot now (all of them, broadcast) for `why`, ahead of anything queued.
+    /// Stops every robot now (all of them, broadcast) for `why`, ahead of anything queued; the
+    /// report's stops list it as `shutdown`.
     pub fn stop_all(&self, why: &str) {
         self.stopper.stop(&StopReason::Shutdown(why.to_string()));
+        if let Ok(mut s) = self.stops.lock() {
+            s.push("shutdown".into());
+        }
+    }
+    /// How long, in s, and why the robot link has failed on every tick; None while it works.
+    pub fn link_problem(&self) -> Option<(f64, String)> {
+        (self.link_failing.as_ref())
+            .map(|(since, why)| (since.elapsed().as_secs_f64(), why.clone()))
+    }
+    /// Why no pose is arriving from the tracker (its address and the reason); None while poses
+    /// arrive.
+    pub fn tracker_problem(&self) -> Option<String> {
+        self.source.problem()
     }
     fn log(&self) -> &SharedLog {
         &self.stopper.log
@@ -202,9 +227,26 @@ impl LiveSession {
             .last_tick
             .map_or(self.dt, |last| now.duration_since(last).as_secs_f64());
         self.last_tick = Some(now);
-        let link_error = self.exchange(t, step, overrides);
-        if let Some(e) = link_error {
-            self.stopper.stop(&StopReason::LinkError(e));
+        match self.exchange(t, step, overrides) {
+            // A link that keeps failing is stopped (and said) once, when it starts failing.
+            Some(e) if self.link_failing.is_none() => {
+                self.stopper.stop(&StopReason::LinkError(e.clone()));
+                if let Ok(mut s) = self.stops.lock() {
+                    s.push("link_error".into());
+                }
+                self.link_failing = Some((now, e));
+            }
+            Some(_) => {}
+            None => self.link_failing = None,
+        }
+        let problem = self.source.problem();
+        if let Some(p) = &problem
+            && self.told_tracker.as_ref() != Some(p)
+        {
+            log::warn!("no poses from the tracker at {p}; retrying with backoff");
+        }
+        if problem.is_some() {
+            self.told_tracker = problem;
         }
         self.beats.policy();
         for &i in self.core.fresh() {
@@ -407,7 +449,11 @@ impl LiveSession {
     fn print_status(&self, t: f64, work: f64) {
         let host = self.core.host();
         let n = self.core.robot_count();
-        let seen = host.tracked().iter().filter(|p| p.seen).count();
+        // Seen: a pose no older than the watchdog allows, not merely one seen once.
+        let max_age = self.scenario.spec.rig.pose_age;
+        let seen = (host.tracked().iter())
+            .filter(|p| p.seen && host.time() - p.stamp <= max_age)
+            .count();
         let counters = self
             .stopper
             .link
@@ -446,6 +492,8 @@ impl LiveSession {
         report.telemetry_received = c.telemetry_received;
         report.silent_robots = c.silent_robots.clone();
         report.stops = self.stops.lock().map(|s| s.clone()).unwrap_or_default();
+        report.tracker_problem = self.source.problem().or_else(|| self.told_tracker.clone());
+        report.link_problem = self.link_failing.as_ref().map(|(_, e)| e.clone());
         report.gif_frames_dropped = self.gif.as_ref().map_or(0, |g| g.dropped);
         if let Ok(l) = self.stopper.link.lock() {
             let c = l.counters().scheduler;

@@ -7,8 +7,39 @@ use crate::recorder::{Recorder, Topic};
 use crate::watchdog::StopReason;
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Firmware;
+use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use std::time::{Duration, Instant};
+
+/// At most one warning per kind of stop in this long; the others are counted into the next.
+const WARN_EVERY: Duration = Duration::from_secs(5);
+
+/// When each kind of stop was last warned of, and how many went unsaid since.
+#[derive(Default)]
+pub(crate) struct WarnLimiter(Mutex<HashMap<&'static str, (Instant, u64)>>);
+
+impl WarnLimiter {
+    /// Whether to warn of a stop of `kind` now, and how many of that kind went unsaid before it.
+    fn admit(&self, kind: &'static str) -> Option<u64> {
+        let mut m = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let now = Instant::now();
+        match m.get_mut(kind) {
+            Some((last, unsaid)) if now.duration_since(*last) < WARN_EVERY => {
+                *unsaid += 1;
+                None
+            }
+            Some((last, unsaid)) => {
+                let n = *unsaid;
+                (*last, *unsaid) = (now, 0);
+                Some(n)
+            }
+            None => {
+                m.insert(kind, (now, 0));
+                Some(0)
+            }
+        }
+    }
+}
 
 pub(crate) type SharedLink = Arc<Mutex<Box<dyn RobotLink>>>;
 pub(crate) type SharedLog = Arc<Mutex<Option<Recorder>>>;
@@ -67,6 +98,7 @@ pub(crate) struct Stopper {
     pub radio: Vec<u8>,
     pub firmware: Firmware,
     pub start: Instant,
+    pub warned: Arc<WarnLimiter>,
 }
 
 impl Stopper {
@@ -88,18 +120,36 @@ impl Stopper {
         let event = serde_json::json!({
             "kind": reason.kind(),
             "robot": reason.robot(),
-            "detail": format!("{reason:?}"),
+            "detail": reason.to_string(),
             "sent": sent.is_ok(),
         });
         record(&self.log, Topic::Events, event.to_string().as_bytes());
-        log::warn!(
-            "safety stop ({}): {reason:?}",
-            if id == BROADCAST_ID {
-                "all robots".to_string()
-            } else {
-                format!("radio {id}")
-            }
-        );
+        let whom = if id == BROADCAST_ID {
+            "all robots".to_string()
+        } else {
+            format!("radio {id}")
+        };
+        // A normal end stops the robots as a matter of course: said, not warned of.
+        if let StopReason::Shutdown(why) = reason {
+            log::debug!("stopped {whom}: {why}");
+            return;
+        }
+        let Some(unsaid) = self.warned.admit(reason.kind()) else {
+            return;
+        };
+        let more = if unsaid > 0 {
+            format!(
+                " ({unsaid} more of this kind in the last {} s)",
+                WARN_EVERY.as_secs()
+            )
+        } else {
+            String::new()
+        };
+        let failed = match &sent {
+            Ok(()) => String::new(),
+            Err(e) => format!("; the stop could not be sent: {e}"),
+        };
+        log::warn!("safety stop of {whom}: {reason}{more}{failed}");
     }
 }
 

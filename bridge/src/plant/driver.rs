@@ -14,9 +14,19 @@ use colcos_sim::shield::Intervention;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+pub(super) fn closed_error() -> PlantError {
+    PlantError::State(
+        "this environment was closed (its robots stopped): make a new one to drive them again"
+            .into(),
+    )
+}
+
 pub(crate) enum Driver {
     Live {
         session: Box<LiveSession>,
+        /// The URLs its errors name.
+        tracker: String,
+        robots: String,
         /// Declared after the session: the session stops the robots before the twin goes.
         _twin: Option<TwinThread>,
     },
@@ -25,13 +35,20 @@ pub(crate) enum Driver {
         ticks: Vec<RecordedTick>,
         next: usize,
     },
+    /// Closed: the last tick's state, kept for reading; nothing can drive from here.
+    Closed { core: Box<LoopCore> },
 }
+
+/// Longest a reset waits for the tracker to have seen every robot.
+pub(crate) const POSE_WAIT_S: f64 = 5.0;
+/// Longest a robot link may fail on every tick before a reset or step gives up.
+pub(crate) const LINK_FAIL_S: f64 = 1.0;
 
 impl Driver {
     pub fn core(&self) -> &LoopCore {
         match self {
             Driver::Live { session, .. } => session.core(),
-            Driver::Replay { core, .. } => core,
+            Driver::Replay { core, .. } | Driver::Closed { core } => core,
         }
     }
     pub fn host(&self) -> &Host {
@@ -40,7 +57,7 @@ impl Driver {
     pub fn host_mut(&mut self) -> &mut Host {
         match self {
             Driver::Live { session, .. } => session.core_mut().host_mut(),
-            Driver::Replay { core, .. } => core.host_mut(),
+            Driver::Replay { core, .. } | Driver::Closed { core } => core.host_mut(),
         }
     }
     pub fn interventions(&self) -> &[Intervention] {
@@ -51,11 +68,22 @@ impl Driver {
     /// tick left (nothing happened).
     pub fn tick(&mut self, overrides: &[Option<WheelCommand>]) -> Result<bool, PlantError> {
         match self {
-            Driver::Live { session, .. } => {
+            Driver::Live {
+                session, robots, ..
+            } => {
                 session.wait_next();
                 session.tick(overrides)?;
-                Ok(true)
+                match session.link_problem() {
+                    Some((for_s, why)) if for_s >= LINK_FAIL_S => {
+                        Err(PlantError::Unreachable(format!(
+                            "the robot link {robots} has failed for {for_s:.1} s ({why}); \
+                             the robots were told to stop"
+                        )))
+                    }
+                    _ => Ok(true),
+                }
             }
+            Driver::Closed { .. } => Err(closed_error()),
             Driver::Replay { core, ticks, next } => {
                 let Some(tick) = ticks.get(*next) else {
                     return Ok(false);
@@ -70,7 +98,7 @@ impl Driver {
     /// Ticks left in a replay (None: live).
     pub fn remaining(&self) -> Option<usize> {
         match self {
-            Driver::Live { .. } => None,
+            Driver::Live { .. } | Driver::Closed { .. } => None,
             Driver::Replay { ticks, next, .. } => Some(ticks.len().saturating_sub(*next)),
         }
     }
@@ -88,7 +116,73 @@ impl Driver {
                 **c = core;
                 *next = 0;
             }
+            Driver::Closed { .. } => return Err(closed_error()),
         }
+        Ok(())
+    }
+
+    /// Waits, ticking with every robot stopped, until the tracker has seen every robot: an
+    /// episode's first observation is never of a pose that was not tracked. Raises naming the URL
+    /// and the reason when the tracker or the link cannot be reached.
+    pub fn await_poses(&mut self) -> Result<(), PlantError> {
+        let Driver::Live { tracker, .. } = self else {
+            return Ok(());
+        };
+        let tracker = tracker.clone();
+        let start = std::time::Instant::now();
+        let n = self.host().tracked().len();
+        let still = vec![Some(WheelCommand::STOP); n];
+        loop {
+            let unseen: Vec<usize> = (self.host().tracked().iter().enumerate())
+                .filter(|(_, p)| !p.seen)
+                .map(|(i, _)| i)
+                .collect();
+            if unseen.is_empty() {
+                return Ok(());
+            }
+            let waited = start.elapsed().as_secs_f64();
+            if waited >= POSE_WAIT_S {
+                let Driver::Live { session, .. } = &*self else {
+                    return Ok(());
+                };
+                let why = if unseen.len() == n {
+                    let reason = session.tracker_problem().unwrap_or_else(|| {
+                        "connected, but no frame with these robots arrived".into()
+                    });
+                    format!("no pose from the tracker {tracker} in {waited:.1} s ({reason})")
+                } else {
+                    let list: Vec<String> = unseen.iter().map(|i| i.to_string()).collect();
+                    format!(
+                        "the tracker {tracker} has not seen robot(s) {} of {n} in {waited:.1} s",
+                        list.join(", ")
+                    )
+                };
+                return Err(PlantError::Unreachable(format!(
+                    "{why}; the robots were told to stop"
+                )));
+            }
+            self.tick(&still)?;
+        }
+    }
+
+    /// Lets go of the tracker, the link (its guard's stop the last frame sent) and a twin started
+    /// here; the last tick's state stays readable.
+    pub fn close(&mut self, scenario: &Scenario) -> Result<(), PlantError> {
+        let placeholder = LoopCore::new(scenario, LegacyDrive::default())?;
+        let old = std::mem::replace(
+            self,
+            Driver::Closed {
+                core: Box::new(placeholder),
+            },
+        );
+        let core = match old {
+            // The session (and its guard's final stop) goes before the twin.
+            Driver::Live { session, _twin, .. } => session.into_core(),
+            Driver::Replay { core, .. } | Driver::Closed { core } => *core,
+        };
+        *self = Driver::Closed {
+            core: Box::new(core),
+        };
         Ok(())
     }
 
@@ -96,6 +190,7 @@ impl Driver {
     pub fn time(&self) -> f64 {
         match self {
             Driver::Live { session, .. } => session.elapsed(),
+            Driver::Closed { core } => core.host().time() as f64,
             Driver::Replay { ticks, next, .. } => next
                 .checked_sub(1)
                 .and_then(|k| ticks.get(k))

@@ -25,10 +25,13 @@ use crate::frames::FrameServer;
 use crate::host::Host;
 use crate::live::{LiveOptions, LiveSession, LoopCore, replay};
 use crate::{SourceOptions, open_pose_source, open_robot_link};
-use colcos_env::encoding::{self, OBS_DIM};
+use colcos_env::encoding::OBS_DIM;
 use colcos_env::task::registry;
 use colcos_env::world_output::{render_world, write_obs, write_patch, write_state};
-use colcos_env::{EnvConfig, EnvError, EnvSpec, Space, Task, VecEnv, shield_bits};
+use colcos_env::{
+    ActionDecoder, Actions, AgentOut, EnvConfig, EnvSpec, Episode, StepEnd, Task, VecEnv,
+    shield_bits,
+};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::{Scenario, SensorSource};
@@ -63,12 +66,12 @@ pub struct LiveEnv {
     patch: Option<colcos_env::PatchConfig>,
     max_speed: f32,
     overrides: Vec<Option<WheelCommand>>,
-    steps: u64,
-    episode: u64,
+    decoder: ActionDecoder,
+    /// Scratch: the agents' decoded commands and deposit rates.
+    commands: Vec<WheelCommand>,
+    deposit_rates: Vec<f32>,
+    episode: Episode,
     needs_reset: bool,
-    done: bool,
-    agent_terminated: Vec<bool>,
-    prev_terminated: Vec<bool>,
     obs: Vec<f32>,
     rewards: Vec<f32>,
     terminated: Vec<bool>,
@@ -76,6 +79,8 @@ pub struct LiveEnv {
     state: Vec<f32>,
     patch_buf: Vec<u8>,
     shield: Vec<u8>,
+    /// The live loop's report as it was when the plant was closed.
+    closed: Option<Option<crate::live::LiveReport>>,
 }
 
 impl LiveEnv {
@@ -88,7 +93,8 @@ impl LiveEnv {
             num_threads: Some(1),
             ..cfg.clone()
         };
-        let spec = VecEnv::new(&one)?.spec().clone();
+        let sim = VecEnv::new(&one)?;
+        let (spec, decoder) = (sim.spec().clone(), sim.action_decoder().clone());
         let (task, mut scenario) = registry::build(&cfg.task, &cfg.scenario, &cfg.params)?;
         scenario.spec.seed = cfg.seed;
         if let Some(p) = cfg.physics {
@@ -119,12 +125,11 @@ impl LiveEnv {
             goto,
             goto_report: GoToReport::default(),
             overrides: vec![None; robots],
-            steps: 0,
-            episode: 0,
+            commands: vec![WheelCommand::STOP; n],
+            deposit_rates: vec![0.0; n * decoder.deposits()],
+            decoder,
+            episode: Episode::new(0, n),
             needs_reset: true,
-            done: false,
-            agent_terminated: vec![false; n],
-            prev_terminated: vec![false; n],
             obs: vec![0.0; n * OBS_DIM],
             rewards: vec![0.0; n],
             terminated: vec![false; n],
@@ -132,6 +137,7 @@ impl LiveEnv {
             state: vec![0.0; state_dim.max(1)],
             patch_buf: vec![0; (n * patch_len).max(1)],
             shield: vec![0; n],
+            closed: None,
             spec,
             scenario,
         })
@@ -221,6 +227,8 @@ impl LiveEnv {
         let session = LiveSession::new(scenario, source, link, frames, live)?;
         Ok(Driver::Live {
             session: Box::new(session),
+            tracker,
+            robots,
             _twin: twin,
         })
     }
@@ -239,10 +247,10 @@ impl LiveEnv {
         self.driver.host()
     }
     pub fn episode(&self) -> u64 {
-        self.episode
+        self.episode.index
     }
     pub fn episode_steps(&self) -> u64 {
-        self.steps
+        self.episode.steps
     }
     pub fn goto_report(&self) -> GoToReport {
         self.goto_report
@@ -300,15 +308,18 @@ impl LiveEnv {
     /// A new episode: a `seed` becomes the scenario's seed and restarts the episode count. On the
     /// twin and the rig the robots are first driven to the episode's start poses (if asked to).
     pub fn reset(&mut self, seed: Option<u64>) -> Result<(), PlantError> {
+        self.refuse_closed()?;
+        // Nothing is driven, and no observation is made, before every robot has been tracked.
+        self.driver.await_poses()?;
         if let Some(s) = seed {
             self.scenario.spec.seed = s;
         }
-        self.episode = if seed.is_some() || self.needs_reset {
+        let episode = if seed.is_some() || self.needs_reset {
             0
         } else {
-            self.episode + 1
+            self.episode.index + 1
         };
-        let index = colcos_env::world_index(0, self.episode);
+        let index = colcos_env::world_index(0, episode);
         if let Some((goto, timeout)) = self.goto {
             let targets = WorldParts::build(&self.scenario, index)?.poses;
             self.goto_report = self.drive_to(&goto, &targets, timeout)?;
@@ -321,10 +332,8 @@ impl LiveEnv {
             self.overrides[i] = Some(WheelCommand::STOP);
         }
         self.driver.tick(&self.overrides)?;
-        self.steps = 0;
-        self.done = false;
+        self.episode.restart(episode);
         self.needs_reset = false;
-        self.agent_terminated.fill(false);
         self.rewards.fill(0.0);
         self.terminated.fill(false);
         self.truncated.fill(false);
@@ -368,93 +377,65 @@ impl LiveEnv {
         })
     }
 
-    /// One step: continuous actions `[N, 2]` in `[-1, 1]` (fractions of the largest wheel speed) or
-    /// discrete ones `[N]`. Terminated agents are stopped and their actions ignored.
-    pub fn step(
-        &mut self,
-        continuous: Option<&[f32]>,
-        discrete: Option<&[i64]>,
-    ) -> Result<(), PlantError> {
+    /// One step: continuous actions `[N, 2 + D]` (wheels as fractions of the largest wheel speed,
+    /// then deposit rates) or discrete ones `[N]`, decoded as the simulated batch decodes them.
+    /// Terminated agents are stopped and their actions ignored.
+    pub fn step(&mut self, actions: Actions) -> Result<(), PlantError> {
+        self.refuse_closed()?;
         if self.needs_reset {
             return Err(PlantError::State("call reset() before step()".into()));
         }
-        if self.done {
+        if self.episode.done {
             return Err(PlantError::State(
                 "the episode has ended: call reset() before stepping again".into(),
             ));
         }
-        let agents = self.task.agents().to_vec();
-        let n = agents.len();
+        self.decoder
+            .decode(actions, 1, &mut self.commands, &mut self.deposit_rates)?;
         self.overrides.fill(None);
-        match (continuous, discrete, &self.spec.action) {
-            (Some(a), None, Space::Box { .. }) if a.len() == 2 * n => {
-                for (k, &i) in agents.iter().enumerate() {
-                    let (l, r) = (a[2 * k], a[2 * k + 1]);
-                    if !(l.is_finite() && r.is_finite()) {
-                        return Err(EnvError::Action(format!(
-                            "action of agent robot_{k} is [{l}, {r}] (must be finite)"
-                        ))
-                        .into());
-                    }
-                    self.overrides[i] = Some(encoding::continuous_command(l, r, self.max_speed));
-                }
-            }
-            (None, Some(a), Space::Discrete { n: count }) if a.len() == n => {
-                for (k, &i) in agents.iter().enumerate() {
-                    let cmd =
-                        encoding::discrete_command(a[k], self.max_speed).ok_or_else(|| {
-                            EnvError::Action(format!(
-                                "action of agent robot_{k} is {}, not in 0..{count}",
-                                a[k]
-                            ))
-                        })?;
-                    self.overrides[i] = Some(cmd);
-                }
-            }
-            _ => {
-                return Err(EnvError::Action(format!(
-                    "expected {} for the {n} agents",
-                    match self.spec.action {
-                        Space::Box { .. } => format!("{} continuous values ([N, 2])", 2 * n),
-                        Space::Discrete { .. } => format!("{n} discrete actions ([N])"),
-                    }
-                ))
-                .into());
-            }
+        let d = self.decoder.deposits();
+        let host = self.driver.host_mut();
+        for (k, (&i, &term)) in (self.task.agents().iter())
+            .zip(&self.episode.terminated)
+            .enumerate()
+        {
+            // A terminated agent is stopped and lays nothing.
+            self.overrides[i] = Some(if term {
+                WheelCommand::STOP
+            } else {
+                self.commands[k]
+            });
+            let lay = self.deposit_rates[k * d..(k + 1) * d].iter();
+            host.set_deposit_actions(i, lay.map(|&f| if term { 0.0 } else { f }));
         }
-        for (k, &i) in agents.iter().enumerate() {
-            if self.agent_terminated[k] {
-                self.overrides[i] = Some(WheelCommand::STOP);
-            }
-        }
-        let ticked = self.driver.tick(&self.overrides)?;
-        self.steps += 1;
-        self.prev_terminated.copy_from_slice(&self.agent_terminated);
-        self.task.evaluate(
+        let end = match self.driver.tick(&self.overrides)? {
+            false => StepEnd::Nothing,
+            true if self.driver.remaining() == Some(0) => StepEnd::LastStep,
+            true => StepEnd::Stepped,
+        };
+        let done = self.episode.finish_step(
+            self.task.as_ref(),
             self.driver.host(),
-            &mut self.rewards,
-            &mut self.agent_terminated,
+            self.spec.max_cycles,
+            end,
+            AgentOut {
+                rewards: &mut self.rewards,
+                terminated: &mut self.terminated,
+                truncated: &mut self.truncated,
+            },
         );
-        for (r, &was) in self.rewards.iter_mut().zip(&self.prev_terminated) {
-            if was || !ticked {
-                *r = 0.0;
-            }
-        }
-        let out_of_ticks = self.driver.remaining() == Some(0);
-        let truncate = self.steps >= self.spec.max_cycles || out_of_ticks || !ticked;
         let interventions = self.driver.interventions();
-        let mut done = true;
-        for (k, &i) in agents.iter().enumerate() {
-            self.terminated[k] = self.agent_terminated[k];
-            self.truncated[k] = truncate && !self.agent_terminated[k];
-            done &= self.terminated[k] || self.truncated[k];
-            self.shield[k] = if self.prev_terminated[k] {
+        for ((&i, &was), flags) in (self.task.agents().iter())
+            .zip(&self.episode.was_terminated)
+            .zip(self.shield.iter_mut())
+        {
+            *flags = if was {
                 0
             } else {
                 shield_bits(interventions[i])
             };
         }
-        self.done = done;
+        debug_assert_eq!(done, self.episode.done);
         self.write_outputs();
         Ok(())
     }
@@ -464,7 +445,12 @@ impl LiveEnv {
         let agents = self.task.agents();
         write_obs(host, agents, self.max_speed, &mut self.obs);
         if self.spec.state.is_some() {
-            write_state(host, self.steps, self.spec.max_cycles, &mut self.state);
+            write_state(
+                host,
+                self.episode.steps,
+                self.spec.max_cycles,
+                &mut self.state,
+            );
         }
         if let Some(p) = &self.patch {
             write_patch(host, agents, p, &mut self.patch_buf);
@@ -478,11 +464,42 @@ impl LiveEnv {
         }
     }
 
-    /// The live loop's measurements so far (ticks, overruns, shield, stops); None for a replay.
+    fn refuse_closed(&self) -> Result<(), PlantError> {
+        match self.closed {
+            Some(_) => Err(driver::closed_error()),
+            None => Ok(()),
+        }
+    }
+
+    /// Stops every robot for `why` and lets go of the tracker, the link and a twin started here:
+    /// `reset` and `step` fail from now on, so a closed plant never drives again. Idempotent.
+    pub fn close(&mut self, why: &str) {
+        if self.closed.is_some() {
+            return;
+        }
+        if let Driver::Live { session, .. } = &self.driver {
+            session.stop_all(why);
+        }
+        let report = self.live_report();
+        if let Err(e) = self.driver.close(&self.scenario) {
+            log::warn!("closing the plant: {e}");
+        }
+        self.closed = Some(report);
+    }
+
+    pub fn is_closed(&self) -> bool {
+        self.closed.is_some()
+    }
+
+    /// The live loop's measurements so far (ticks, overruns, shield, stops, `shutdown` for each
+    /// stop on closing or asked for); None for a replay.
     pub fn live_report(&self) -> Option<crate::live::LiveReport> {
+        if let Some(r) = &self.closed {
+            return r.clone();
+        }
         match &self.driver {
             Driver::Live { session, .. } => Some(session.report()),
-            Driver::Replay { .. } => None,
+            Driver::Replay { .. } | Driver::Closed { .. } => None,
         }
     }
     /// Seconds since the plant started (live) or the replay's recorded time.

@@ -84,6 +84,9 @@ pub enum PlantError {
     Option { key: String, reason: String },
     #[error("{0}")]
     State(String),
+    /// The tracker or the robot link cannot be reached: the URL and the reason.
+    #[error("{0}")]
+    Unreachable(String),
 }
 
 impl PlantError {

@@ -43,9 +43,11 @@ pub struct PoseSnapshot {
 pub enum ConnectionState {
     Connecting,
     Connected,
-    /// Lost; the next attempt is after the backoff.
+    /// Lost or never reached; the next attempt is after the backoff. `reason` names the address
+    /// and what went wrong ("127.0.0.1:6699: Connection refused (os error 111)").
     Disconnected {
         retry_in: Duration,
+        reason: String,
     },
     /// A replay reached its end.
     Finished,
@@ -87,6 +89,11 @@ pub trait PoseSource: Send {
     fn latest(&self) -> Option<PoseSnapshot>;
     fn state(&self) -> ConnectionState;
     fn counters(&self) -> SourceCounters;
+    /// Why no pose is arriving, naming the address ("127.0.0.1:6699: Connection refused"); None
+    /// while frames arrive (and before the first attempt has failed).
+    fn problem(&self) -> Option<String> {
+        None
+    }
     /// Events (`Calibrated`, `Closed`) since the last call.
     fn take_events(&mut self) -> Vec<TrackerEvent>;
     /// Asks the tracker to calibrate; only SwarmCon can.

@@ -20,6 +20,8 @@ pub(crate) struct State {
     pub events: VecDeque<TrackerEvent>,
     /// A command line waiting to be written to the server.
     pub outgoing: Option<String>,
+    /// Why no pose is arriving (the last failure), until the next frame arrives.
+    pub problem: Option<String>,
 }
 
 /// The thread's handle on the shared state.
@@ -38,6 +40,7 @@ impl Shared {
                 counters: SourceCounters::default(),
                 events: VecDeque::new(),
                 outgoing: None,
+                problem: None,
             })),
             stop: Arc::new(AtomicBool::new(false)),
         }
@@ -53,7 +56,13 @@ impl Shared {
     }
 
     pub fn set_state(&self, s: ConnectionState) {
-        self.lock().state = s;
+        let mut g = self.lock();
+        match &s {
+            ConnectionState::Disconnected { reason, .. } => g.problem = Some(reason.clone()),
+            ConnectionState::Failed(reason) => g.problem = Some(reason.clone()),
+            _ => {}
+        }
+        g.state = s;
     }
 
     pub fn publish(&self, t: f64, poses: Vec<TrackedPose>) {
@@ -66,6 +75,7 @@ impl Shared {
             poses,
         });
         g.counters.frames += 1;
+        g.problem = None;
     }
 
     pub fn event(&self, e: TrackerEvent) {
@@ -143,6 +153,10 @@ impl PoseSource for ThreadedSource {
 
     fn counters(&self) -> SourceCounters {
         self.shared.lock().counters
+    }
+
+    fn problem(&self) -> Option<String> {
+        self.shared.lock().problem.clone()
     }
 
     fn take_events(&mut self) -> Vec<TrackerEvent> {

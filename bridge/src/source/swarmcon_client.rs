@@ -38,20 +38,27 @@ fn run(shared: &Shared, addr: &str, opts: &SourceOptions) {
     let mut connected_before = false;
     while !shared.stopped() {
         shared.set_state(ConnectionState::Connecting);
-        if let Ok(stream) = connect(addr, opts.connect_timeout) {
-            if connected_before {
-                shared.lock().counters.reconnects += 1;
+        let reason = match connect(addr, opts.connect_timeout) {
+            Err(e) => format!("{addr}: {e}"),
+            Ok(stream) => {
+                if connected_before {
+                    shared.lock().counters.reconnects += 1;
+                }
+                connected_before = true;
+                backoff = opts.backoff_initial;
+                parser.reset();
+                shared.set_state(ConnectionState::Connected);
+                serve(shared, stream, &mut parser, opts);
+                format!("{addr}: the server closed the connection")
             }
-            connected_before = true;
-            backoff = opts.backoff_initial;
-            parser.reset();
-            shared.set_state(ConnectionState::Connected);
-            serve(shared, stream, &mut parser, opts);
-        }
+        };
         if shared.stopped() {
             break;
         }
-        shared.set_state(ConnectionState::Disconnected { retry_in: backoff });
+        shared.set_state(ConnectionState::Disconnected {
+            retry_in: backoff,
+            reason,
+        });
         if !shared.sleep(backoff) {
             break;
         }

@@ -31,6 +31,7 @@ from colcos._core import (
     ColcosError,
     DisplayError,
     InternalError,
+    PlantUnreachableError,
     ScenarioError,
     StateError,
     TaskError,
@@ -40,6 +41,7 @@ from colcos._core import (
     observation_names,
 )
 from colcos.pettingzoo_env import ColcosParallelEnv, env, parallel_env, raw_env
+from colcos import preflight as preflight  # noqa: E402  (after pettingzoo_env, which it imports)
 
 __version__ = _core.__version__
 
@@ -52,6 +54,7 @@ __all__ = [
     "DisplayError",
     "ColcosParallelEnv",
     "InternalError",
+    "PlantUnreachableError",
     "ScenarioError",
     "StateError",
     "TaskError",
@@ -64,6 +67,7 @@ __all__ = [
     "gymnasium_vector",
     "observation_names",
     "parallel_env",
+    "preflight",
     "raw_env",
     "sweep",
     "tasks",

@@ -290,12 +290,13 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
 
     def close(self) -> None:
         """Closes the `render_mode="human"` window, if one is open; on the twin and the rig, stops
-        every robot."""
+        every robot and lets go of the tracker and the link: `reset` and `step` raise from then on,
+        so a closed plant never drives again."""
         if self._window is not None:
             self._window.close()
         if self.plant != "sim":
             assert isinstance(self._core, _core.Plant)
-            self._core.stop("the environment was closed")
+            self._core.close("the environment was closed")
 
     def __enter__(self) -> ColcosParallelEnv:
         return self

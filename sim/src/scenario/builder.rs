@@ -247,6 +247,7 @@ impl RobotGroupSpec {
             region: None,
             poses: Vec::new(),
             deposits: Vec::new(),
+            deposit_actions: Vec::new(),
             emits: Vec::new(),
         }
     }

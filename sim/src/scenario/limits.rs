@@ -190,17 +190,28 @@ pub(super) fn check_step_work(sc: &Scenario, grid: &GridSpec) -> Result<()> {
     let side =
         |support: f32, n: usize| ((2.0 * support / grid.cell).ceil() as f64 + 2.0).min(n as f64);
     for (g, group) in s.robots.iter().enumerate() {
-        for (d, dep) in group.deposits.iter().enumerate() {
-            let support = dep.kernel.support();
+        let trails = (group.deposits.iter().map(|d| ("deposits", d.kernel))).chain(
+            group
+                .deposit_actions
+                .iter()
+                .map(|d| ("deposit_actions", d.kernel)),
+        );
+        for (d, (list, kernel)) in trails.enumerate() {
+            let d = if list == "deposits" {
+                d
+            } else {
+                d - group.deposits.len()
+            };
+            let support = kernel.support();
             cells += group.count as f64 * side(support, grid.nx) * side(support, grid.ny);
             if cells > MAX_DEPOSIT_CELLS {
-                let (name, size) = match dep.kernel {
+                let (name, size) = match kernel {
                     crate::field::Kernel::Disc { radius }
                     | crate::field::Kernel::Cone { radius } => ("radius", radius),
                     crate::field::Kernel::Gaussian { sigma } => ("sigma", sigma),
                 };
                 return Err(SimError::invalid(
-                    format!("robots[{g}].deposits[{d}].kernel.{name}"),
+                    format!("robots[{g}].{list}[{d}].kernel.{name}"),
                     size,
                     format!(
                         "the deposits would touch {cells:.0} cells a step, more than {MAX_DEPOSIT_CELLS:.0e}"

@@ -238,6 +238,10 @@ pub struct RobotGroupSpec {
     /// Trails this group lays on grid pheromones.
     #[serde(default)]
     pub deposits: Vec<DepositSpec>,
+    /// Trails this group's agents choose to lay, step by step (an RL environment's pheromone
+    /// actions): one action entry each, a fraction of `max_rate`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub deposit_actions: Vec<DepositActionSpec>,
     /// Gaussian sources this group emits.
     #[serde(default)]
     pub emits: Vec<EmitSpec>,
@@ -251,6 +255,17 @@ pub struct DepositSpec {
     pub kernel: Kernel,
     /// Units per second at the kernel's peak.
     pub rate: f32,
+}
+
+/// A trail an agent lays at a rate it chooses each step: `fraction * max_rate`, along the same path
+/// and with the same kernels as a [`DepositSpec`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DepositActionSpec {
+    pub pheromone: String,
+    pub kernel: Kernel,
+    /// Units per second at the kernel's peak when the action is 1.
+    pub max_rate: f32,
 }
 
 /// A Gaussian source attached to each robot of a group.

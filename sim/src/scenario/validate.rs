@@ -494,18 +494,37 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
                 "poses are only used with placement = \"explicit\"",
             ));
         }
-        for (d, dep) in group.deposits.iter().enumerate() {
-            let key = format!("robots[{g}].deposits[{d}]");
-            let p = find_pheromone(sc, &format!("{key}.pheromone"), &dep.pheromone)?;
+        let trails = (group.deposits.iter().enumerate())
+            .map(|(d, dep)| {
+                (
+                    format!("robots[{g}].deposits[{d}]"),
+                    dep.pheromone.as_str(),
+                    dep.kernel,
+                    "rate",
+                    dep.rate,
+                )
+            })
+            .chain(group.deposit_actions.iter().enumerate().map(|(d, dep)| {
+                (
+                    format!("robots[{g}].deposit_actions[{d}]"),
+                    dep.pheromone.as_str(),
+                    dep.kernel,
+                    "max_rate",
+                    dep.max_rate,
+                )
+            }));
+        for (key, pheromone, kernel, rate_key, rate) in trails {
+            let p = find_pheromone(sc, &format!("{key}.pheromone"), pheromone)?;
             if s.pheromones[p].model != ModelKind::Grid {
                 return Err(SimError::invalid(
                     format!("{key}.pheromone"),
-                    format!("{:?}", dep.pheromone),
-                    "trail deposits need a grid pheromone",
+                    format!("{pheromone:?}"),
+                    "trail deposits need a grid pheromone (an agent cannot switch a Gaussian \
+                     source on and off yet)",
                 ));
             }
-            non_negative(&format!("{key}.rate"), dep.rate)?;
-            let (name, size) = match dep.kernel {
+            non_negative(&format!("{key}.{rate_key}"), rate)?;
+            let (name, size) = match kernel {
                 crate::field::Kernel::Disc { radius } | crate::field::Kernel::Cone { radius } => {
                     ("radius", radius)
                 }

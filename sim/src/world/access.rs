@@ -104,6 +104,16 @@ impl World {
         self.injection
             .point(self.robots.poses(), self.tracking.tracked(), i)
     }
+    /// Robot `i`'s deposit actions (`[[robots]] deposit_actions`), as fractions of their
+    /// `max_rate` laid from the next step on; empty for a robot without any.
+    pub fn deposit_actions(&self, i: usize) -> &[f32] {
+        self.injection.deposit_actions(i)
+    }
+    /// Chooses how much robot `i` lays of each of its deposit actions from the next step on:
+    /// fractions of `max_rate`, clamped to `[0, 1]` (0 lays nothing).
+    pub fn set_deposit_actions(&mut self, i: usize, fractions: impl IntoIterator<Item = f32>) {
+        self.injection.set_deposit_actions(i, fractions);
+    }
     /// Installs a field backend that steps the pheromones from now on (`None`: the CPU).
     pub fn set_field_backend(&mut self, backend: Option<Box<dyn FieldBackend>>) {
         self.fields.set_backend(backend);

@@ -126,6 +126,19 @@ impl WorldParts {
                         pheromone,
                         kernel: d.kernel,
                         rate: d.rate,
+                        action: None,
+                    });
+                }
+                // An agent's chosen trails right after the scripted ones: a constant action lays
+                // what a `deposits` rule in their place would, in the same order.
+                for (k, d) in group.deposit_actions.iter().enumerate() {
+                    let pheromone = scenario.pheromone_index(&d.pheromone).expect("validated");
+                    deposits.push(Deposit {
+                        robot: index,
+                        pheromone,
+                        kernel: d.kernel,
+                        rate: d.max_rate,
+                        action: Some(k),
                     });
                 }
                 for e in &group.emits {

@@ -62,8 +62,10 @@ pub(super) struct Deposit {
     pub robot: usize,
     pub pheromone: usize,
     pub kernel: Kernel,
-    /// Units per second at the kernel's peak.
+    /// Units per second at the kernel's peak (for an agent's action: at a fraction of 1).
     pub rate: f32,
+    /// `Some(k)`: the robot's deposit action `k`, laid at the fraction its agent chose.
+    pub action: Option<usize>,
 }
 
 /// A Gaussian source attached to one robot.
@@ -82,6 +84,10 @@ pub struct Injection {
     emitters: Vec<Emitter>,
     /// Where each robot injected last (None before its first tracked pose).
     last_injection: Vec<Option<Vec2>>,
+    /// Each robot's deposit actions' fractions for the next step (`[robot][action]`, flat; robot
+    /// `i`'s from `action_first[i]`), 0 until an agent chooses.
+    action_rates: Vec<f32>,
+    action_first: Vec<usize>,
     /// Scratch: this step's trail segments.
     segments: Vec<Segment>,
     /// Scratch: for each band of rows of each grid field (in field order), the indices of the segments
@@ -98,14 +104,41 @@ impl Injection {
         emitters: Vec<Emitter>,
         robots: usize,
     ) -> Self {
+        let mut action_first = vec![0; robots + 1];
+        for d in deposits.iter().filter(|d| d.action.is_some()) {
+            action_first[d.robot + 1] += 1;
+        }
+        for i in 0..robots {
+            action_first[i + 1] += action_first[i];
+        }
         Injection {
             inject_at,
+            action_rates: vec![0.0; action_first[robots]],
+            action_first,
             deposits,
             emitters,
             last_injection: vec![None; robots],
             segments: Vec::new(),
             band_segments: Vec::new(),
             band_lists: Vec::new(),
+        }
+    }
+
+    /// Robot `i`'s deposit actions' fractions of their `max_rate` for the next steps.
+    pub fn deposit_actions(&self, i: usize) -> &[f32] {
+        &self.action_rates[self.action_first[i]..self.action_first[i + 1]]
+    }
+
+    /// Sets robot `i`'s deposit actions (fractions of `max_rate`, clamped to `[0, 1]`; a non-finite
+    /// one lays nothing); extra entries are ignored, missing ones keep their value.
+    pub fn set_deposit_actions(&mut self, i: usize, fractions: impl IntoIterator<Item = f32>) {
+        let range = self.action_first[i]..self.action_first[i + 1];
+        for (out, f) in self.action_rates[range].iter_mut().zip(fractions) {
+            *out = if f.is_finite() {
+                f.clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
         }
     }
 
@@ -136,12 +169,19 @@ pub fn inject(
         let Some(to) = point(robot) else {
             continue;
         };
+        let rate = match dep.action {
+            None => dep.rate,
+            Some(k) => match injection.action_rates[injection.action_first[robot] + k] {
+                0.0 => continue,
+                f => dep.rate * f,
+            },
+        };
         injection.segments.push(Segment {
             pheromone: dep.pheromone,
             kernel: dep.kernel,
             from: injection.last_injection[robot].unwrap_or(to),
             to,
-            amount: dep.rate * dt,
+            amount: rate * dt,
         });
     }
     deposit_segments(injection, fields.pheromones_mut());

@@ -75,14 +75,24 @@ fn drive_one(
 }
 
 /// Stages `decide` and `drive` in one pass over the robots (one parallel region, not two): every
-/// robot's behaviour decides from its observation, and its drive takes the command.
+/// robot takes its override if it has one (an agent's command from a policy), or else its own
+/// behaviour decides from its observation; its drive takes the command. `overrides` is one entry
+/// per robot, or empty for none.
 ///
-/// Reads `observations`; writes each slot's behaviour state, random stream, drive and command, and the
-/// body velocities that [`physics`] reads.
-pub fn decide_and_drive(robots: &mut RobotSet, observations: &[Observation], dt: f32) {
+/// Reads `observations` and `overrides`; writes each deciding slot's behaviour state and random
+/// stream, every slot's drive and command, and the body velocities that [`physics`] reads.
+pub fn decide_and_drive(
+    robots: &mut RobotSet,
+    observations: &[Observation],
+    overrides: &[Option<WheelCommand>],
+    dt: f32,
+) {
     let params = &robots.params;
-    let decide_and_drive = |(slot, obs): (&mut RobotSlot, &Observation)| {
-        let cmd = slot.behaviour.act(obs, &mut slot.rng);
+    let decide_and_drive = |(i, (slot, obs)): (usize, (&mut RobotSlot, &Observation))| {
+        let cmd = match overrides.get(i) {
+            Some(Some(cmd)) => *cmd,
+            _ => slot.behaviour.act(obs, &mut slot.rng),
+        };
         drive_one(slot, cmd, params, dt)
     };
     robots.velocities.clear();
@@ -91,6 +101,7 @@ pub fn decide_and_drive(robots: &mut RobotSet, observations: &[Observation], dt:
             .slots
             .par_iter_mut()
             .zip(observations.par_iter())
+            .enumerate()
             .map(decide_and_drive)
             .collect_into_vec(&mut robots.velocities);
     } else {
@@ -98,6 +109,7 @@ pub fn decide_and_drive(robots: &mut RobotSet, observations: &[Observation], dt:
             .slots
             .iter_mut()
             .zip(observations.iter())
+            .enumerate()
             .map(decide_and_drive);
         robots.velocities.extend(velocities);
     }

@@ -11,8 +11,27 @@ use crate::robot::RapierHost;
 impl World {
     /// One step with every robot's own behaviour deciding from its current observation.
     pub fn step(&mut self) {
-        decide_and_drive(&mut self.robots, self.sensing.observations(), self.dt);
+        self.step_with_overrides(&[]);
+    }
+
+    /// One step with one controller per robot: a robot with an override takes it (an agent's
+    /// command from a policy), the others decide with their own behaviour, as in [`Self::step`].
+    /// `overrides` is one entry per robot, or empty for none; non-finite commands are a stop.
+    ///
+    /// # Panics
+    /// If `overrides` is neither empty nor one per robot (a programming error).
+    pub fn step_with_overrides(&mut self, overrides: &[Option<WheelCommand>]) {
+        self.decide(overrides);
         self.advance();
+    }
+
+    fn decide(&mut self, overrides: &[Option<WheelCommand>]) {
+        assert!(
+            overrides.is_empty() || overrides.len() == self.robots.len(),
+            "one override (or none) per robot"
+        );
+        let observations = self.sensing.observations();
+        decide_and_drive(&mut self.robots, observations, overrides, self.dt);
     }
 
     /// One step with the given wheel commands (one per robot, m/s), e.g. from a learned policy.
@@ -39,20 +58,15 @@ impl World {
         self.robots.physics.attach(host, slot)
     }
 
-    /// The first half of [`Self::step_with_commands`] for a world attached to `host`: the commands
-    /// and the world's own part of the motion. Once every world of the host began its step, call
-    /// [`RapierHost::step`], then [`Self::finish_step_in`] on each. A world not attached to `host`
-    /// moves alone here.
+    /// The first half of [`Self::step_with_overrides`] for a world attached to `host`: the
+    /// decisions and the world's own part of the motion. Once every world of the host began its
+    /// step, call [`RapierHost::step`], then [`Self::finish_step_in`] on each. A world not attached
+    /// to `host` moves alone here.
     ///
     /// # Panics
-    /// If `commands.len()` differs from the number of robots.
-    pub fn begin_step_in(&mut self, commands: &[WheelCommand], host: &mut RapierHost) {
-        assert_eq!(
-            commands.len(),
-            self.robots.len(),
-            "one wheel command per robot"
-        );
-        drive(&mut self.robots, commands, self.dt);
+    /// If `overrides` is neither empty nor one per robot.
+    pub fn begin_step_in(&mut self, overrides: &[Option<WheelCommand>], host: &mut RapierHost) {
+        self.decide(overrides);
         self.advance_clock();
         physics_in(&mut self.robots, self.dt, host);
     }
