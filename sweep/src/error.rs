@@ -89,13 +89,9 @@ impl SweepError {
         value: impl std::fmt::Display,
         reason: impl Into<String>,
     ) -> Self {
-        let mut value = value.to_string();
-        if value.chars().count() > 80 {
-            value = format!("{}...", value.chars().take(77).collect::<String>());
-        }
         SweepError::Invalid {
             key: key.into(),
-            value,
+            value: shorten(value.to_string()),
             reason: reason.into(),
         }
     }
@@ -120,7 +116,7 @@ impl SweepError {
         } else {
             format!("axes[{index}] ({name})")
         };
-        format!("{first} sets {key} = {value}")
+        format!("{first} sets {key} = {}", shorten(value.to_string()))
     }
 
     pub(crate) fn io(context: impl Into<String>, source: std::io::Error) -> Self {
@@ -135,6 +131,15 @@ impl SweepError {
             context: context.into(),
             source,
         }
+    }
+}
+
+/// A value cut to 80 characters: an error line stays one readable line.
+fn shorten(value: String) -> String {
+    if value.chars().count() > 80 {
+        format!("{}...", value.chars().take(77).collect::<String>())
+    } else {
+        value
     }
 }
 

@@ -5,7 +5,8 @@
 //! seeds, the duration and the metrics. [`Plan`] turns it into runs, each run's scenario checked by the
 //! scenario code before the first run starts; [`run_sweep`] runs them in parallel and appends one row
 //! per finished run to a resumable CSV table ([`table`]). The same runs can be computed elsewhere
-//! ([`run_ids`], what a Ray task calls) and appended to the same table.
+//! ([`run_ids`], what a Ray task calls) and appended to the same table. [`effects`] tells which axes
+//! changed which metrics (an axis the model ignores gives identical runs at all its values).
 //!
 //! ```no_run
 //! let plan = colcos_sweep::Plan::from_file("scenarios/sweeps/tiny.toml")?;
