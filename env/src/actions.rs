@@ -10,6 +10,7 @@
 use crate::encoding::{self, DISCRETE_ACTIONS};
 use crate::error::{EnvError, Result};
 use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::scenario::Scenario;
 
 /// A batch's actions, `[E, N, 2 + D]` floats or `[E, N]` integers, flat.
 #[derive(Clone, Copy, Debug)]
@@ -147,6 +148,44 @@ impl ActionDecoder {
             c => format!("deposit rate {}", c - 2),
         }
     }
+}
+
+/// Deposit actions per agent: every agent's group declares the same number, and only agents'
+/// groups declare any (a scripted robot could not choose its rates).
+pub(crate) fn deposit_actions_per_agent(scenario: &Scenario, agents: &[usize]) -> Result<usize> {
+    let mut first = 0;
+    let mut per_agent: Option<(usize, usize)> = None;
+    for (g, group) in scenario.spec.robots.iter().enumerate() {
+        let d = group.deposit_actions.len();
+        let range = first..first + group.count;
+        first += group.count;
+        let is_agent = agents.iter().any(|i| range.contains(i));
+        let key = format!("robots[{g}].deposit_actions");
+        if !is_agent {
+            if d > 0 {
+                return Err(EnvError::param(
+                    key,
+                    "this group's robots are not agents of the task, so nothing would choose \
+                     their rates (give them `deposits` instead)",
+                ));
+            }
+            continue;
+        }
+        match per_agent {
+            None => per_agent = Some((g, d)),
+            Some((h, e)) if e != d => {
+                return Err(EnvError::param(
+                    key,
+                    format!(
+                        "{d} deposit actions, but the agents of robots[{h}] have {e}: every agent \
+                         of a task takes actions of one width"
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(per_agent.map_or(0, |(_, d)| d))
 }
 
 #[cfg(test)]

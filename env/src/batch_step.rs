@@ -6,7 +6,7 @@
 //! depend on the number of threads.
 use crate::error::Result;
 use crate::world_slot::WorldSlot;
-use crate::world_step::{Begun, Ctx, Out, begin_world, finish_world};
+use crate::world_step::{Begun, Ctx, Out, begin_world, conclude_world, finish_world};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::{MAX_HOSTED_ARENAS, PhysicsBackend, RapierHost};
 use colcos_sim::scenario::Scenario;
@@ -125,48 +125,7 @@ pub(crate) fn step_batch(
     len: Lengths,
 ) -> Result<()> {
     let c = chunks.size();
-    let Buffers {
-        obs,
-        rewards,
-        terminated,
-        truncated,
-        state,
-        patch,
-        final_obs,
-        final_mask,
-        shield,
-    } = buffers;
-    let outs = obs
-        .par_chunks_mut(c * len.obs)
-        .zip(rewards.par_chunks_mut(c * len.agents))
-        .zip(terminated.par_chunks_mut(c * len.agents))
-        .zip(truncated.par_chunks_mut(c * len.agents))
-        .zip(state.par_chunks_mut(c * len.state))
-        .zip(patch.par_chunks_mut(c * len.patch))
-        .zip(final_obs.par_chunks_mut(c * len.obs))
-        .zip(final_mask.par_chunks_mut(c))
-        .zip(shield.par_chunks_mut(c * len.agents))
-        .map(
-            |(
-                (
-                    ((((((obs, rewards), terminated), truncated), state), patch), final_obs),
-                    final_mask,
-                ),
-                shield,
-            )| {
-                Buffers {
-                    obs,
-                    rewards,
-                    terminated,
-                    truncated,
-                    state,
-                    patch,
-                    final_obs,
-                    final_mask,
-                    shield,
-                }
-            },
-        );
+    let outs = split(buffers, c, len);
     chunks
         .par_iter_mut(slots)
         .zip(commands.par_chunks(c * len.agents))
@@ -220,4 +179,84 @@ fn step_chunk(
         }
     }
     result
+}
+
+/// The buffers cut into chunks of `c` worlds.
+fn split(
+    buffers: Buffers<'_>,
+    c: usize,
+    len: Lengths,
+) -> impl IndexedParallelIterator<Item = Buffers<'_>> {
+    let Buffers {
+        obs,
+        rewards,
+        terminated,
+        truncated,
+        state,
+        patch,
+        final_obs,
+        final_mask,
+        shield,
+    } = buffers;
+    obs.par_chunks_mut(c * len.obs)
+        .zip(rewards.par_chunks_mut(c * len.agents))
+        .zip(terminated.par_chunks_mut(c * len.agents))
+        .zip(truncated.par_chunks_mut(c * len.agents))
+        .zip(state.par_chunks_mut(c * len.state))
+        .zip(patch.par_chunks_mut(c * len.patch))
+        .zip(final_obs.par_chunks_mut(c * len.obs))
+        .zip(final_mask.par_chunks_mut(c))
+        .zip(shield.par_chunks_mut(c * len.agents))
+        .map(
+            |(
+                (
+                    ((((((obs, rewards), terminated), truncated), state), patch), final_obs),
+                    final_mask,
+                ),
+                shield,
+            )| {
+                Buffers {
+                    obs,
+                    rewards,
+                    terminated,
+                    truncated,
+                    state,
+                    patch,
+                    final_obs,
+                    final_mask,
+                    shield,
+                }
+            },
+        )
+}
+
+/// The end of every world's step that awaits it (a task written in Python: `ctx.evaluation` gives
+/// the rewards and terminations), chunk by chunk on the current rayon pool.
+pub(crate) fn conclude_batch(
+    ctx: &Ctx,
+    slots: &mut [WorldSlot],
+    chunks: &mut Chunks,
+    buffers: Buffers,
+    len: Lengths,
+) -> Result<()> {
+    let c = chunks.size();
+    chunks
+        .par_iter_mut(slots)
+        .zip(split(buffers, c, len))
+        .enumerate()
+        .try_for_each(|(k, ((slots, mut host), mut buffers))| {
+            let mut result = Ok(());
+            for (i, slot) in slots.iter_mut().enumerate().rev() {
+                if !slot.awaiting {
+                    continue;
+                }
+                let mut out = buffers.world(i, len);
+                let in_host = host.as_deref_mut().map(|h| (h, i));
+                let concluded = conclude_world(ctx, k * c + i, slot, &mut out, in_host);
+                if result.is_ok() {
+                    result = concluded;
+                }
+            }
+            result
+        })
 }

@@ -70,9 +70,37 @@ impl Episode {
         end: StepEnd,
         out: AgentOut,
     ) -> bool {
+        self.finish_with(|r, t| task.evaluate(world, r, t), max_cycles, end, out)
+    }
+
+    /// [`Self::finish_step`] with rewards and terminations given (a task written in Python, whose
+    /// hooks ran on the whole batch): `terminated` only ever sets an agent's flag, never clears it.
+    pub fn finish_given(
+        &mut self,
+        rewards: &[f32],
+        terminated: &[bool],
+        max_cycles: u64,
+        out: AgentOut,
+    ) -> bool {
+        let evaluate = |r: &mut [f32], t: &mut [bool]| {
+            r.copy_from_slice(rewards);
+            for (mine, &given) in t.iter_mut().zip(terminated) {
+                *mine |= given;
+            }
+        };
+        self.finish_with(evaluate, max_cycles, StepEnd::Stepped, out)
+    }
+
+    fn finish_with(
+        &mut self,
+        evaluate: impl FnOnce(&mut [f32], &mut [bool]),
+        max_cycles: u64,
+        end: StepEnd,
+        out: AgentOut,
+    ) -> bool {
         self.steps += 1;
         self.was_terminated.copy_from_slice(&self.terminated);
-        task.evaluate(world, out.rewards, &mut self.terminated);
+        evaluate(out.rewards, &mut self.terminated);
         for (r, &was) in out.rewards.iter_mut().zip(&self.was_terminated) {
             if was || end == StepEnd::Nothing {
                 *r = 0.0;

@@ -82,6 +82,20 @@ impl EnvSpec {
         observation_bounds()
     }
 
+    /// Per-entry bounds `(low, high)` of a continuous action with deposit actions: wheels in
+    /// `[-1, 1]`, deposit rates in `[0, 1]` (see [`crate::actions`]); None where the box's scalar
+    /// envelope is exact (wheels only, or discrete actions).
+    pub fn action_bounds(&self) -> Option<(Vec<f32>, Vec<f32>)> {
+        match &self.action {
+            Space::Box { shape, .. } if shape.iter().product::<usize>() > 2 => {
+                let w: usize = shape.iter().product();
+                let low = (0..w).map(|i| if i < 2 { -1.0 } else { 0.0 }).collect();
+                Some((low, vec![1.0; w]))
+            }
+            _ => None,
+        }
+    }
+
     /// Per-entry bounds `(low, high)` of the global state, if it is enabled.
     pub fn state_bounds(&self) -> Option<(Vec<f32>, Vec<f32>)> {
         self.state.as_ref().map(|s| state_bounds(s.flat_len()))

@@ -6,7 +6,7 @@
 //! `reset` overwrites them in place.
 use crate::actions::{ActionDecoder, Actions};
 use crate::backend::EnvBackend;
-use crate::batch_step::{Buffers, Chunks, Lengths, step_batch};
+use crate::batch_step::{Buffers, Chunks, Lengths, conclude_batch, step_batch};
 use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
 use crate::encoding::OBS_DIM;
 use crate::error::{EnvError, Result};
@@ -16,7 +16,7 @@ pub use crate::world_output::render_world;
 use crate::world_output::{write_obs, write_patch, write_state};
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
-use crate::world_step::{Ctx, step_world};
+use crate::world_step::{Ctx, Evaluation, step_world};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::shield::Shield;
 use colcos_sim::world::World;
@@ -53,6 +53,8 @@ pub struct VecEnv {
     state_dim: usize,
     patch_len: usize,
     needs_reset: bool,
+    /// A deferred step waits for [`VecEnv::conclude`].
+    awaiting: bool,
 }
 
 impl VecEnv {
@@ -95,7 +97,7 @@ impl VecEnv {
         let decoder = ActionDecoder::new(
             cfg.action == ActionKind::Discrete,
             n,
-            deposit_actions_per_agent(&scenario, task.agents())?,
+            crate::actions::deposit_actions_per_agent(&scenario, task.agents())?,
             scenario.spec.robot.max_wheel_speed,
         );
         let patch_len = cfg.patch.map_or(0, |p| p.pixels * p.pixels * 3);
@@ -185,6 +187,7 @@ impl VecEnv {
             state_dim,
             patch_len,
             needs_reset: true,
+            awaiting: false,
         };
         env.write_all_outputs();
         Ok(env)
@@ -227,6 +230,10 @@ impl VecEnv {
         self.slots[e].episode.index
     }
     /// Whether world `e` has finished its episode (and awaits a reset).
+    /// World `e` moved in the last deferred step and awaits [`Self::conclude`].
+    pub fn is_awaiting(&self, e: usize) -> bool {
+        self.slots[e].awaiting
+    }
     pub fn is_done(&self, e: usize) -> bool {
         self.slots[e].episode.done
     }
@@ -294,6 +301,9 @@ impl VecEnv {
     /// restarts the episode count of the reset worlds, so `reset(seed)` reproduces a run exactly.
     pub fn reset(&mut self, seed: Option<u64>, mask: Option<&[bool]>) -> Result<()> {
         let e = self.spec.num_envs;
+        // A deferred step not yet concluded is dropped: its worlds start over or step on.
+        self.awaiting = false;
+        self.slots.iter_mut().for_each(|s| s.awaiting = false);
         if let Some(m) = mask.filter(|m| m.len() != e) {
             return Err(EnvError::Action(format!(
                 "reset mask has {} entries, expected num_envs = {e}",
@@ -339,18 +349,75 @@ impl VecEnv {
 
     /// One step of every world. Agents that have terminated are stopped and their actions ignored.
     pub fn step(&mut self, actions: Actions) -> Result<()> {
+        self.run(Some(actions), Evaluation::Task)
+    }
+
+    /// The first half of a step for a task written in Python: every world moves, and waits for
+    /// [`Self::conclude`] to hand out its rewards and terminations (the task's hooks run on the
+    /// whole batch in between; the Rust task's own evaluation is not used).
+    pub fn step_deferred(&mut self, actions: Actions) -> Result<()> {
+        self.run(Some(actions), Evaluation::Deferred)?;
+        self.awaiting = true;
+        Ok(())
+    }
+
+    /// The second half of [`Self::step_deferred`]: `rewards` and `terminated`, `[E, N]`, for the
+    /// worlds that stepped (a world that only reset this step keeps its zeros); episodes end, the
+    /// outputs are written and, in same-step mode, finished worlds reset.
+    pub fn conclude(&mut self, rewards: &[f32], terminated: &[bool]) -> Result<()> {
+        if !self.awaiting {
+            return Err(EnvError::State(
+                "nothing to conclude: call step_deferred() first".into(),
+            ));
+        }
+        let (e, n) = (self.spec.num_envs, self.spec.num_agents);
+        if rewards.len() != e * n || terminated.len() != e * n {
+            return Err(EnvError::Action(format!(
+                "expected {} rewards and terminations (num_envs {e} x agents {n}), got {} and {}",
+                e * n,
+                rewards.len(),
+                terminated.len()
+            )));
+        }
+        if let Some(k) = rewards.iter().position(|r| !r.is_finite()) {
+            return Err(EnvError::Action(format!(
+                "reward of world {}, agent robot_{} is {} (must be finite)",
+                k / n,
+                k % n,
+                rewards[k]
+            )));
+        }
+        self.awaiting = false;
+        self.run(
+            None,
+            Evaluation::Given {
+                rewards,
+                terminated,
+            },
+        )
+    }
+
+    /// A step (with `actions`) or the conclusion of a deferred one (without).
+    fn run(&mut self, actions: Option<Actions>, evaluation: Evaluation) -> Result<()> {
         if self.needs_reset {
             return Err(EnvError::State("call reset() before step()".into()));
         }
-        self.decode(actions)?;
-        let blocked = match self.mode {
-            AutoresetMode::Disabled => self.slots.iter().position(|s| s.episode.done),
-            _ => None,
-        };
-        if let Some(w) = blocked {
-            return Err(EnvError::State(format!(
-                "world {w} has finished its episode; reset it (autoreset mode is disabled)"
-            )));
+        if actions.is_some() && self.awaiting {
+            return Err(EnvError::State(
+                "the last step awaits its rewards: call conclude() first".into(),
+            ));
+        }
+        if let Some(actions) = actions {
+            self.decode(actions)?;
+            let blocked = match self.mode {
+                AutoresetMode::Disabled => self.slots.iter().position(|s| s.episode.done),
+                _ => None,
+            };
+            if let Some(w) = blocked {
+                return Err(EnvError::State(format!(
+                    "world {w} has finished its episode; reset it (autoreset mode is disabled)"
+                )));
+            }
         }
         let n = self.spec.num_agents;
         let ctx = Ctx {
@@ -364,6 +431,7 @@ impl VecEnv {
             patch: self.patch_cfg,
             shield: self.shield,
             deposits: self.decoder.deposits(),
+            evaluation,
         };
         let len = Lengths {
             agents: n,
@@ -383,13 +451,18 @@ impl VecEnv {
             final_mask: &mut self.final_mask,
             shield: &mut self.shield_flags,
         };
-        if let [slot] = self.slots.as_mut_slice() {
+        let (slots, chunks) = (&mut self.slots, &mut self.chunks);
+        if actions.is_none() {
+            return self
+                .pool
+                .install(|| conclude_batch(&ctx, slots, chunks, buffers, len));
+        }
+        if let [slot] = slots.as_mut_slice() {
             // One world (a PettingZoo `parallel_env`): step it on the calling thread. Handing a single
             // world to the pool costs two thread wake-ups per step, a third of the step at this size.
             let actions = (&self.commands[..], &self.deposit_rates[..]);
             return step_world(&ctx, 0, slot, actions, &mut buffers.world(0, len));
         }
-        let (slots, chunks) = (&mut self.slots, &mut self.chunks);
         let (commands, rates) = (&self.commands, &self.deposit_rates);
         self.pool
             .install(|| step_batch(&ctx, slots, chunks, commands, rates, buffers, len))
@@ -465,42 +538,4 @@ pub struct BufferPtrs {
     pub final_obs: *mut f32,
     pub final_mask: *mut bool,
     pub shield: *mut u8,
-}
-
-/// Deposit actions per agent: every agent's group declares the same number, and only agents'
-/// groups declare any (a scripted robot could not choose its rates).
-fn deposit_actions_per_agent(scenario: &Scenario, agents: &[usize]) -> Result<usize> {
-    let mut first = 0;
-    let mut per_agent: Option<(usize, usize)> = None;
-    for (g, group) in scenario.spec.robots.iter().enumerate() {
-        let d = group.deposit_actions.len();
-        let range = first..first + group.count;
-        first += group.count;
-        let is_agent = agents.iter().any(|i| range.contains(i));
-        let key = format!("robots[{g}].deposit_actions");
-        if !is_agent {
-            if d > 0 {
-                return Err(EnvError::param(
-                    key,
-                    "this group's robots are not agents of the task, so nothing would choose \
-                     their rates (give them `deposits` instead)",
-                ));
-            }
-            continue;
-        }
-        match per_agent {
-            None => per_agent = Some((g, d)),
-            Some((h, e)) if e != d => {
-                return Err(EnvError::param(
-                    key,
-                    format!(
-                        "{d} deposit actions, but the agents of robots[{h}] have {e}: every agent \
-                         of a task takes actions of one width"
-                    ),
-                ));
-            }
-            Some(_) => {}
-        }
-    }
-    Ok(per_agent.map_or(0, |(_, d)| d))
 }

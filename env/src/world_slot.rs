@@ -21,6 +21,8 @@ pub(crate) struct WorldSlot {
     /// behaviours (`None`).
     pub overrides: Vec<Option<WheelCommand>>,
     pub episode: Episode,
+    /// Stepped, its rewards and terminations not yet handed out (a task written in Python).
+    pub awaiting: bool,
 }
 
 impl WorldSlot {
@@ -54,6 +56,7 @@ impl WorldSlot {
             world,
             overrides,
             episode: Episode::new(episode, agents.len()),
+            awaiting: false,
         })
     }
 }

@@ -41,6 +41,22 @@ pub(crate) struct Ctx<'a> {
     pub(crate) shield: Option<Shield>,
     /// Deposit actions per agent.
     pub(crate) deposits: usize,
+    /// How a step's evaluation is made (see [`Evaluation`]).
+    pub(crate) evaluation: Evaluation<'a>,
+}
+
+/// Who hands out rewards and terminations at the end of a step.
+#[derive(Clone, Copy)]
+pub(crate) enum Evaluation<'a> {
+    /// The Rust task, right after the world's step.
+    Task,
+    /// Later, by [`conclude_world`] with values given for the whole batch (`[E, N]`): a task
+    /// written in Python, whose hooks run once on every world's state in between.
+    Deferred,
+    Given {
+        rewards: &'a [f32],
+        terminated: &'a [bool],
+    },
 }
 
 /// How far [`begin_world`] took a world's step.
@@ -140,17 +156,50 @@ pub(crate) fn finish_world(
         (Begun::InHost, Some((host, _))) => slot.world.finish_step_in(host),
         _ => {}
     }
-    let done = slot.episode.finish_step(
-        ctx.task,
-        &slot.world,
-        ctx.max_cycles,
-        StepEnd::Stepped,
-        AgentOut {
-            rewards: out.rewards,
-            terminated: out.terminated,
-            truncated: out.truncated,
-        },
-    );
+    if let Evaluation::Deferred = ctx.evaluation {
+        slot.awaiting = true;
+        return Ok(());
+    }
+    conclude_world(ctx, w, slot, out, host)
+}
+
+/// The end of a world's step once it has moved: rewards, ends of episodes, outputs, and a
+/// same-step autoreset.
+pub(crate) fn conclude_world(
+    ctx: &Ctx,
+    w: usize,
+    slot: &mut WorldSlot,
+    out: &mut Out,
+    host: Option<(&mut RapierHost, usize)>,
+) -> Result<()> {
+    slot.awaiting = false;
+    let agent_out = AgentOut {
+        rewards: out.rewards,
+        terminated: out.terminated,
+        truncated: out.truncated,
+    };
+    let done = match ctx.evaluation {
+        Evaluation::Given {
+            rewards,
+            terminated,
+        } => {
+            let n = ctx.task.agents().len();
+            let part = w * n..(w + 1) * n;
+            (slot.episode).finish_given(
+                &rewards[part.clone()],
+                &terminated[part],
+                ctx.max_cycles,
+                agent_out,
+            )
+        }
+        _ => slot.episode.finish_step(
+            ctx.task,
+            &slot.world,
+            ctx.max_cycles,
+            StepEnd::Stepped,
+            agent_out,
+        ),
+    };
     write_world(ctx, slot, out);
     if done && ctx.mode == AutoresetMode::SameStep {
         out.final_obs.copy_from_slice(out.obs);

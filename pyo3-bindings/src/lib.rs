@@ -11,6 +11,7 @@ mod plant;
 mod registry;
 mod spec;
 mod sweep;
+mod task_hooks;
 mod vec_env;
 mod window;
 
@@ -26,6 +27,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     registry::register(m)?;
     window::register(m)?;
     sweep::register(m)?;
+    task_hooks::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -57,7 +57,7 @@ pub fn spec_dict<'py>(
         "observation",
         space_dict(py, &s.observation, Some(s.observation_bounds()))?,
     )?;
-    d.set_item("action", space_dict(py, &s.action, None)?)?;
+    d.set_item("action", space_dict(py, &s.action, s.action_bounds())?)?;
     d.set_item(
         "state",
         s.state

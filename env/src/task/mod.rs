@@ -4,6 +4,7 @@
 //! fields) to hand out rewards and end episodes. Agents still observe only their own sensors.
 
 pub mod aggregation;
+pub mod external;
 pub mod foraging;
 pub mod registry;
 pub mod trail;

@@ -1,5 +1,5 @@
 //! Tasks by name.
-use super::{Task, aggregation, foraging, trail};
+use super::{Task, aggregation, external, foraging, trail};
 use crate::config::ScenarioSource;
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
@@ -26,11 +26,21 @@ const REGISTRY: &[(&str, &str, &str, Builder)] = &[
         trail::DEFAULT_SCENARIO,
         trail::build,
     ),
+    // Last, and left out of `list`: built for a `colcos.Task` written in Python, on the scenario it
+    // names (the `trail` task's by default).
+    (
+        external::NAME,
+        external::DESCRIPTION,
+        trail::DEFAULT_SCENARIO,
+        external::build,
+    ),
 ];
 
 /// Names and one-line descriptions of all tasks.
 pub fn list() -> impl Iterator<Item = (&'static str, &'static str)> {
-    REGISTRY.iter().map(|(n, d, _, _)| (*n, *d))
+    (REGISTRY.iter())
+        .filter(|(n, ..)| *n != external::NAME)
+        .map(|(n, d, _, _)| (*n, *d))
 }
 
 /// The built-in scenario text of task `name`.
@@ -65,10 +75,6 @@ fn find(name: &str) -> Result<&'static (&'static str, &'static str, &'static str
         .find(|(n, _, _, _)| *n == name)
         .ok_or_else(|| EnvError::UnknownTask {
             name: name.to_string(),
-            known: REGISTRY
-                .iter()
-                .map(|(n, _, _, _)| *n)
-                .collect::<Vec<_>>()
-                .join(", "),
+            known: list().map(|(n, _)| n).collect::<Vec<_>>().join(", "),
         })
 }

@@ -23,6 +23,7 @@ from __future__ import annotations
 # `colcos.vector` and `colcos.gymnasium_vector` come with `import colcos` (they need only numpy and
 # gymnasium); the SB3 and TorchRL adapters import their libraries and stay opt-in.
 from colcos import _core, gymnasium_vector, sweep, vector
+from colcos import preflight as preflight  # noqa: E402  (after pettingzoo_env, which it imports)
 from colcos._core import (
     ActionError,
     ActionTypeError,
@@ -41,7 +42,7 @@ from colcos._core import (
     observation_names,
 )
 from colcos.pettingzoo_env import ColcosParallelEnv, env, parallel_env, raw_env
-from colcos import preflight as preflight  # noqa: E402  (after pettingzoo_env, which it imports)
+from colcos.task import ResetContext, Task, TaskHookError, View
 
 __version__ = _core.__version__
 
@@ -55,10 +56,14 @@ __all__ = [
     "ColcosParallelEnv",
     "InternalError",
     "PlantUnreachableError",
+    "ResetContext",
     "ScenarioError",
     "StateError",
+    "Task",
     "TaskError",
+    "TaskHookError",
     "UnknownAgentError",
+    "View",
     "behaviour_params",
     "behaviours",
     "default_scenario",

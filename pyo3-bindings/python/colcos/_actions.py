@@ -1,7 +1,8 @@
 """Actions checked against the action space, agent by agent, before anything is stepped.
 
-Continuous: two wheel speeds, any real array-like of shape (2,); values outside [-1, 1] are clipped
-to it (as the native core does), NaN and infinities refused. Discrete: one integer (Python or numpy)
+Continuous: two wheel speeds, then one rate in [0, 1] per deposit action (`robots[].deposit_actions`),
+any real array-like of shape (2 + D,); values beyond their bounds are clipped (as the native core
+does), NaN and infinities refused. Discrete: one integer (Python or numpy)
 in 0..n. `None`, scalars for continuous actions, floats for discrete ones, strings and wrong shapes
 are refused with the agent named.
 """
@@ -21,14 +22,19 @@ def _show(a: Any) -> str:
     return r if len(r) <= 80 else r[:77] + "..."
 
 
-def continuous(agent: str, a: Any) -> np.ndarray:
-    """Agent `agent`'s two wheel speeds as float32 (not yet clipped), or an error naming it."""
-    if type(a) is np.ndarray and a.dtype == np.float32 and a.shape == (2,):
+def _entries(width: int) -> str:
+    return "two wheel speeds" if width == 2 else f"two wheel speeds and {width - 2} deposit rates"
+
+
+def continuous(agent: str, a: Any, width: int = 2) -> np.ndarray:
+    """Agent `agent`'s action (two wheel speeds, then `width - 2` deposit rates) as float32 (not yet
+    clipped), or an error naming it."""
+    if type(a) is np.ndarray and a.dtype == np.float32 and a.shape == (width,):
         arr = a
     else:
         if a is None or isinstance(a, (str, bytes, dict)):
             raise ActionTypeError(
-                f"action of agent {agent!r} must be two wheel speeds in [-1, 1] (shape (2,)), got {_show(a)}"
+                f"action of agent {agent!r} must be {_entries(width)} (shape ({width},)), got {_show(a)}"
             )
         try:
             arr = np.asarray(a)
@@ -38,9 +44,10 @@ def continuous(agent: str, a: Any) -> np.ndarray:
             raise ActionTypeError(
                 f"action of agent {agent!r} must be real numbers, got {_show(a)} (dtype {arr.dtype})"
             )
-        if arr.shape != (2,):
+        if arr.shape != (width,):
             raise ActionError(
-                f"action of agent {agent!r} must have shape (2,) (two wheel speeds), got shape {arr.shape}: {_show(a)}"
+                f"action of agent {agent!r} must have shape ({width},) ({_entries(width)}), "
+                f"got shape {arr.shape}: {_show(a)}"
             )
     if not np.isfinite(arr).all():
         raise ActionError(f"action of agent {agent!r} is {_show(a)} (must be finite)")

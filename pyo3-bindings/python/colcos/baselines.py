@@ -10,6 +10,7 @@ import json
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 
 from colcos import _checks, _core
 from colcos.vector import VecEnv
@@ -51,6 +52,9 @@ class RandomPolicy:
     def act(self, obs: np.ndarray | None = None) -> np.ndarray:
         e, n = self.env.num_envs, self.env.num_agents
         if self.env.continuous:
-            return self.rng.uniform(-1.0, 1.0, size=(e, n, 2)).astype(np.float32)
+            # Wheels in [-1, 1], then deposit rates (if any) in [0, 1]: the action space's bounds.
+            space = self.env.single_action_space
+            assert isinstance(space, spaces.Box)
+            return self.rng.uniform(space.low, space.high, size=(e, n, *space.shape)).astype(np.float32)
         n_actions = int(getattr(self.env.single_action_space, "n", 0))
         return self.rng.integers(0, n_actions, size=(e, n))

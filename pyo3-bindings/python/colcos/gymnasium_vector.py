@@ -48,7 +48,7 @@ class ColcosVectorEnv(VectorEnv):
         self._obs = v.obs.reshape(n, -1)
         self._rew = v.rewards.reshape(n)
         self._act_shape = v._act_shape
-        self._flat_act_shape = (n, 2) if v.continuous else (n,)
+        self._flat_act_shape = (n, v.action_width) if v.continuous else (n,)
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
         if isinstance(seed, (list, tuple)):

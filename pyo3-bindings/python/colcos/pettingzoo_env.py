@@ -23,6 +23,7 @@ from colcos._options import (
     share_signature,
     twin_kwargs,
 )
+from colcos.task import Task, TaskRunner, core_task
 
 RENDER_WIDTH = 640
 _F32 = np.dtype(np.float32)
@@ -36,7 +37,8 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
     with the same seed follow the same trajectory. Observations are copies (safe to keep).
 
     Args:
-        task: `"aggregation"`, `"foraging"` or `"trail"` (see `colcos.tasks()`).
+        task: `"aggregation"`, `"foraging"` or `"trail"` (see `colcos.tasks()`), or a `colcos.Task`
+            written in Python (on `plant="sim"`; see `colcos.task`).
         scenario: a scenario file (path) or scenario TOML text; default: the task's own.
         max_cycles: steps per episode before truncation (default: the scenario's duration / dt).
         render_mode: None, `"human"` (a window showing the screen with the robots, at the field's
@@ -88,7 +90,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
 
     def __init__(
         self,
-        task: str = "aggregation",
+        task: str | Task = "aggregation",
         scenario: str | os.PathLike[str] | None = None,
         max_cycles: int | None = 500,
         render_mode: str | None = None,
@@ -115,8 +117,14 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             twin_scenario=twin_scenario, **params,
         )
         _checks.choice(render_mode, "render_mode", [None, "human", "rgb_array"])
-        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend, physics)
         _checks.choice(plant, "plant", list(PLANTS))
+        if isinstance(task, Task) and plant != "sim":
+            raise TaskError(
+                f"a task written in Python runs on plant='sim' (got plant={plant!r}); the twin, the rig and "
+                "replays take the built-in tasks"
+            )
+        native, scenario, params = (task, scenario, params) if isinstance(task, str) else core_task(task, scenario, params)
+        kw = core_kwargs(native, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend, physics)
         self.plant = plant
         self._core: _core.VecEnv | _core.Plant
         if plant == "sim":
@@ -141,7 +149,18 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self.possible_agents: list[str] = list(spec["agent_names"])
         self.agents: list[str] = []
         self._index = {a: i for i, a in enumerate(self.possible_agents)}
+        self._runner: TaskRunner | None = None
+        if isinstance(task, Task):
+            assert isinstance(self._core, _core.VecEnv)
+            self._runner = TaskRunner(task, self._core, spec, same_step=False)
         vector = make_space(spec["observation"])
+        if self._runner is not None:
+            assert isinstance(vector, spaces.Box)
+            vector = spaces.Box(
+                low=np.concatenate([vector.low, self._runner.obs_low]),
+                high=np.concatenate([vector.high, self._runner.obs_high]),
+                dtype=np.float32,
+            )
         if spec["patch"] is not None:
             obs_space: spaces.Space = spaces.Dict({"vector": vector, "patch": make_space(spec["patch"])})
         else:
@@ -151,11 +170,13 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self.action_spaces = {a: make_space(spec["action"]) for a in self.possible_agents}
         self._continuous = spec["action"]["kind"] == "box"
         self._n_actions = 0 if self._continuous else int(spec["action"]["n"])
+        # Two wheels, then one rate per deposit action (`robots[].deposit_actions`).
+        self._width = int(np.prod(spec["action"]["shape"])) if self._continuous else 0
         if spec["state"] is not None:
             self.state_space = make_space(spec["state"])
         self._views = self._core.views()
         n = len(self.possible_agents)
-        self._actions = np.zeros((1, n, 2), np.float32) if self._continuous else np.zeros((1, n), np.int64)
+        self._actions = np.zeros((1, n, self._width), np.float32) if self._continuous else np.zeros((1, n), np.int64)
         self._needs_reset = True
         self._window: HumanWindow | None = None
         if render_mode == "human":
@@ -188,8 +209,11 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
     def num_envs(self) -> int:
         return 1
 
+    def _all_obs(self) -> np.ndarray:
+        return self._runner.obs if self._runner is not None else self._views["obs"]
+
     def _obs(self, i: int) -> Any:
-        v = self._views["obs"][0, i].copy()
+        v = self._all_obs()[0, i].copy()
         if "patch" in self._views:
             return {"vector": v, "patch": self._views["patch"][0, i].copy()}
         return v
@@ -198,6 +222,8 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         if seed is not None:
             seed = _checks.seed(seed)
         self._core.reset(seed)
+        if self._runner is not None:
+            self._runner.after_reset(np.zeros(1, np.int64))
         self.agents = self.possible_agents[:]
         self._needs_reset = False
         if self._window is not None:
@@ -224,7 +250,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             i = index.get(name)
             if i is None:
                 raise UnknownAgentError(f"unknown agent {name!r}; the agents are {self.possible_agents}")
-            if fast and type(a) is np.ndarray and a.dtype is _F32 and a.shape == (2,):
+            if fast and type(a) is np.ndarray and a.dtype is _F32 and a.shape == (self._width,):
                 buf[0, i] = a  # the common case; the core refuses non-finite values, naming the agent
             elif name in self.agents:
                 buf[0, i] = self.check_action(name, a)
@@ -234,13 +260,16 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             missing = [a for a in self.agents if a not in actions]
             if missing:
                 raise ActionError(f"no action for agents {missing}: every agent in env.agents needs one")
-        self._core.step(buf)
+        if self._runner is not None:
+            self._runner.step(buf)
+        else:
+            self._core.step(buf)
         v = self._views
         # One copy and one conversion per buffer rather than per agent: each agent's observation is a
         # row of this step's own copy (never a view of the native buffer, which the next step rewrites).
         rew, term, trunc = v["rewards"][0].tolist(), v["terminated"][0].tolist(), v["truncated"][0].tolist()
         shield = v["shield"][0].tolist()
-        all_obs = v["obs"][0].copy()
+        all_obs = self._all_obs()[0].copy()
         patches = v["patch"][0].copy() if "patch" in v else None
         obs: dict[str, Any] = {}
         rewards: dict[str, float] = {}
@@ -267,7 +296,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         if agent not in self._index:
             raise UnknownAgentError(f"unknown agent {agent!r}; the agents are {self.possible_agents}")
         if self._continuous:
-            return _actions.continuous(agent, action)
+            return _actions.continuous(agent, action, self._width)
         return _actions.discrete(agent, action, self._n_actions)
 
     def state(self) -> np.ndarray:

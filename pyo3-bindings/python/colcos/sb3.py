@@ -38,7 +38,7 @@ class ColcosSB3VecEnv(SB3VecEnv):
     def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict]]:
         v = self.venv
         a = np.asarray(self._actions)
-        want = (self.num_envs, 2) if v.continuous else (self.num_envs,)
+        want = (self.num_envs, v.action_width) if v.continuous else (self.num_envs,)
         if a.shape != want:
             raise ActionError(f"actions have shape {a.shape}, expected {want} = (num_envs, ...)")
         obs, rew, term, trunc, _ = v.step(a.reshape(v._act_shape))

@@ -46,7 +46,10 @@ class ColcosTorchEnv(EnvBase):
             spec["state"] = Bounded(low=lo, high=hi, shape=(e, *s.shape), dtype=torch.float32, device=self.device)
         self.observation_spec = spec
         if v.continuous:
-            act = Bounded(low=-1.0, high=1.0, shape=(e, n, 2), dtype=torch.float32, device=self.device)
+            a = v.single_action_space
+            assert isinstance(a, spaces.Box)
+            lo, hi = (torch.as_tensor(np.broadcast_to(b, (e, n, *a.shape)).copy()) for b in (a.low, a.high))
+            act = Bounded(low=lo, high=hi, shape=(e, n, *a.shape), dtype=torch.float32, device=self.device)
         else:
             assert isinstance(v.single_action_space, spaces.Discrete)
             act = Categorical(n=int(v.single_action_space.n), shape=(e, n), dtype=torch.int64, device=self.device)

@@ -24,6 +24,7 @@ from gymnasium import spaces
 from colcos import _checks, _core
 from colcos._core import ActionError, ActionTypeError, ArgumentTypeError
 from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_box, make_space
+from colcos.task import Task, TaskRunner, core_task
 
 __all__ = ["VecEnv"]
 
@@ -34,7 +35,8 @@ class VecEnv(BackendInfo):
     """`num_envs` worlds of one task, batched.
 
     Args:
-        task: task name (`colcos.tasks()`).
+        task: task name (`colcos.tasks()`), or a `colcos.Task` written in Python (its hooks run once
+            per step over the whole batch; see `colcos.task`).
         num_envs: number of worlds `E` (1..=65536; a batch whose worlds would not fit in memory is
             refused, naming num_envs).
         seed: base seed, an integer in 0..=2**64-1; `reset(seed=...)` replaces it.
@@ -52,7 +54,7 @@ class VecEnv(BackendInfo):
 
     def __init__(
         self,
-        task: str = "aggregation",
+        task: str | Task = "aggregation",
         num_envs: int = 1,
         seed: int = 0,
         num_threads: int | None = None,
@@ -79,7 +81,8 @@ class VecEnv(BackendInfo):
             continuous=continuous, autoreset_mode=autoreset_mode, global_state=global_state, patch=patch,
             patch_side=patch_side, backend=backend, physics=physics, render_mode=render_mode, **params,
         )
-        kw = core_kwargs(task, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend, physics)
+        native, scenario, params = (task, scenario, params) if isinstance(task, str) else core_task(task, scenario, params)
+        kw = core_kwargs(native, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend, physics)
         self._core = _core.VecEnv(num_envs=num_envs, seed=seed, num_threads=num_threads, autoreset_mode=autoreset_mode, **kw)
         log_backend(self._core, backend)
         self.spec: dict[str, Any] = self._core.spec()
@@ -104,8 +107,23 @@ class VecEnv(BackendInfo):
         self.patch: np.ndarray | None = v.get("patch")
         self.final_obs: np.ndarray = v["final_obs"]
         self.final_mask: np.ndarray = v["final_mask"]
-        self._act_shape = (self.num_envs, self.num_agents, 2) if self.continuous else (self.num_envs, self.num_agents)
+        # Continuous: two wheels, then one rate per deposit action (`robots[].deposit_actions`).
+        self.action_width = int(np.prod(self.spec["action"]["shape"])) if self.continuous else 0
+        self._act_shape = (
+            (self.num_envs, self.num_agents, self.action_width) if self.continuous else (self.num_envs, self.num_agents)
+        )
         self._act_dtype = np.float32 if self.continuous else np.int64
+        # A task written in Python: its hooks run around every step; observations gain its entries.
+        self._runner: TaskRunner | None = None
+        if isinstance(task, Task):
+            self._runner = TaskRunner(task, self._core, self.spec, autoreset_mode == "same_step")
+            self.obs, self.final_obs = self._runner.obs, self._runner.final_obs
+            box = self.single_observation_space
+            self.single_observation_space = spaces.Box(
+                low=np.concatenate([box.low, self._runner.obs_low]),
+                high=np.concatenate([box.high, self._runner.obs_high]),
+                dtype=np.float32,
+            )
 
     def __getstate__(self) -> dict[str, Any]:
         # Pickling rebuilds the env from its arguments (a fresh copy that needs a reset).
@@ -128,6 +146,8 @@ class VecEnv(BackendInfo):
         if seed is not None:
             seed = _checks.seed(seed)
         self._core.reset(seed, mask)
+        if self._runner is not None:
+            self._runner.after_reset(np.arange(self.num_envs) if mask is None else np.flatnonzero(mask))
         if self._window is not None:
             self._window.show(self._core.render(0, 640))
         return self.obs, self._infos()
@@ -151,7 +171,10 @@ class VecEnv(BackendInfo):
                 a = a.astype(self._act_dtype)
         if a.shape != self._act_shape:
             raise ActionError(f"actions have shape {a.shape}, expected {self._act_shape}")
-        self._core.step(a)
+        if self._runner is not None:
+            self._runner.step(a)
+        else:
+            self._core.step(a)
         if self._window is not None:
             self._window.show(self._core.render(0, 640))
         return self.obs, self.rewards, self.terminated, self.truncated, self._infos()
@@ -162,6 +185,8 @@ class VecEnv(BackendInfo):
             infos["state"] = self.state
         if self.patch is not None:
             infos["patch"] = self.patch
+        if self._runner is not None and self._runner.last_info is not None:
+            infos["task"] = self._runner.last_info
         if self.autoreset_mode == "same_step" and self.final_mask.any():
             infos["final_obs"] = self.final_obs
             infos["_final_obs"] = self.final_mask

@@ -1,0 +1,122 @@
+"""Tasks written in Python (`colcos.Task`): the built-in tasks re-written under examples/tasks/ give
+exactly the Rust tasks' rewards, terminations and observations over 1,000 steps of a batch; hooks see
+the whole batch at once; a hook that raises or returns the wrong shape is named."""
+
+from __future__ import annotations
+
+import importlib.util
+import pathlib
+
+import numpy as np
+import pytest
+
+import colcos
+
+EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples" / "tasks"
+
+
+def _load(name: str):
+    spec = importlib.util.spec_from_file_location(f"colcos_example_{name}", EXAMPLES / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize(("name", "cls"), [("trail", "Trail"), ("foraging", "Foraging")])
+def test_python_rewrites_of_the_builtin_tasks_match_them_exactly(name, cls):
+    task = getattr(_load(name), cls)()
+    kw = dict(num_envs=6, seed=4, max_cycles=300, num_threads=2)
+    rust = colcos.vector.VecEnv(name, **kw)
+    py = colcos.vector.VecEnv(task, **kw)
+    assert py.single_observation_space == rust.single_observation_space
+    o1, _ = rust.reset(seed=4)
+    o2, _ = py.reset(seed=4)
+    np.testing.assert_array_equal(o1, o2)
+    rng = np.random.default_rng(0)
+    ended = 0
+    for t in range(1000):
+        a = rng.uniform(-0.3, 1.0, (6, rust.num_agents, 2)).astype(np.float32)
+        r1 = rust.step(a)
+        r2 = py.step(a)
+        for what, x, y in zip(("obs", "rewards", "terminated", "truncated"), r1[:4], r2[:4]):
+            assert np.array_equal(x, y), f"{name}: {what} differ at step {t}"
+        ended += int(r1[2].sum() + r1[3].sum())
+    assert ended > 0, "no episode ended: the test would not see terminations or truncations"
+
+
+class Probe(colcos.Task):
+    """Counts what it is asked, adds two observation entries, ends world 0's episodes at step 5."""
+
+    name = "probe"
+    obs_low = (0.0, -1.0)
+    obs_high = (1.0, 1.0)
+
+    def __init__(self) -> None:
+        self.resets: list[list[int]] = []
+        self.calls = 0
+
+    def reset(self, ctx: colcos.ResetContext) -> None:
+        self.resets.append(sorted(int(w) for w in ctx.worlds))
+
+    def observe(self, view: colcos.View) -> np.ndarray:
+        e, n = view.obs.shape[:2]
+        x = view.agents(view.poses)[..., 0] / np.float32(view.arena[0])
+        return np.stack([x, np.full((e, n), 2.0, np.float32)], axis=-1)  # 2.0 is clipped to 1
+
+    def reward(self, view: colcos.View) -> np.ndarray:
+        self.calls += 1
+        return np.ones(view.obs.shape[:2], np.float32) * view.steps[:, None]
+
+    def terminated(self, view: colcos.View) -> np.ndarray:
+        t = np.zeros(view.obs.shape[:2], bool)
+        t[0] = view.steps[0] >= 5
+        return t
+
+
+def test_hooks_run_once_per_step_over_the_whole_batch():
+    task = Probe()
+    env = colcos.vector.VecEnv(task, num_envs=3, seed=1, max_cycles=100)
+    assert env.single_observation_space.shape == (19,)
+    obs, _ = env.reset(seed=1)
+    assert task.resets == [[0, 1, 2]]
+    assert obs.shape == (3, env.num_agents, 19) and (obs[..., 18] == 1.0).all()
+    for _ in range(5):
+        obs, rew, term, trunc, _ = env.step(np.zeros((3, env.num_agents, 2), np.float32))
+    assert task.calls == 5
+    assert term[0].all() and not term[1:].any()
+    assert rew[1, 0] == 5.0
+    env.step(np.zeros((3, env.num_agents, 2), np.float32))  # world 0 starts over (next-step autoreset)
+    assert task.resets[-1] == [0]
+    assert env.episode(0) == 1 and env.episode(1) == 0
+
+
+class Broken(colcos.Task):
+    name = "broken"
+
+    def __init__(self, mode: str) -> None:
+        self.mode = mode
+
+    def reward(self, view: colcos.View) -> np.ndarray:
+        if self.mode == "raise":
+            raise KeyError("food")
+        if self.mode == "shape":
+            return np.zeros(3, np.float32)
+        return np.full(view.obs.shape[:2], np.nan, np.float32)
+
+
+@pytest.mark.parametrize(
+    ("mode", "needle"),
+    [("raise", r"'broken': hook reward\(\) raised KeyError"), ("shape", r"reward\(\) returned shape \(3,\), expected"),
+     ("nan", "non-finite")],
+)
+def test_a_broken_hook_is_named(mode, needle):
+    env = colcos.vector.VecEnv(Broken(mode), num_envs=2)
+    env.reset()
+    with pytest.raises(colcos.TaskHookError, match=needle):
+        env.step(np.zeros((2, env.num_agents, 2), np.float32))
+
+
+def test_a_python_task_refuses_builtin_parameters():
+    with pytest.raises(colcos.TaskError, match="channel"):
+        colcos.vector.VecEnv(Probe(), channel="b")
