@@ -99,3 +99,16 @@ def plain(value: Any, key: str) -> Any:
     raise ArgumentTypeError(
         f"task parameter `{key}` must be a number, string, bool or a list of them, got {_show(value)} ({type(value).__name__})"
     )
+
+
+def options(options: Any, known: tuple[str, ...]) -> None:
+    """A `reset` options dict: None or a dict whose keys are all in `known` (a misspelt key would
+    otherwise be ignored without a word)."""
+    if options is None:
+        return
+    if not isinstance(options, dict):
+        raise ArgumentTypeError(f"options must be a dict or None, got {type(options).__name__}")
+    unknown = sorted(str(k) for k in options if k not in known)
+    if unknown:
+        expected = ", ".join(repr(k) for k in known) if known else "none"
+        raise TaskError(f"unknown reset option(s) {unknown}; known: {expected}")

@@ -40,7 +40,8 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         task: `"aggregation"`, `"foraging"` or `"trail"` (see `colcos.tasks()`), or a `colcos.Task`
             written in Python (on `plant="sim"`; see `colcos.task`).
         scenario: a scenario file (path) or scenario TOML text; default: the task's own.
-        max_cycles: steps per episode before truncation (default: the scenario's duration / dt).
+        max_cycles: steps per episode before truncation (default 500; None: the scenario's
+            duration / dt).
         render_mode: None, `"human"` (a window showing the screen with the robots, at the field's
             rate, updated by every `reset` and `step`; `close()` closes it) or `"rgb_array"` (that
             image as an array).
@@ -219,6 +220,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         return v
 
     def reset(self, seed: int | None = None, options: dict | None = None) -> tuple[dict, dict]:
+        # No options of its own; PettingZoo's API test passes some, so any are accepted.
         if seed is not None:
             seed = _checks.seed(seed)
         self._core.reset(seed)
@@ -304,14 +306,16 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             raise StateError("this environment was made with global_state=False")
         return self._views["state"][0].copy()
 
-    def render(self, mode: str | None = None) -> np.ndarray | None:
+    def render(self, mode: str | None = None, width: int | None = None) -> np.ndarray | None:
+        """The screen with the robots on it: an array `(H, W, 3)` (`rgb_array`, `width` pixels wide,
+        16..=7,680, 640 by default) or the window (`human`)."""
         mode = mode or self.render_mode
         _checks.choice(mode, "render mode", [None, "human", "rgb_array"])
         if mode is None:
             warnings.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human'", stacklevel=2)
             return None
         if mode == "rgb_array":
-            return self._core.render(0, RENDER_WIDTH)
+            return self._core.render(0, RENDER_WIDTH if width is None else width)
         if self._window is None:
             self._window = HumanWindow(f"colcos: {self._spec['env_name']}", 1.0 / self._spec["dt"])
         self._show()  # the frame of this step, if reset/step has not shown it yet

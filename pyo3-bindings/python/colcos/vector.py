@@ -22,7 +22,7 @@ import numpy as np
 from gymnasium import spaces
 
 from colcos import _checks, _core
-from colcos._core import ActionError, ActionTypeError, ArgumentTypeError
+from colcos._core import ActionError, ActionTypeError
 from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_box, make_space
 from colcos.task import Task, TaskRunner, core_task
 
@@ -135,8 +135,7 @@ class VecEnv(BackendInfo):
     def reset(self, seed: int | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
         """Resets all worlds, or those in `options["reset_mask"]` (bool array of length E)."""
         mask = None
-        if options is not None and not isinstance(options, dict):
-            raise ArgumentTypeError(f"options must be a dict or None, got {type(options).__name__}")
+        _checks.options(options, ("reset_mask",))
         if options and options.get("reset_mask") is not None:
             mask = np.asarray(options["reset_mask"])
             if mask.dtype != np.bool_:

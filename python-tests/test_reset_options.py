@@ -1,0 +1,26 @@
+"""Reset options and render sizes as documented: a misspelt option key of the vector env is refused by
+name instead of being ignored (PettingZoo envs take any, as PettingZoo's API test expects), and
+`render(width=)` gives an image of that width."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import colcos
+
+
+def test_a_misspelt_reset_option_is_refused():
+    v = colcos.vector.VecEnv("aggregation", num_envs=2)
+    with pytest.raises(colcos.TaskError, match="reset_msk"):
+        v.reset(options={"reset_msk": np.array([True, False])})
+    v.reset(options={"reset_mask": np.array([True, False])})
+    with pytest.raises(colcos.TaskError, match="unknown reset option"):
+        v.reset(options={"seed": 3})
+
+
+def test_render_takes_a_width():
+    env = colcos.parallel_env(task="aggregation", render_mode="rgb_array")
+    env.reset(seed=0)
+    assert env.render(width=320).shape[1] == 320
+    assert env.render().shape[1] == 640
