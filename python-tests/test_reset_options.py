@@ -24,3 +24,13 @@ def test_render_takes_a_width():
     env.reset(seed=0)
     assert env.render(width=320).shape[1] == 320
     assert env.render().shape[1] == 640
+
+
+def test_patches_reach_the_gymnasium_vector_env():
+    from colcos.gymnasium_vector import ColcosVectorEnv
+
+    env = ColcosVectorEnv("aggregation", num_envs=2, patch=8)
+    _, infos = env.reset(seed=0)
+    assert infos["patch"].shape == (2 * 3, 8, 8, 3) and infos["patch"].dtype == np.uint8
+    _, _, _, _, infos = env.step(env.action_space.sample())
+    assert infos["patch"].shape == (6, 8, 8, 3)

@@ -94,6 +94,9 @@ class ColcosVectorEnv(VectorEnv):
         if waiting is not None and waiting.any():
             infos["waiting"] = waiting
             infos["_waiting"] = waiting
+        if v.patch is not None:
+            # Each sub-environment's (agent's) screen patch, (E*N, P, P, 3) uint8.
+            infos["patch"] = v.patch.reshape(self.num_envs, *v.patch.shape[2:]).copy()
         return infos
 
     def render(self) -> Any:

@@ -48,6 +48,11 @@ class ColcosSB3VecEnv(SB3VecEnv):
         t = term.reshape(n)
         u = trunc.reshape(n)
         infos: list[dict] = [{} for _ in range(n)]
+        if v.patch is not None:
+            # Each sub-environment's (agent's) screen patch, (P, P, 3) uint8.
+            patches = v.patch.reshape(n, *v.patch.shape[2:])
+            for info, patch in zip(infos, patches, strict=True):
+                info["patch"] = patch.copy()
         for i in np.flatnonzero(dones):
             infos[i]["terminal_observation"] = final[i].copy()
             infos[i]["TimeLimit.truncated"] = bool(u[i] and not t[i])

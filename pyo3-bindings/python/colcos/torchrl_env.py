@@ -21,6 +21,7 @@ from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
 from colcos import _checks
+from colcos._core import TaskError
 from colcos.vector import VecEnv
 
 
@@ -30,6 +31,11 @@ class ColcosTorchEnv(EnvBase):
 
     def __init__(self, task: str = "aggregation", num_envs: int = 1, device: str | torch.device = "cpu", **kwargs: Any) -> None:
         kwargs["autoreset_mode"] = "disabled"
+        if kwargs.get("patch") is not None:
+            raise TaskError(
+                "patch= is not carried by the TorchRL adapter; use colcos.vector.VecEnv (infos['patch']) or "
+                "colcos.gymnasium_vector (infos['patch'])"
+            )
         self.venv = VecEnv(task, num_envs=num_envs, **kwargs)
         v = self.venv
         super().__init__(device=device, batch_size=torch.Size([v.num_envs]))
