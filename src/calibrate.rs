@@ -128,6 +128,13 @@ fn parse_grid(s: &str) -> Result<[usize; 2], String> {
 /// Opens the tracker, the frame stream and (if given) the link.
 fn open_rig(common: &Common) -> Result<(Scenario, Rig)> {
     let sc = Scenario::from_file(&common.scenario)?;
+    // The output's folder exists (or is made) before anything is measured: a measurement is not
+    // thrown away for a missing `calib/`.
+    if let Some(dir) = common.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| {
+            format!("--out {}: creating {}", common.out.display(), dir.display())
+        })?;
+    }
     let tracker = match common
         .tracker
         .parse::<PoseUrl>()

@@ -194,6 +194,9 @@ fn run_command(command: Command, text: &mut String) -> Result<()> {
         }
         Command::Check { scenario } => {
             let sc = Scenario::from_file(&scenario)?;
+            // What the bridge would refuse as it starts: calibration files that cannot be used.
+            colcos_bridge::calibrate::RigCalibration::load(&sc)
+                .with_context(|| format!("{}", scenario.display()))?;
             let a = sc.arena_size();
             writeln!(text, "{}: ok", scenario.display())?;
             writeln!(

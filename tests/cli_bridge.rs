@@ -58,3 +58,52 @@ fn a_bridge_whose_tracker_is_not_there_says_so_once_and_fails() {
         "{summary}"
     );
 }
+
+/// `colcos check` refuses what the bridge would refuse as it starts: a `[rig] screen_calibration`
+/// that does not exist, named by its key.
+#[test]
+fn check_refuses_a_missing_screen_calibration_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/case2_alarm.toml");
+    let text = std::fs::read_to_string(base).unwrap();
+    let text = if text.contains("[rig]") {
+        text.replace(
+            "[rig]",
+            "[rig]\nscreen_calibration = \"nowhere/screen.json\"",
+        )
+    } else {
+        format!("{text}\n[rig]\nscreen_calibration = \"nowhere/screen.json\"\n")
+    };
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_colcos"))
+        .arg("check")
+        .arg(&path)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(stderr.contains("rig.screen_calibration"), "{stderr}");
+    assert!(stderr.contains("nowhere/screen.json"), "{stderr}");
+}
+
+/// `colcos calibrate --out calib/screen.json` makes `calib/` before it measures anything, so that a
+/// measurement is never lost to a missing folder (here the tracker is not there, and the folder is
+/// made all the same).
+#[test]
+fn calibrate_makes_its_output_folder_before_measuring() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("calib").join("screen.json");
+    let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/case2_alarm.toml");
+    let tracker = format!("swarmcon://127.0.0.1:{}", dead_port());
+    let run = Command::new(env!("CARGO_BIN_EXE_colcos"))
+        .args(["calibrate", "screen", scenario, "--tracker", &tracker])
+        .args(["--frames", "127.0.0.1:0", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "{stderr}");
+    assert!(stderr.contains("--tracker"), "{stderr}");
+    assert!(dir.path().join("calib").is_dir());
+}

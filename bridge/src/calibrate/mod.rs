@@ -38,6 +38,12 @@ pub enum CalibrationError {
     Fit(String),
     #[error("calibration run: {0}")]
     Run(String),
+    /// A calibration the scenario names under `key` (`rig.screen_calibration`) is unusable.
+    #[error("`{key}`: {source}")]
+    Key {
+        key: &'static str,
+        source: Box<CalibrationError>,
+    },
 }
 
 impl CalibrationError {
@@ -62,19 +68,30 @@ impl RigCalibration {
     pub fn load(scenario: &Scenario) -> Result<RigCalibration, CalibrationError> {
         let rig = &scenario.spec.rig;
         let resolve = |p: &str| scenario.base_dir.join(p);
+        let keyed = |key| {
+            move |e| CalibrationError::Key {
+                key,
+                source: Box::new(e),
+            }
+        };
         let screen = match &rig.screen_calibration {
             Some(p) => {
-                let cal = ScreenCalibration::load(&resolve(p))?;
-                let s = &scenario.spec.screen;
-                cal.check_screen(s.resolution, [s.size[0] as f64, s.size[1] as f64])?;
-                Some(cal)
+                let load = || -> Result<ScreenCalibration, CalibrationError> {
+                    let cal = ScreenCalibration::load(&resolve(p))?;
+                    let s = &scenario.spec.screen;
+                    cal.check_screen(s.resolution, [s.size[0] as f64, s.size[1] as f64])?;
+                    Ok(cal)
+                };
+                Some(load().map_err(keyed("rig.screen_calibration"))?)
             }
             None => None,
         };
         let colour = match &rig.colour_calibration {
             Some(p) => {
                 let path = resolve(p);
-                Some(ColourCalibration::load(&path).map_err(|e| CalibrationError::file(&path, e))?)
+                let cal =
+                    ColourCalibration::load(&path).map_err(|e| CalibrationError::file(&path, e));
+                Some(cal.map_err(keyed("rig.colour_calibration"))?)
             }
             None => None,
         };
