@@ -92,14 +92,27 @@ fn run_rig(
         sc.spec.tracker.latency.to_string()
     );
     assert_eq!(report.tracker_latency, sc.spec.tracker.latency);
-    // The trajectory has the simulator's columns and one row per robot and tick.
+    // The trajectory has the simulator's columns and one row per robot and tick from the tracker's
+    // first pose on, counted from 0; no robot is ever at the (0, 0) of a pose not yet tracked.
     let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(
         lines.next(),
         Some(colcos_sim::output::trajectory::header().as_str())
     );
-    assert_eq!(lines.count() as u64, 5 * report.ticks);
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len() as u64, 5 * report.logged_ticks);
+    assert!(report.logged_ticks > 0 && report.logged_ticks <= report.ticks);
+    assert!(rows[0].starts_with("0,"), "{}", rows[0]);
+    for row in &rows[..5] {
+        let xy: Vec<f64> = row
+            .split(',')
+            .skip(4)
+            .take(2)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert!(xy != [0.0, 0.0], "a robot at (0, 0): {row}");
+    }
     // The run's GIF, complete when the loop returns: a frame per `gif_interval`.
     let gif = std::fs::read(dir.path().join("run.gif")).unwrap();
     let frames = gif.windows(3).filter(|w| *w == [0x21, 0xF9, 0x04]).count();

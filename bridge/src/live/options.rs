@@ -42,6 +42,8 @@ pub struct LiveOptions {
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct LiveReport {
     pub ticks: u64,
+    /// Ticks in the trajectory log: those from the tracker's first pose on.
+    pub logged_ticks: u64,
     pub seconds: f64,
     /// Ticks that ended after their slot.
     pub overruns: u64,

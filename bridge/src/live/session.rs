@@ -257,7 +257,10 @@ impl LiveSession {
             record(self.log(), Topic::Events, e.as_bytes());
         }
         self.show_screen(t);
+        // Nothing is drawn or logged before the tracker's first pose: robots are not at (0, 0).
+        let tracking = self.report.pose_blocks > 0;
         if let Some(gif) = self.gif.as_mut()
+            && tracking
             && t >= self.next_gif
         {
             self.next_gif = t + gif.interval;
@@ -270,7 +273,9 @@ impl LiveSession {
                 h,
             ));
         }
-        self.write_trajectory()?;
+        if tracking {
+            self.write_trajectory()?;
+        }
         if let Ok(mut l) = self.log().lock()
             && let Some(r) = l.as_mut()
         {
@@ -433,7 +438,8 @@ impl LiveSession {
         if let Some(traj) = self.trajectory.as_mut() {
             let host = self.core.host();
             traj.record_rows(&TickRows {
-                tick: self.report.ticks,
+                // Counted from 0 at the first tick with poses, as `colcos run` counts its steps.
+                tick: self.report.logged_ticks,
                 time: host.time(),
                 poses: host.poses(),
                 tracked: host.tracked(),
@@ -442,6 +448,7 @@ impl LiveSession {
                 groups: &self.groups,
                 group_specs: &self.scenario.spec.robots,
             })?;
+            self.report.logged_ticks += 1;
         }
         Ok(())
     }
