@@ -99,10 +99,7 @@ fn bumper_pass(
 fn main() {
     println!(
         "{ROBOTS} robots, 200 obstacles ({} parry2d parts), arena {} x {} m, {} threads",
-        Obstacles::of_scenario(&scenario("discs"))
-            .unwrap()
-            .parts()
-            .len(),
+        scenario("discs").obstacles().unwrap().parts().len(),
         ARENA[0],
         ARENA[1],
         rayon::current_num_threads()

@@ -8,7 +8,8 @@ mod expand;
 mod render;
 mod rows;
 mod simd;
-pub use render::{Instructions, ScreenRenderer};
+pub use render::ScreenRenderer;
+pub use rows::Instructions;
 
 /// The display panel: resolution in pixels and physical size in metres. Pixel row 0 is at the top
 /// (`y = height`), as in images.

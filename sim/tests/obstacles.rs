@@ -309,7 +309,7 @@ fn robots_are_placed_off_obstacles_or_refused() {
         ".",
     )
     .unwrap();
-    let obs = Obstacles::of_scenario(&sc).unwrap();
+    let obs = sc.obstacles().unwrap();
     for seed in 0..5 {
         let sc = sc.clone().with_overrides(Some(seed), None).unwrap();
         let world = World::new(&sc).unwrap();
@@ -396,7 +396,7 @@ shape = { disc = { centre = [0.5, 0.5], radius = 0.45 } }
 fn a_disc_arena_holds_its_robots() {
     let text = format!("{DISC_ARENA}[[robots]]\ncount = 40\nbehaviour = \"avoid\"\n");
     let sc = Scenario::from_toml_str(&text, ".").unwrap();
-    let obs = Arc::new(Obstacles::of_scenario(&sc).unwrap());
+    let obs = Arc::new(sc.obstacles().unwrap());
     // Bumper: facing the wall 1 cm from the rim (the wall's inner face is the disc's edge).
     let r = bumpers(&obs, Pose::new(0.5 + 0.45 - R - 0.01, 0.5, 0.0));
     assert!(close(r[1], 0.5, 1e-2), "{r:?}");

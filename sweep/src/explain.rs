@@ -2,30 +2,35 @@
 //! it sets and the value, on one line. The scenario a combination runs is generated (the base with the
 //! axis values set), so the parser's line numbers, source lines and Rust type names would point the
 //! user into a file they never see.
+use crate::axis::Axis;
 use crate::error::SweepError;
-use crate::plan::Plan;
 use colcos_sim::error::SimError;
 use colcos_sim::scenario::ScenarioSpec;
 
-/// The error of combination `combo` (seed `seed`), whose scenario `table` failed with `err`.
-pub(crate) fn combination_error(
-    plan: &Plan,
-    combo: usize,
-    seed: u64,
-    table: &toml::Table,
-    err: SimError,
-) -> SweepError {
+/// What an error needs to know of the plan: the sweep file, the axes, and the combination.
+pub(crate) struct Combination<'a> {
+    pub file: &'a str,
+    pub axes: &'a [Axis],
+    /// Its index, one value per axis, and those values as `Plan::describe` says them.
+    pub index: usize,
+    pub values: &'a [toml::Value],
+    pub described: String,
+    pub seed: u64,
+}
+
+/// The error of a combination whose scenario `table` failed with `err`.
+pub(crate) fn combination_error(c: &Combination, table: &toml::Table, err: SimError) -> SweepError {
     let found = match &err {
         SimError::Parse { .. } => parse_failure(table),
         SimError::Invalid { key, reason, .. } => Some((key.clone(), reason.clone())),
         _ => None,
     };
     let Some((path, reason)) = found else {
-        return whole_combination(plan, combo, seed, err);
+        return whole_combination(c, err);
     };
-    match find_axis(plan, &path) {
+    match find_axis(c.axes, &path) {
         Some(i) => {
-            let axis = &plan.axes[i];
+            let axis = &c.axes[i];
             // The key the error is about, among the axis's keys.
             let key = axis
                 .keys
@@ -34,9 +39,9 @@ pub(crate) fn combination_error(
                 .find(|k| inside(&path, k) || inside(k, &path))
                 .unwrap_or_else(|| axis.keys[0].to_string());
             SweepError::Axis {
-                file: plan.file.clone(),
-                setting: SweepError::setting(i, &axis.name, &key, &plan.combos[combo][i]),
-                combo,
+                file: c.file.to_string(),
+                setting: SweepError::setting(i, &axis.name, &key, &c.values[i]),
+                combo: c.index,
                 reason,
             }
         }
@@ -49,17 +54,17 @@ pub(crate) fn combination_error(
                 },
                 other => other,
             };
-            whole_combination(plan, combo, seed, source)
+            whole_combination(c, source)
         }
     }
 }
 
-fn whole_combination(plan: &Plan, combo: usize, seed: u64, source: SimError) -> SweepError {
+fn whole_combination(c: &Combination, source: SimError) -> SweepError {
     SweepError::Combination {
-        file: plan.file.clone(),
-        combo,
-        params: plan.describe(combo),
-        seed,
+        file: c.file.to_string(),
+        combo: c.index,
+        params: c.described.clone(),
+        seed: c.seed,
         source: Box::new(source),
     }
 }
@@ -85,9 +90,9 @@ fn inside(a: &str, b: &str) -> bool {
 
 /// The axis an error at `path` is about: one that sets `path` or a table holding it, else the only
 /// axis that sets a key inside `path` (several: the combination as a whole is named instead).
-fn find_axis(plan: &Plan, path: &str) -> Option<usize> {
-    let keys = |i: usize| plan.axes[i].keys.iter().map(|k| k.to_string());
-    let n = plan.axes.len();
+fn find_axis(axes: &[Axis], path: &str) -> Option<usize> {
+    let keys = |i: usize| axes[i].keys.iter().map(|k| k.to_string());
+    let n = axes.len();
     if let Some(i) = (0..n).find(|&i| keys(i).any(|k| inside(path, &k))) {
         return Some(i);
     }

@@ -297,12 +297,20 @@ impl Plan {
         }
         let text = toml::to_string(&table)
             .map_err(|e| SweepError::invalid("scenario", "(table)", e.to_string()))?;
+        let this = || crate::explain::Combination {
+            file: &self.file,
+            axes: &self.axes,
+            index: combo,
+            values: &self.combos[combo],
+            described: self.describe(combo),
+            seed,
+        };
         let scenario = Scenario::from_toml_str(&text, self.scenario_dir.clone())
-            .map_err(|e| crate::explain::combination_error(self, combo, seed, &table, e))?;
+            .map_err(|e| crate::explain::combination_error(&this(), &table, e))?;
         if check_metrics {
             self.metrics.check_scenario(&scenario).map_err(|m| {
                 let source = SimError::invalid("metrics", self.describe(combo), m);
-                crate::explain::combination_error(self, combo, seed, &table, source)
+                crate::explain::combination_error(&this(), &table, source)
             })?;
         }
         Ok(scenario)

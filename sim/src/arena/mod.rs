@@ -95,16 +95,6 @@ impl Obstacles {
         Ok(out)
     }
 
-    /// The obstacles of a scenario (none when it lists none).
-    pub fn of_scenario(sc: &crate::scenario::Scenario) -> Result<Obstacles> {
-        Self::build_in(
-            &sc.spec.obstacles,
-            sc.spec.arena.shape.as_ref(),
-            sc.arena_size(),
-            &sc.base_dir,
-        )
-    }
-
     /// True when there are no physical obstacles (nothing to collide with or see by bumper).
     pub fn is_empty(&self) -> bool {
         self.parts.is_empty()

@@ -1,6 +1,6 @@
 //! Trail following: steer toward the side whose colour sensor sees more of one channel; wander when
 //! off the trail.
-use super::registry::ParamDoc;
+use super::param_doc::ParamDoc;
 use super::{Behaviour, Observation, Wander, WheelCommand};
 use crate::rng::SimRng;
 use serde::{Deserialize, Serialize};

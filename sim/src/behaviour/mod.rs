@@ -6,6 +6,7 @@ mod avoid;
 mod follow;
 mod observation;
 pub mod paper;
+pub mod param_doc;
 pub mod registry;
 mod wander;
 

@@ -2,27 +2,16 @@
 //! group's `params` table and rejects unknown keys.
 use super::follow::{FollowParams, channel_index};
 use super::paper::{FollowerParams, ForagingParams, LeaderParams};
+pub use super::param_doc::ParamDoc;
 use super::{Avoid, Behaviour, Follow, Wander};
 use crate::error::{Result, SimError};
 use crate::robot::ColiasParams;
-use crate::scenario::RobotGroupSpec;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 /// Builds a behaviour from its `params` table (`key` names it in errors) for a robot with `robot`'s
 /// body (a behaviour that turns at a set yaw rate needs its wheel base).
 type Builder = fn(&toml::Table, &str, &ColiasParams) -> Result<Box<dyn Behaviour>>;
-
-/// One key of a behaviour's `params` table, for `colcos behaviours` and `colcos.behaviour_params()`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ParamDoc {
-    pub name: &'static str,
-    /// TOML type, unit and allowed range.
-    pub ty: &'static str,
-    /// The value used when the key is left out, as TOML.
-    pub default: &'static str,
-    pub meaning: &'static str,
-}
 
 /// A registered behaviour.
 struct Entry {
@@ -109,17 +98,9 @@ pub fn build(name: &str, params: &toml::Table, key: &str) -> Result<Box<dyn Beha
     build_with(name, params, key, &ColiasParams::default())
 }
 
-/// The behaviour of every robot of `group` (`key`, e.g. `robots[2]`, names it in errors), for a robot
-/// with the scenario's body `robot`: the one constructor of scenario behaviours, whoever runs them.
-pub fn build_for_group(
-    group: &RobotGroupSpec,
-    robot: &ColiasParams,
-    key: &str,
-) -> Result<Box<dyn Behaviour>> {
-    build_with(&group.behaviour, &group.params, key, robot)
-}
-
-/// Builds behaviour `name` from its parameter table for a robot with body `robot`.
+/// Builds behaviour `name` from its parameter table for a robot with body `robot` (`key`, e.g.
+/// `robots[2]`, names it in errors): the one constructor of scenario behaviours, whoever runs them
+/// (`RobotGroupSpec::build_behaviour`).
 pub fn build_with(
     name: &str,
     params: &toml::Table,

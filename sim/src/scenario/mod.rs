@@ -15,7 +15,7 @@ pub use limits::{
     MAX_POLYLINE_POINTS, MAX_POSES_IN_FLIGHT, MAX_ROBOTS, MAX_SOURCE_PAIRS, MAX_SUBSTEPS,
     MAX_TRACKER_LATENCY, MAX_TRACKER_RATE_HZ,
 };
-pub use randomize::RandomizeSpec;
+pub use randomize::{RandomizeSpec, Randomized};
 pub use rig::{BROADCAST_ID, Firmware, RigSpec, SensorSource};
 pub use spec::*;
 
@@ -31,6 +31,16 @@ pub struct Scenario {
 }
 
 impl Scenario {
+    /// Its obstacles (none when it lists none), built as the world builds them.
+    pub fn obstacles(&self) -> Result<crate::arena::Obstacles> {
+        crate::arena::Obstacles::build_in(
+            &self.spec.obstacles,
+            self.spec.arena.shape.as_ref(),
+            self.arena_size(),
+            &self.base_dir,
+        )
+    }
+
     /// Reads, parses and validates a scenario file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();

@@ -44,7 +44,7 @@ impl Placed {
 /// without overlap, on a grid, or explicit. Robots closer than a diameter to an earlier one (explicit
 /// or grid) and groups that cannot be placed are errors naming the key. Validation runs this for
 /// world 0, the world builds with it, so a scenario that validates also places. `obstacles` are the
-/// scenario's ([`Obstacles::of_scenario`], built once by the caller, who keeps them).
+/// scenario's ([`super::Scenario::obstacles`], built once by the caller, who keeps them).
 pub(crate) fn place(sc: &Scenario, obstacles: &Obstacles, rng: &mut SimRng) -> Result<Vec<Pose>> {
     let s = &sc.spec;
     // Robots start clear of the obstacles: explicit and grid poses inside one are errors, random

@@ -3,11 +3,20 @@
 //! anew), so that a policy trained on the simulator meets rigs whose numbers differ from the defaults:
 //! latency, pose noise, sensor gain and crosstalk, motor lag, wheel-speed limit. Centre the ranges on
 //! the rig's calibrated values.
-use super::spec::ScenarioSpec;
 use crate::error::{Result, SimError};
 use crate::rng::SimRng;
+use crate::robot::ColiasParams;
+use crate::sensors::ColourSensorParams;
+use crate::tracker::TrackerParams;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
+
+/// The parts of a scenario that `[randomize]` draws anew.
+pub struct Randomized<'a> {
+    pub tracker: &'a mut TrackerParams,
+    pub sensor: &'a mut ColourSensorParams,
+    pub robot: &'a mut ColiasParams,
+}
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -66,8 +75,9 @@ impl RandomizeSpec {
         Ok(())
     }
 
-    /// Draws every randomised value into `spec` from `rng`, in a fixed order.
-    pub fn apply(&self, spec: &mut ScenarioSpec, rng: &mut SimRng) {
+    /// Draws every randomised value into a scenario's tracker, sensor and robot parameters from
+    /// `rng`, in a fixed order.
+    pub fn apply(&self, spec: Randomized, rng: &mut SimRng) {
         let mut draw =
             |r: Option<[f32; 2]>| r.map(|[a, b]| if a < b { rng.random_range(a..=b) } else { a });
         if let Some(v) = draw(self.tracker_latency) {

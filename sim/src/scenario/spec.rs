@@ -247,6 +247,17 @@ pub struct RobotGroupSpec {
     pub emits: Vec<EmitSpec>,
 }
 
+impl RobotGroupSpec {
+    /// A robot's behaviour as this group names it (`key`: the group's key, for errors).
+    pub fn build_behaviour(
+        &self,
+        robot: &crate::robot::ColiasParams,
+        key: &str,
+    ) -> crate::error::Result<Box<dyn crate::behaviour::Behaviour>> {
+        crate::behaviour::registry::build_with(&self.behaviour, &self.params, key, robot)
+    }
+}
+
 /// Trail injection along each robot's path.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

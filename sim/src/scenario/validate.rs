@@ -4,7 +4,6 @@
 use super::Scenario;
 use super::limits::{self, *};
 use super::spec::*;
-use crate::behaviour::registry;
 use crate::error::{Result, SimError};
 
 fn positive(key: &str, v: f32) -> Result<()> {
@@ -417,7 +416,7 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
                 format!("more than {MAX_ROBOTS} robots in the scenario"),
             ));
         }
-        registry::build_for_group(group, &s.robot, &format!("robots[{g}]"))?;
+        group.build_behaviour(&s.robot, &format!("robots[{g}]"))?;
         let region = group.region.unwrap_or([0.0, 0.0, arena.x, arena.y]);
         for (n, v) in region.iter().enumerate() {
             finite(&format!("robots[{g}].region[{n}]"), *v)?;
@@ -565,7 +564,7 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
     limits::check_step_work(sc, &crate::field::GridSpec::covering(arena, s.field.cell))?;
     // The placement the world runs for world 0, from the same stream.
     let mut rng = crate::rng::stream_of(s.seed, 0, crate::rng::Stream::Placement);
-    let obstacles = crate::arena::Obstacles::of_scenario(sc)?;
+    let obstacles = sc.obstacles()?;
     super::placement::place(sc, &obstacles, &mut rng).map(|_| ())
 }
 

@@ -7,13 +7,11 @@
 //! pixel, their sources frozen once per frame). 3840x2160 with three grids: ~2 ms on two cores.
 use super::ScreenSpec;
 use super::expand::ColumnTable;
-use super::rows::{self, BandScratch, Plan, PlanSource};
+use super::rows::{self, BandScratch, CHUNK, GridLayout, Instructions, Plan, PlanSource};
 use crate::field::{FieldModel, FrozenSources, GridSpec, Pheromone, lerp_index};
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
-/// Pixels per inner block: the accumulators of a block stay in L1 and the loops have a fixed length.
-pub(super) const CHUNK: usize = 64;
 /// Pixel rows per parallel task: each expands the grid rows its pixel rows read (about 4 of 5 mm
 /// cells at 4K, so a row is expanded 1.3 times on average), and they stay in cache.
 const BAND_ROWS: usize = 48;
@@ -27,19 +25,6 @@ pub struct ScreenRenderer {
     layout: Option<Layout>,
     frozen: FrozenSources,
     instructions: Instructions,
-}
-
-/// The vector instructions a [`ScreenRenderer`] may use. All give the same bytes; the choice is for
-/// tests and comparisons.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Instructions {
-    /// The widest this CPU has (AVX-512 with VBMI, else AVX2, else none).
-    #[default]
-    Best,
-    /// At most AVX2.
-    Avx2,
-    /// None beyond the target's baseline.
-    Portable,
 }
 
 /// What the tables were made for.
@@ -60,14 +45,6 @@ struct Layout {
     /// Pixel row centres, m, top row first.
     ys: Vec<f32>,
     grids: Vec<Option<GridLayout>>,
-}
-
-/// One grid's cells and weights at the image's pixels, as [`lerp_index`] gives them.
-pub(super) struct GridLayout {
-    /// The cells and weights of each pixel column.
-    pub(super) cols: ColumnTable,
-    /// `(j0, j1, ty)` of each pixel row, top row first.
-    pub(super) rows: Vec<(u32, u32, f32)>,
 }
 
 impl Layout {

@@ -2,13 +2,37 @@
 //! into a scratch buffer that stays in cache, then each pixel row blended from two of them, in
 //! strips of columns (the strip's rows stay in L1), by the vector kernel ([`super::simd`]) or in
 //! blocks of [`CHUNK`] pixels (any field model, any CPU).
-use super::render::{CHUNK, GridLayout, Instructions};
+use super::expand::ColumnTable;
 #[cfg(target_arch = "x86_64")]
 use super::simd;
 use super::to_level;
 use crate::field::FrozenSource;
 use glam::Vec2;
 use std::mem::MaybeUninit;
+
+/// Pixels per inner block: the accumulators of a block stay in L1 and the loops have a fixed length.
+pub(super) const CHUNK: usize = 64;
+
+/// The vector instructions a [`super::ScreenRenderer`] may use. All give the same bytes; the choice is for
+/// tests and comparisons.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Instructions {
+    /// The widest this CPU has (AVX-512 with VBMI, else AVX2, else none).
+    #[default]
+    Best,
+    /// At most AVX2.
+    Avx2,
+    /// None beyond the target's baseline.
+    Portable,
+}
+
+/// One grid's cells and weights at the image's pixels, as [`crate::field::lerp_index`] gives them.
+pub(super) struct GridLayout {
+    /// The cells and weights of each pixel column.
+    pub(super) cols: ColumnTable,
+    /// `(j0, j1, ty)` of each pixel row, top row first.
+    pub(super) rows: Vec<(u32, u32, f32)>,
+}
 
 /// Pixel columns per strip: a strip of the expanded rows a pixel row reads (two per grid) fits L1.
 const STRIP: usize = 1024;

@@ -2,7 +2,7 @@
 //! parts without bodies or a tracker model, for a host whose robots and tracker are real.
 use super::inject::{Deposit, Emitter};
 use super::{FieldSet, Injection, RobotSet, RobotSlot, Sensing, Tracking, World};
-use crate::behaviour::{WheelCommand, registry};
+use crate::behaviour::WheelCommand;
 use crate::error::Result;
 use crate::field::{
     FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec, Pheromone,
@@ -44,7 +44,13 @@ impl World {
         } else {
             let mut sc = scenario.clone();
             let mut rng = rng::stream_of(sc.spec.seed, world_index, Stream::Randomize);
-            scenario.spec.randomize.apply(&mut sc.spec, &mut rng);
+            let s = &mut sc.spec;
+            let parts = crate::scenario::Randomized {
+                tracker: &mut s.tracker,
+                sensor: &mut s.sensor,
+                robot: &mut s.robot,
+            };
+            scenario.spec.randomize.apply(parts, &mut rng);
             drawn = sc;
             &drawn
         };
@@ -103,7 +109,7 @@ impl WorldParts {
 
         let mut placement_rng = rng::stream_of(spec.seed, world_index, Stream::Placement);
         // Built once: placement keeps robots off them, then the bumpers and physics see them.
-        let obstacles = std::sync::Arc::new(crate::arena::Obstacles::of_scenario(scenario)?);
+        let obstacles = std::sync::Arc::new(scenario.obstacles()?);
         let poses: Vec<Pose> = placement::place(scenario, &obstacles, &mut placement_rng)?;
         let mut slots = Vec::with_capacity(poses.len());
         let mut deposits = Vec::new();
@@ -114,7 +120,7 @@ impl WorldParts {
             for (index, &pose) in poses.iter().enumerate().skip(first).take(group.count) {
                 slots.push(RobotSlot {
                     group: g,
-                    behaviour: registry::build_for_group(group, &spec.robot, &key)?,
+                    behaviour: group.build_behaviour(&spec.robot, &key)?,
                     rng: rng::stream_of(spec.seed, world_index, Stream::Robot(index)),
                     drive: DriveState::default(),
                     command: WheelCommand::STOP,

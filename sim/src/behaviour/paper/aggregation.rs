@@ -13,7 +13,7 @@
 //! Directions come from eq. (6) ([`Observation::gradient_direction`]); see the parent module for the
 //! sign of eq. (8).
 use super::{GREEN, RED, check, eq8, wrap_angle};
-use crate::behaviour::registry::ParamDoc;
+use crate::behaviour::param_doc::ParamDoc;
 use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
 use crate::error::Result;
 use crate::rng::SimRng;

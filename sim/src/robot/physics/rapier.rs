@@ -1,6 +1,5 @@
 //! The rapier2d solver: dynamic discs driven by velocity in four thick static wall boxes.
 use super::FRICTION;
-use super::rapier_host::HostedArena;
 use crate::arena::Obstacles;
 use crate::robot::Pose;
 use glam::Vec2;
@@ -53,6 +52,15 @@ struct SharedSets {
 
 thread_local! {
     static SHARED: RefCell<SharedSets> = RefCell::default();
+}
+
+/// What an arena living in a [`RapierHost`](super::RapierHost) keeps of it.
+pub(super) struct HostedArena {
+    pub(super) slot: usize,
+    /// The host's bodies lag this arena's mirror (free steps, a teleport, a new episode).
+    pub(super) stale: bool,
+    /// Its velocities are in the host and its poses will be read back after the host's step.
+    pub(super) pending: bool,
 }
 
 /// The rapier solver's state. What a free step reads is kept in this small struct, held inline by

@@ -17,7 +17,7 @@
 //!
 //! [`ArenaPhysics::step_in`]: super::ArenaPhysics::step_in
 //! [`ArenaPhysics::finish_in`]: super::ArenaPhysics::finish_in
-use super::rapier::{self, RapierState, settle};
+use super::rapier::{self, HostedArena, RapierState, settle};
 use crate::arena::Obstacles;
 use crate::robot::Pose;
 use glam::Vec2;
@@ -45,15 +45,6 @@ pub struct RapierHost {
 struct HostSlot {
     bodies: Vec<RigidBodyHandle>,
     awake: bool,
-}
-
-/// What an arena living in a host keeps of it.
-pub(super) struct HostedArena {
-    slot: usize,
-    /// The host's bodies lag this arena's mirror (free steps, a teleport, a new episode).
-    pub(super) stale: bool,
-    /// Its velocities are in the host and its poses will be read back after the host's step.
-    pending: bool,
 }
 
 fn bounds(obstacles: &Obstacles) -> Vec<(Vec2, Vec2)> {
