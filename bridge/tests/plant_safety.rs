@@ -72,3 +72,30 @@ fn a_twin_plant_whose_tracker_is_not_there_names_it_within_seconds() {
     // And it still refuses to step: nothing was observed.
     assert!(env.step(Actions::Continuous(&[0.0; 6])).is_err());
 }
+
+#[test]
+fn a_replay_of_another_scenarios_log_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("rig.mcap");
+    let mut opts = PlantOptions::new(PlantKind::Twin);
+    opts.goto = false;
+    opts.log = Some(log.clone());
+    let mut env = LiveEnv::new(&config(), &opts).unwrap();
+    env.reset(Some(1)).unwrap();
+    let n = env.spec().num_agents;
+    for _ in 0..5 {
+        env.step(Actions::Continuous(&vec![0.2; 2 * n])).unwrap();
+    }
+    env.close("recorded");
+    drop(env);
+    let mut replay = PlantOptions::new(PlantKind::Replay);
+    replay.log = Some(log);
+    // The same task's scenario replays; another task's (4 robots, not 5) is refused by name.
+    assert!(LiveEnv::new(&config(), &replay).is_ok());
+    let err = LiveEnv::new(&EnvConfig::new("trail"), &replay)
+        .err()
+        .expect("a log of another scenario must be refused")
+        .to_string();
+    assert!(err.contains("was recorded with scenario"), "{err}");
+    assert!(err.contains("robots"), "{err}");
+}

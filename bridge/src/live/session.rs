@@ -523,6 +523,9 @@ fn run_metadata(scenario: &Scenario) -> std::collections::BTreeMap<String, Strin
     let rig = &scenario.spec.rig;
     let none = || "none".to_string();
     [
+        // What a replay checks the log against: the scenario it is replayed with.
+        ("scenario", scenario.spec.name.clone()),
+        ("robots", scenario.robot_count().to_string()),
         ("rig_latency", rig.latency.to_string()),
         ("tracker_latency", scenario.spec.tracker.latency.to_string()),
         (

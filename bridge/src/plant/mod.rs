@@ -150,6 +150,7 @@ impl LiveEnv {
             })?;
             let bytes = std::fs::read(path)
                 .map_err(|e| PlantError::option("replay", format!("{}: {e}", path.display())))?;
+            refuse_another_scenario(&bytes, path, scenario)?;
             let ticks = replay::read_ticks(&bytes, scenario.robot_count())?;
             return Ok(Driver::Replay {
                 core: Box::new(LoopCore::new(scenario, LegacyDrive::default())?),
@@ -517,4 +518,35 @@ pub struct PlantBuffers {
     pub state: *mut f32,
     pub patch: *mut u8,
     pub shield: *mut u8,
+}
+
+/// A rig log recorded with another scenario (its `rig` metadata names it and its robot count) is
+/// refused: its poses would be fed to the wrong robots. Logs without that metadata are taken.
+fn refuse_another_scenario(
+    bytes: &[u8],
+    path: &std::path::Path,
+    scenario: &Scenario,
+) -> Result<(), PlantError> {
+    let rig = crate::recorder::read_metadata(bytes)
+        .into_iter()
+        .find(|(name, _)| name == "rig");
+    let Some((_, meta)) = rig else {
+        return Ok(());
+    };
+    let (ours, n) = (&scenario.spec.name, scenario.robot_count());
+    let robots = meta.get("robots").and_then(|r| r.parse::<usize>().ok());
+    let name = meta.get("scenario");
+    if robots.is_some_and(|r| r != n) || name.is_some_and(|s| s != ours) {
+        return Err(PlantError::option(
+            "replay",
+            format!(
+                "{} was recorded with scenario {:?} ({} robots); this environment's scenario is \
+                 {ours:?} ({n} robots)",
+                path.display(),
+                name.map_or("?", String::as_str),
+                robots.map_or("?".to_string(), |r| r.to_string()),
+            ),
+        ));
+    }
+    Ok(())
 }
