@@ -28,6 +28,13 @@ def test_a_policy_that_keeps_clear_passes():
     assert report.steps == 100 and len(report.returns) == 1
 
 
+def test_a_boundary_refusal_names_the_robot_the_step_and_the_distance():
+    strict = PreflightLimits(overruns=0.5, walled=1.0, capped=1.0, edge_tolerance=-0.05)
+    with pytest.raises(PreflightError, match=r"boundary = \d+ over the limit 0 \(worst: robot \d+, episode 0, step \d+: [\d.]+ mm (past|inside) the edge\)") as e:
+        preflight(lambda obs: np.ones(2, np.float32), episodes=1, max_cycles=150, limits=strict)
+    assert e.value.report.worst_boundary is not None
+
+
 def test_bad_arguments_are_named():
     with pytest.raises(colcos.TaskError, match="episodes"):
         preflight(lambda obs: obs[:2], episodes=0)

@@ -39,12 +39,15 @@ class PreflightLimits:
     capped: float = 0.05
     """Agent-steps whose wheel speeds the shield capped."""
     boundary: int = 0
-    """Steps with a robot's body past the arena's edge (by its tracked pose)."""
+    """Steps with a robot's body past the arena's edge by more than `edge_tolerance` m (by its
+    tracked pose)."""
     collisions: float = 0.02
     """Steps with two robots overlapping by more than `overlap` m (by their tracked poses)."""
     overruns: float = 0.02
     """Loop ticks that ended after their 20 ms slot."""
     overlap: float = 0.005
+    edge_tolerance: float = 0.003
+    """How far past the edge a tracked body may seem to be without counting (the tracker's noise)."""
 
 
 @dataclass
@@ -59,6 +62,9 @@ class PreflightReport:
     collisions: int = 0
     overruns: int = 0
     returns: list[float] = field(default_factory=list)
+    worst_boundary: dict[str, Any] | None = None
+    """The nearest a body came to the edge, or the farthest past it: episode, step, robot, metres past
+    (negative: inside)."""
     broken: list[str] = field(default_factory=list)
 
     def as_dict(self) -> dict[str, Any]:
@@ -97,7 +103,14 @@ def preflight(
                 report.walled += sum(bool(i["shield_walled"]) for i in infos.values())
                 report.capped += sum(bool(i["shield_capped"]) for i in infos.values())
                 poses = env.poses()
-                report.boundary += int(_past_edge(poses, radius, arena))
+                past = _past_edge(poses, radius, arena)
+                worst = int(np.argmax(past))
+                if past[worst] > limits.edge_tolerance:
+                    report.boundary += 1
+                if report.worst_boundary is None or past[worst] > report.worst_boundary["past"]:
+                    report.worst_boundary = dict(
+                        episode=episode, step=env._core.episode_steps(0), robot=worst, past=float(past[worst])
+                    )
                 report.collisions += int(_overlapping(poses, radius, limits.overlap))
             info = env.plant_info()
             report.ticks += int(info.get("ticks", report.steps))
@@ -113,7 +126,15 @@ def preflight(
     ]
     for name, value, limit in checks:
         if value > limit:
-            report.broken.append(f"{name} = {value:.4g} over the limit {limit:g}")
+            detail = ""
+            if name == "boundary" and report.worst_boundary is not None:
+                w = report.worst_boundary
+                where = "past" if w["past"] > 0 else "inside"
+                detail = (
+                    f" (worst: robot {w['robot']}, episode {w['episode']}, step {w['step']}: "
+                    f"{1000 * abs(w['past']):.1f} mm {where} the edge)"
+                )
+            report.broken.append(f"{name} = {value:.4g} over the limit {limit:g}{detail}")
     if report.broken:
         raise PreflightError(
             f"pre-flight refused over {report.episodes} twin episodes: " + "; ".join(report.broken), report
@@ -128,9 +149,10 @@ def _geometry(env: ColcosParallelEnv) -> tuple[float, tuple[float, float]]:
     return radius, (float(size[0]), float(size[1]))
 
 
-def _past_edge(poses: np.ndarray, radius: float, arena: tuple[float, float]) -> bool:
+def _past_edge(poses: np.ndarray, radius: float, arena: tuple[float, float]) -> np.ndarray:
+    """How far each robot's body reaches past the arena's edge, m (negative: inside)."""
     x, y = poses[:, 0], poses[:, 1]
-    return bool(((x < radius) | (y < radius) | (x > arena[0] - radius) | (y > arena[1] - radius)).any())
+    return np.max(np.stack([radius - x, radius - y, x + radius - arena[0], y + radius - arena[1]]), axis=0)
 
 
 def _overlapping(poses: np.ndarray, radius: float, overlap: float) -> bool:
