@@ -118,6 +118,10 @@ impl Host {
         self.parts.fields.pheromones_mut()
     }
     /// Installs a field backend (`None`: the CPU).
+    /// Robot `i`'s deposit actions' fractions, as `World::deposit_actions`.
+    pub fn deposit_actions(&self, i: usize) -> &[f32] {
+        self.parts.injection.deposit_actions(i)
+    }
     /// Chooses how much robot `i` lays of each of its deposit actions from the next tick on, as
     /// `World::set_deposit_actions`: injected at its tracked pose like any trail.
     pub fn set_deposit_actions(&mut self, i: usize, fractions: impl IntoIterator<Item = f32>) {

@@ -80,6 +80,7 @@ impl Episode {
         rewards: &[f32],
         terminated: &[bool],
         max_cycles: u64,
+        end: StepEnd,
         out: AgentOut,
     ) -> bool {
         let evaluate = |r: &mut [f32], t: &mut [bool]| {
@@ -88,7 +89,7 @@ impl Episode {
                 *mine |= given;
             }
         };
-        self.finish_with(evaluate, max_cycles, StepEnd::Stepped, out)
+        self.finish_with(evaluate, max_cycles, end, out)
     }
 
     fn finish_with(

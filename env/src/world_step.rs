@@ -189,6 +189,7 @@ pub(crate) fn conclude_world(
                 &rewards[part.clone()],
                 &terminated[part],
                 ctx.max_cycles,
+                StepEnd::Stepped,
                 agent_out,
             )
         }

@@ -12,6 +12,7 @@ mod registry;
 mod spec;
 mod sweep;
 mod task_hooks;
+mod task_view;
 mod vec_env;
 mod window;
 

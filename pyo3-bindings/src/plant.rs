@@ -19,7 +19,7 @@ pub struct PyPlant {
     width: Option<usize>,
 }
 
-fn plant_err(e: PlantError) -> PyErr {
+pub(crate) fn plant_err(e: PlantError) -> PyErr {
     let msg = e.to_string();
     match e {
         PlantError::Env(e) => to_py(e),
@@ -67,7 +67,7 @@ fn twin_choice(
 
 impl PyPlant {
     /// The lock. Call only with the GIL released (inside `py.detach`).
-    fn lock(&self) -> MutexGuard<'_, LiveEnv> {
+    pub(crate) fn lock(&self) -> MutexGuard<'_, LiveEnv> {
         self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
 }

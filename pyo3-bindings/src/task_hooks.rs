@@ -1,24 +1,38 @@
-//! What a task written in Python (`colcos.Task`) needs of a `VecEnv`: the step in two halves (the
+//! What a task written in Python (`colcos.Task`) needs of a `VecEnv` or a plant: the step in two halves (the
 //! worlds move; then the hooks' rewards and terminations end it), the state of every world as numpy
 //! arrays, and the fields sampled at any points, each once per batched step over all worlds.
 //! Functions of the module rather than methods: the env's own class stays about stepping.
 use crate::args::guard;
 use crate::errors::{Kind, to_py};
+use crate::plant::{PyPlant, plant_err};
+use crate::task_view::{Counters, View};
 use crate::vec_env::{Owned, PyVecEnv, action_width, owned_actions};
-use colcos_env::Actions;
+use colcos_bridge::plant::LiveEnv;
 use colcos_env::encoding::OBS_DIM;
-use colcos_env::world_output::write_obs;
+use colcos_env::{Actions, VecEnv};
+use colcos_sim::scenario::Scenario;
+use colcos_sim::world::ArenaView;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-fn env_of<'a, 'py>(env: &'a Bound<'py, PyAny>) -> PyResult<&'a Bound<'py, PyVecEnv>> {
-    env.cast::<PyVecEnv>().map_err(|_| {
-        Kind::ArgumentType.err(format!(
-            "env must be a colcos._core.VecEnv, got {}",
-            crate::args::show(env)
-        ))
-    })
+/// A batch of worlds, or a plant's one arena.
+enum Core<'a> {
+    Batch(&'a PyVecEnv),
+    Plant(&'a PyPlant),
+}
+
+fn core_of<'a>(env: &'a Bound<'_, PyAny>) -> PyResult<Core<'a>> {
+    if let Ok(b) = env.cast::<PyVecEnv>() {
+        return Ok(Core::Batch(b.get()));
+    }
+    if let Ok(p) = env.cast::<PyPlant>() {
+        return Ok(Core::Plant(p.get()));
+    }
+    Err(Kind::ArgumentType.err(format!(
+        "env must be a colcos._core.VecEnv or Plant, got {}",
+        crate::args::show(env)
+    )))
 }
 
 /// The first half of a step: every world moves with `actions` and waits for `conclude`.
@@ -28,22 +42,38 @@ fn step_deferred(
     env: &Bound<'_, PyAny>,
     actions: &Bound<'_, PyAny>,
 ) -> PyResult<()> {
-    guard(|| {
-        let env = env_of(env)?.get();
-        let (e, n, width) = py.detach(|| {
-            let g = env.lock();
-            let s = g.env.spec();
-            (s.num_envs, s.num_agents, action_width(&s.action))
-        });
-        let acts = owned_actions(actions, e, n, width)?;
-        py.detach(|| {
-            let mut g = env.lock();
-            match &acts {
-                Owned::Discrete(a) => g.env.step_deferred(Actions::Discrete(a)),
-                Owned::Continuous(a) => g.env.step_deferred(Actions::Continuous(a)),
-            }
-        })
-        .map_err(to_py)
+    guard(|| match core_of(env)? {
+        Core::Batch(env) => {
+            let (e, n, width) = py.detach(|| {
+                let g = env.lock();
+                let s = g.env.spec();
+                (s.num_envs, s.num_agents, action_width(&s.action))
+            });
+            let acts = owned_actions(actions, e, n, width)?;
+            py.detach(|| {
+                let mut g = env.lock();
+                match &acts {
+                    Owned::Discrete(a) => g.env.step_deferred(Actions::Discrete(a)),
+                    Owned::Continuous(a) => g.env.step_deferred(Actions::Continuous(a)),
+                }
+            })
+            .map_err(to_py)
+        }
+        Core::Plant(plant) => {
+            let (n, width) = py.detach(|| {
+                let g = plant.lock();
+                (g.spec().num_agents, action_width(&g.spec().action))
+            });
+            let acts = owned_actions(actions, 1, n, width)?;
+            py.detach(|| {
+                let mut g = plant.lock();
+                match &acts {
+                    Owned::Discrete(a) => g.step_deferred(Actions::Discrete(a)),
+                    Owned::Continuous(a) => g.step_deferred(Actions::Continuous(a)),
+                }
+            })
+            .map_err(plant_err)
+        }
     })
 }
 
@@ -56,96 +86,29 @@ fn conclude(
     terminated: PyReadonlyArrayDyn<'_, bool>,
 ) -> PyResult<()> {
     guard(|| {
-        let env = env_of(env)?.get();
         let r: Vec<f32> = rewards.as_array().iter().copied().collect();
         let t: Vec<bool> = terminated.as_array().iter().copied().collect();
-        py.detach(|| env.lock().env.conclude(&r, &t)).map_err(to_py)
+        match core_of(env)? {
+            Core::Batch(env) => py.detach(|| env.lock().env.conclude(&r, &t)).map_err(to_py),
+            Core::Plant(p) => py.detach(|| p.lock().conclude(&r, &t)).map_err(plant_err),
+        }
     })
 }
 
 /// Every world's state now, as arrays: `poses`/`tracked` float32 `[E, R, 3]` (x m, y m, heading
-/// rad; true, and as the tracker last delivered them), `seen` bool `[E, R]`, `wheels` float32
-/// `[E, R, 2]` (the drives' wheel speeds, m/s), `commands` float32 `[E, R, 2]` (the last commands,
-/// m/s), `obs` float32 `[E, N, 17]` (the agents' sensor values now), `deposit_actions` float32
-/// `[E, N, D]`, `steps` (this episode's, the deferred step's
-/// included) and `episode` int64 `[E]`, `stepped` bool `[E]` (moved in the deferred step; false:
-/// only reset), `time` float32 `[E]`.
+/// rad: true, and as the tracker last delivered them; on a plant both are the tracked poses as
+/// used), `seen` bool `[E, R]`, `wheels` float32 `[E, R, 2]` (the drives' wheel speeds, m/s),
+/// `commands` float32 `[E, R, 2]` (the last commands, m/s), `obs` float32 `[E, N, 17]` (the
+/// agents' sensor values now), `deposit_actions` float32 `[E, N, D]`, `steps` (this episode's, the
+/// deferred step's included) and `episode` int64 `[E]`, `stepped` bool `[E]` (moved in the
+/// deferred step; false: only reset), `time` float32 `[E]`.
 #[pyfunction]
 fn task_view<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
-        let env = env_of(env)?.get();
-        struct View {
-            e: usize,
-            r: usize,
-            n: usize,
-            d: usize,
-            poses: Vec<f32>,
-            tracked: Vec<f32>,
-            seen: Vec<bool>,
-            wheels: Vec<f32>,
-            commands: Vec<f32>,
-            deposits: Vec<f32>,
-            obs: Vec<f32>,
-            steps: Vec<i64>,
-            stepped: Vec<bool>,
-            episode: Vec<i64>,
-            time: Vec<f32>,
-        }
-        let v = py.detach(|| {
-            let g = env.lock();
-            let s = g.env.spec();
-            let (e, r, n) = (s.num_envs, s.num_robots, s.num_agents);
-            let agents = s.agent_robots.clone();
-            let d = g.env.action_decoder().deposits();
-            let mut v = View {
-                e,
-                r,
-                n,
-                d,
-                poses: Vec::with_capacity(e * r * 3),
-                tracked: Vec::with_capacity(e * r * 3),
-                seen: Vec::with_capacity(e * r),
-                wheels: Vec::with_capacity(e * r * 2),
-                commands: Vec::with_capacity(e * r * 2),
-                deposits: Vec::with_capacity(e * n * d),
-                obs: vec![0.0; e * n * OBS_DIM],
-                steps: Vec::with_capacity(e),
-                stepped: Vec::with_capacity(e),
-                episode: Vec::with_capacity(e),
-                time: Vec::with_capacity(e),
-            };
-            let max_speed = g.env.scenario().spec.robot.max_wheel_speed;
-            for w in 0..e {
-                let Some(world) = g.env.world(w) else {
-                    continue;
-                };
-                // The observations of now (the outputs are written when the step is concluded).
-                let part = &mut v.obs[w * n * OBS_DIM..(w + 1) * n * OBS_DIM];
-                write_obs(world, &agents, max_speed, part);
-                for p in world.poses() {
-                    v.poses.extend([p.pos.x, p.pos.y, p.heading]);
-                }
-                for t in world.tracked() {
-                    v.tracked
-                        .extend([t.pose.pos.x, t.pose.pos.y, t.pose.heading]);
-                    v.seen.push(t.seen);
-                }
-                for slot in world.robots() {
-                    v.wheels.extend([slot.drive.left, slot.drive.right]);
-                    v.commands.extend([slot.command.left, slot.command.right]);
-                }
-                for &i in &agents {
-                    v.deposits.extend_from_slice(world.deposit_actions(i));
-                }
-                // Counting the step a deferred step's world has just taken.
-                let stepped = g.env.is_awaiting(w);
-                v.steps.push(g.env.episode_steps(w) as i64 + stepped as i64);
-                v.stepped.push(stepped);
-                v.episode.push(g.env.episode(w) as i64);
-                v.time.push(world.time());
-            }
-            v
-        });
+        let v = match core_of(env)? {
+            Core::Batch(env) => py.detach(|| batch_view(&env.lock().env)),
+            Core::Plant(p) => py.detach(|| plant_view(&p.lock())),
+        };
         let d = PyDict::new(py);
         let (e, r, n) = (v.e, v.r, v.n);
         d.set_item("poses", PyArray1::from_vec(py, v.poses).reshape([e, r, 3])?)?;
@@ -162,10 +125,8 @@ fn task_view<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'p
             "commands",
             PyArray1::from_vec(py, v.commands).reshape([e, r, 2])?,
         )?;
-        d.set_item(
-            "deposit_actions",
-            PyArray1::from_vec(py, v.deposits).reshape([e, n, v.d])?,
-        )?;
+        let deposits = PyArray1::from_vec(py, v.deposits).reshape([e, n, v.d])?;
+        d.set_item("deposit_actions", deposits)?;
         d.set_item(
             "obs",
             PyArray1::from_vec(py, v.obs).reshape([e, n, OBS_DIM])?,
@@ -178,31 +139,80 @@ fn task_view<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'p
     })
 }
 
+fn batch_view(env: &VecEnv) -> View {
+    let s = env.spec();
+    let agents = &s.agent_robots;
+    let max_speed = env.scenario().spec.robot.max_wheel_speed;
+    let d = env.action_decoder().deposits();
+    let mut v = View::new(s.num_envs, s.num_robots, s.num_agents, d);
+    for w in 0..s.num_envs {
+        let Some(world) = env.world(w) else {
+            continue;
+        };
+        let stepped = env.is_awaiting(w);
+        let c = Counters {
+            steps: env.episode_steps(w) + stepped as u64,
+            stepped,
+            episode: env.episode(w),
+            time: world.time(),
+        };
+        let deposits = |i| world.deposit_actions(i);
+        v.push(world, world.tracked(), agents, deposits, max_speed, c);
+    }
+    v
+}
+
+fn plant_view(env: &LiveEnv) -> View {
+    let s = env.spec();
+    let host = env.host();
+    let d = env.action_decoder().deposits();
+    let mut v = View::new(1, s.num_robots, s.num_agents, d);
+    let stepped = env.is_awaiting();
+    let c = Counters {
+        steps: env.episode_steps() + stepped as u64,
+        stepped: true,
+        episode: env.episode(),
+        time: host.time(),
+    };
+    let max_speed = env.scenario().spec.robot.max_wheel_speed;
+    let deposits = |i| host.deposit_actions(i);
+    v.push(
+        host,
+        host.tracked(),
+        &s.agent_robots,
+        deposits,
+        max_speed,
+        c,
+    );
+    v
+}
+
 /// What stays fixed: `arena` (w, h) m, `roles` [R], `pheromones` [F] names, `max_wheel_speed` and
 /// `wheel_base` m/s and m, `dt` s.
 #[pyfunction]
 fn task_info<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
-        let env = env_of(env)?.get();
-        let (arena, roles, names, speed, base, dt) = py.detach(|| {
-            let g = env.lock();
-            let sc = g.env.scenario();
-            let world = g.env.world(0);
+        let info = |sc: &Scenario, view: Option<&dyn ArenaView>| {
             let roles: Vec<String> = (0..sc.robot_count())
-                .map(|i| world.map_or(String::new(), |w| w.role(i).to_string()))
+                .map(|i| view.map_or(String::new(), |w| w.role(i).to_string()))
                 .collect();
             let names: Vec<String> = sc.spec.pheromones.iter().map(|p| p.name.clone()).collect();
             let a = sc.arena_size();
             let p = &sc.spec.robot;
-            (
-                (a.x, a.y),
-                roles,
-                names,
-                p.max_wheel_speed,
-                p.wheel_base,
-                sc.spec.dt,
-            )
-        });
+            let (speed, base, dt) = (p.max_wheel_speed, p.wheel_base, sc.spec.dt);
+            ((a.x, a.y), roles, names, speed, base, dt)
+        };
+        let (arena, roles, names, speed, base, dt) = match core_of(env)? {
+            Core::Batch(env) => py.detach(|| {
+                let g = env.lock();
+                let world = g.env.world(0).map(|w| w as &dyn ArenaView);
+                info(g.env.scenario(), world)
+            }),
+            Core::Plant(p) => py.detach(|| {
+                let g = p.lock();
+                info(g.scenario(), Some(g.host()))
+            }),
+        };
         let d = PyDict::new(py);
         d.set_item("arena", arena)?;
         d.set_item("roles", roles)?;
@@ -222,33 +232,49 @@ fn sample_fields<'py>(
     points: PyReadonlyArrayDyn<'py, f32>,
 ) -> PyResult<Bound<'py, PyAny>> {
     guard(|| {
-        let env = env_of(env)?.get();
         let shape = points.shape().to_vec();
         let pts: Vec<f32> = points.as_array().iter().copied().collect();
-        let (out, e, p, f) = py
-            .detach(|| {
+        let sample = |e: usize, field: &dyn Fn(usize) -> Option<Vec<f32>>| {
+            if shape.len() != 3 || shape[0] != e || shape[2] != 2 {
+                return Err(format!(
+                    "points must have shape ({e}, P, 2) = (num_envs, points, xy), got {shape:?}"
+                ));
+            }
+            let p = shape[1];
+            let mut out = Vec::new();
+            for w in 0..e {
+                out.extend(field(w).unwrap_or_default());
+            }
+            Ok((out, p))
+        };
+        let values = |phs: &[colcos_sim::field::Pheromone], w: usize, p: usize| -> Vec<f32> {
+            let xy = &pts[w * p * 2..(w + 1) * p * 2];
+            (xy.chunks_exact(2))
+                .flat_map(|q| {
+                    let at = colcos_sim::Vec2::new(q[0], q[1]);
+                    phs.iter().map(move |ph| ph.value_at(at))
+                })
+                .collect()
+        };
+        let p = shape.get(1).copied().unwrap_or(0);
+        let (out, e, f) = match core_of(env)? {
+            Core::Batch(env) => py.detach(|| {
                 let g = env.lock();
-                let e = g.env.spec().num_envs;
-                let f = g.env.scenario().spec.pheromones.len();
-                if shape.len() != 3 || shape[0] != e || shape[2] != 2 {
-                    return Err(format!(
-                        "points must have shape ({e}, P, 2) = (num_envs, points, xy), got {shape:?}"
-                    ));
-                }
-                let p = shape[1];
-                let mut out = Vec::with_capacity(e * p * f);
-                for w in 0..e {
-                    let Some(world) = g.env.world(w) else {
-                        continue;
-                    };
-                    for xy in pts[w * p * 2..(w + 1) * p * 2].chunks_exact(2) {
-                        let at = colcos_sim::Vec2::new(xy[0], xy[1]);
-                        out.extend(world.pheromones().iter().map(|ph| ph.value_at(at)));
-                    }
-                }
-                Ok((out, e, p, f))
-            })
-            .map_err(|m| Kind::Action.err(m))?;
+                let (e, f) = (
+                    g.env.spec().num_envs,
+                    g.env.scenario().spec.pheromones.len(),
+                );
+                let field = |w: usize| g.env.world(w).map(|x| values(x.pheromones(), w, p));
+                sample(e, &field).map(|(o, _)| (o, e, f))
+            }),
+            Core::Plant(pl) => py.detach(|| {
+                let g = pl.lock();
+                let f = g.scenario().spec.pheromones.len();
+                let field = |w: usize| Some(values(g.host().pheromones(), w, p));
+                sample(1, &field).map(|(o, _)| (o, 1, f))
+            }),
+        }
+        .map_err(|m| Kind::Action.err(m))?;
         Ok(PyArray1::from_vec(py, out).reshape([e, p, f])?.into_any())
     })
 }

@@ -10,6 +10,7 @@
 //! `step` is paced to the screen's 20 ms on the twin and the rig; `reset` drives the robots to the
 //! episode's start poses with a tracker-guided [`GoTo`], bounded in time, unless asked not to.
 mod calibration_gate;
+mod deferred;
 pub(crate) mod driver;
 mod goto;
 mod options;
@@ -72,6 +73,8 @@ pub struct LiveEnv {
     deposit_rates: Vec<f32>,
     episode: Episode,
     needs_reset: bool,
+    /// A deferred step (a task written in Python) waits for `conclude` with how it ended.
+    awaiting: Option<StepEnd>,
     obs: Vec<f32>,
     rewards: Vec<f32>,
     terminated: Vec<bool>,
@@ -130,6 +133,7 @@ impl LiveEnv {
             decoder,
             episode: Episode::new(0, n),
             needs_reset: true,
+            awaiting: None,
             obs: vec![0.0; n * OBS_DIM],
             rewards: vec![0.0; n],
             terminated: vec![false; n],
@@ -310,6 +314,8 @@ impl LiveEnv {
     /// twin and the rig the robots are first driven to the episode's start poses (if asked to).
     pub fn reset(&mut self, seed: Option<u64>) -> Result<(), PlantError> {
         self.refuse_closed()?;
+        // A deferred step not concluded is dropped with its episode.
+        self.awaiting = None;
         // Nothing is driven, and no observation is made, before every robot has been tracked.
         self.driver.await_poses()?;
         if let Some(s) = seed {
@@ -382,7 +388,19 @@ impl LiveEnv {
     /// then deposit rates) or discrete ones `[N]`, decoded as the simulated batch decodes them.
     /// Terminated agents are stopped and their actions ignored.
     pub fn step(&mut self, actions: Actions) -> Result<(), PlantError> {
+        let end = self.advance(actions)?;
+        self.finish(end, None);
+        Ok(())
+    }
+
+    /// The arena's part of a step: the actions decoded and sent, one tick.
+    fn advance(&mut self, actions: Actions) -> Result<StepEnd, PlantError> {
         self.refuse_closed()?;
+        if self.awaiting.is_some() {
+            return Err(PlantError::State(
+                "the last step awaits its rewards: call conclude() first".into(),
+            ));
+        }
         if self.needs_reset {
             return Err(PlantError::State("call reset() before step()".into()));
         }
@@ -409,22 +427,28 @@ impl LiveEnv {
             let lay = self.deposit_rates[k * d..(k + 1) * d].iter();
             host.set_deposit_actions(i, lay.map(|&f| if term { 0.0 } else { f }));
         }
-        let end = match self.driver.tick(&self.overrides)? {
+        Ok(match self.driver.tick(&self.overrides)? {
             false => StepEnd::Nothing,
             true if self.driver.remaining() == Some(0) => StepEnd::LastStep,
             true => StepEnd::Stepped,
+        })
+    }
+
+    /// The end of a step: the task's (or the `given`) rewards and terminations, the shield's
+    /// flags, the outputs.
+    fn finish(&mut self, end: StepEnd, given: Option<(&[f32], &[bool])>) {
+        let out = AgentOut {
+            rewards: &mut self.rewards,
+            terminated: &mut self.terminated,
+            truncated: &mut self.truncated,
         };
-        let done = self.episode.finish_step(
-            self.task.as_ref(),
-            self.driver.host(),
-            self.spec.max_cycles,
-            end,
-            AgentOut {
-                rewards: &mut self.rewards,
-                terminated: &mut self.terminated,
-                truncated: &mut self.truncated,
-            },
-        );
+        let max = self.spec.max_cycles;
+        let done = match given {
+            Some((r, t)) => self.episode.finish_given(r, t, max, end, out),
+            None => {
+                (self.episode).finish_step(self.task.as_ref(), self.driver.host(), max, end, out)
+            }
+        };
         let interventions = self.driver.interventions();
         for ((&i, &was), flags) in (self.task.agents().iter())
             .zip(&self.episode.was_terminated)
@@ -438,7 +462,6 @@ impl LiveEnv {
         }
         debug_assert_eq!(done, self.episode.done);
         self.write_outputs();
-        Ok(())
     }
 
     fn write_outputs(&mut self) {

@@ -38,7 +38,8 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
 
     Args:
         task: `"aggregation"`, `"foraging"` or `"trail"` (see `colcos.tasks()`), or a `colcos.Task`
-            written in Python (on `plant="sim"`; see `colcos.task`).
+            written in Python (on every plant; on the twin and the rig its view is of tracked poses;
+            see `colcos.task`).
         scenario: a scenario file (path) or scenario TOML text; default: the task's own.
         max_cycles: steps per episode before truncation (default 500; None: the scenario's
             duration / dt).
@@ -119,11 +120,6 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         )
         _checks.choice(render_mode, "render_mode", [None, "human", "rgb_array"])
         _checks.choice(plant, "plant", list(PLANTS))
-        if isinstance(task, Task) and plant != "sim":
-            raise TaskError(
-                f"a task written in Python runs on plant='sim' (got plant={plant!r}); the twin, the rig and "
-                "replays take the built-in tasks"
-            )
         native, scenario, params = (task, scenario, params) if isinstance(task, str) else core_task(task, scenario, params)
         kw = core_kwargs(native, scenario, max_cycles, continuous, global_state, patch, patch_side, params, backend, physics)
         self.plant = plant
@@ -152,7 +148,6 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self._index = {a: i for i, a in enumerate(self.possible_agents)}
         self._runner: TaskRunner | None = None
         if isinstance(task, Task):
-            assert isinstance(self._core, _core.VecEnv)
             self._runner = TaskRunner(task, self._core, spec, same_step=False)
         vector = make_space(spec["observation"])
         if self._runner is not None:

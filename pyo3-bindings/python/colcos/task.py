@@ -45,7 +45,7 @@ class View:
     names, `max_wheel_speed`, `wheel_base`, `dt`. `fields(points)` samples every pheromone.
     """
 
-    def __init__(self, core: _core.VecEnv, info: dict[str, Any], agent_robots: np.ndarray) -> None:
+    def __init__(self, core: _core.VecEnv | _core.Plant, info: dict[str, Any], agent_robots: np.ndarray) -> None:
         d = _core.task_view(core)
         self._core = core
         self.poses: np.ndarray = d["poses"]
@@ -133,7 +133,7 @@ class TaskRunner:
     """Runs a `Task`'s hooks around a native `VecEnv` of the `python` task: the step in two halves
     with the hooks between, the observations with the task's extra entries."""
 
-    def __init__(self, task: Task, core: _core.VecEnv, spec: dict[str, Any], same_step: bool) -> None:
+    def __init__(self, task: Task, core: _core.VecEnv | _core.Plant, spec: dict[str, Any], same_step: bool) -> None:
         self.task = task
         self.core = core
         self.same_step = same_step
@@ -152,6 +152,7 @@ class TaskRunner:
         self.shape = (e, n)
         self.native = core.views()
         self.obs = np.zeros((e, n, OBS_DIM + self.k), np.float32)
+        # Same-step autoreset's final observations (the batched env only).
         self.final_obs = np.zeros_like(self.obs)
         self.rng = np.random.default_rng(task.seed)
         self.last_info: dict[str, Any] | None = None
@@ -220,8 +221,8 @@ class TaskRunner:
             _core.conclude(self.core, np.ascontiguousarray(rewards), np.ascontiguousarray(terminated))
         except ActionError as e:
             raise TaskHookError(f"task {self.task.name!r}: {e}") from None
-        final = self.native["final_mask"]
-        if self.same_step and final.any():
+        final = self.native["final_mask"] if self.same_step else None
+        if final is not None and final.any():
             # Finished worlds were reset within the step: their last observation is the final one.
             self._write_obs(self.final_obs, self.native["final_obs"], extra)
             again = self.view()
