@@ -202,6 +202,17 @@ impl LiveSession {
             s.push("shutdown".into());
         }
     }
+    /// Marks in the rig log that episode `episode` starts with the next tick (a replay plays the
+    /// recorded episodes one by one).
+    pub fn mark_episode(&self, episode: u64) {
+        let marker = serde_json::json!({"kind": "episode", "episode": episode, "tick": self.report.ticks + 1});
+        record(self.log(), Topic::Events, marker.to_string().as_bytes());
+    }
+    /// Marks in the rig log that the episode under way ends with the last tick.
+    pub fn mark_episode_end(&self) {
+        let marker = serde_json::json!({"kind": "episode_end", "tick": self.report.ticks + 1});
+        record(self.log(), Topic::Events, marker.to_string().as_bytes());
+    }
     /// How long, in s, and why the robot link has failed on every tick; None while it works.
     pub fn link_problem(&self) -> Option<(f64, String)> {
         (self.link_failing.as_ref())

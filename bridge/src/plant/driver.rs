@@ -33,7 +33,11 @@ pub(crate) enum Driver {
     Replay {
         core: Box<LoopCore>,
         ticks: Vec<RecordedTick>,
+        /// The ticks of each recorded episode, `[first, end)`.
+        episodes: Vec<(usize, usize)>,
+        /// The next tick, and the end of the episode being replayed.
         next: usize,
+        end: usize,
     },
     /// Closed: the last tick's state, kept for reading; nothing can drive from here.
     Closed { core: Box<LoopCore> },
@@ -84,8 +88,14 @@ impl Driver {
                 }
             }
             Driver::Closed { .. } => Err(closed_error()),
-            Driver::Replay { core, ticks, next } => {
-                let Some(tick) = ticks.get(*next) else {
+            Driver::Replay {
+                core,
+                ticks,
+                next,
+                end,
+                ..
+            } => {
+                let Some(tick) = ticks.get(*next).filter(|_| next < end) else {
                     return Ok(false);
                 };
                 feed(core, tick, overrides);
@@ -95,26 +105,51 @@ impl Driver {
         }
     }
 
+    /// Marks in a live plant's rig log that the episode under way ends here (what follows, up to the
+    /// next episode, is a reset's go-to drive).
+    pub fn mark_end(&self) {
+        if let Driver::Live { session, .. } = self {
+            session.mark_episode_end();
+        }
+    }
+
     /// Ticks left in a replay (None: live).
     pub fn remaining(&self) -> Option<usize> {
         match self {
             Driver::Live { .. } | Driver::Closed { .. } => None,
-            Driver::Replay { ticks, next, .. } => Some(ticks.len().saturating_sub(*next)),
+            Driver::Replay { next, end, .. } => Some(end.saturating_sub(*next)),
         }
     }
 
     /// A new episode: fresh fields and behaviours (random streams of world index `index`) on the
-    /// same link and tracker; a replay starts again from its first tick.
-    pub fn restart(&mut self, scenario: &Scenario, index: u64) -> Result<(), PlantError> {
+    /// same link and tracker; a replay plays the log's recorded episode `episode` (counted from the
+    /// seed, as the live plant counted them; after the last, the first again).
+    pub fn restart(
+        &mut self,
+        scenario: &Scenario,
+        index: u64,
+        episode: u64,
+    ) -> Result<(), PlantError> {
         let mut core = LoopCore::with_index(scenario, LegacyDrive::default(), index)?;
         match self {
             Driver::Live { session, .. } => {
                 core.host_mut().adopt_tracking(session.core().host());
                 session.replace_core(core);
+                session.mark_episode(episode);
             }
-            Driver::Replay { core: c, next, .. } => {
+            Driver::Replay {
+                core: c,
+                episodes,
+                next,
+                end,
+                ..
+            } => {
+                // The recorded episodes in turn, from the first again after the last.
+                let Some(&range) = episodes.get(episode as usize % episodes.len().max(1)) else {
+                    return Err(PlantError::State("the rig log holds no episode".into()));
+                };
                 **c = core;
-                *next = 0;
+                (*next, *end) = range;
             }
             Driver::Closed { .. } => return Err(closed_error()),
         }
@@ -197,6 +232,45 @@ impl Driver {
                 .map_or(0.0, |t| t.t),
         }
     }
+}
+
+/// The ticks of each episode a plant recorded (`[first, end)`, from its `episode` and
+/// `episode_end` events: a reset's go-to drive lies between two episodes), or, in a log without
+/// them, one episode from the first tick with poses to the end.
+pub(crate) fn episode_ranges(
+    log: &[crate::recorder::Recorded],
+    ticks: &[RecordedTick],
+) -> Vec<(usize, usize)> {
+    let at = |tick: u64| {
+        ticks
+            .iter()
+            .position(|t| t.tick >= tick)
+            .unwrap_or(ticks.len())
+    };
+    let events: Vec<(bool, usize)> = (log.iter())
+        .filter(|m| m.topic == crate::recorder::Topic::Events)
+        .filter_map(|m| serde_json::from_slice::<serde_json::Value>(&m.data).ok())
+        .filter_map(|v| {
+            let start = match v["kind"].as_str()? {
+                "episode" => true,
+                "episode_end" => false,
+                _ => return None,
+            };
+            Some((start, at(v["tick"].as_u64()?)))
+        })
+        .collect();
+    let mut ranges = Vec::new();
+    for (k, &(start, first)) in events.iter().enumerate() {
+        if start {
+            let end = events[k + 1..].first().map_or(ticks.len(), |&(_, e)| e);
+            ranges.push((first, end));
+        }
+    }
+    if ranges.is_empty() {
+        let first = ticks.iter().position(|t| !t.poses.is_empty()).unwrap_or(0);
+        ranges.push((first, ticks.len()));
+    }
+    ranges
 }
 
 /// A digital twin on loopback, ticking on its own thread until dropped.

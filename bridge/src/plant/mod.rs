@@ -155,11 +155,15 @@ impl LiveEnv {
             let bytes = std::fs::read(path)
                 .map_err(|e| PlantError::option("replay", format!("{}: {e}", path.display())))?;
             refuse_another_scenario(&bytes, path, scenario)?;
-            let ticks = replay::read_ticks(&bytes, scenario.robot_count())?;
+            let log = crate::recorder::read_log(&bytes);
+            let ticks = replay::ticks_of(&log, scenario.robot_count())?;
+            let episodes = driver::episode_ranges(&log, &ticks);
             return Ok(Driver::Replay {
                 core: Box::new(LoopCore::new(scenario, LegacyDrive::default())?),
                 ticks,
+                episodes,
                 next: 0,
+                end: 0,
             });
         }
         let local =
@@ -327,11 +331,14 @@ impl LiveEnv {
             self.episode.index + 1
         };
         let index = colcos_env::world_index(0, episode);
+        if !self.needs_reset {
+            self.driver.mark_end();
+        }
         if let Some((goto, timeout)) = self.goto {
             let targets = WorldParts::build(&self.scenario, index)?.poses;
             self.goto_report = self.drive_to(&goto, &targets, timeout)?;
         }
-        self.driver.restart(&self.scenario, index)?;
+        self.driver.restart(&self.scenario, index, episode)?;
         self.task.on_reset(self.driver.host_mut().pheromones_mut());
         // One tick with the agents still, so that their observations are of this episode.
         self.overrides.fill(None);
