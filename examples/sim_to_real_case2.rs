@@ -167,7 +167,7 @@ fn on_twin(label: &str, host: &Scenario, twin: &Scenario) -> Curve {
     c
 }
 
-static FONT: &[u8] = include_bytes!("../src/experiment/assets/DejaVuSans-subset.ttf");
+use colcos_sim::output::draw::FONT;
 
 /// The S(t) curves (label, points) in one chart.
 fn plot(curves: &[(String, Vec<(f64, f64)>)], title: &str, path: &std::path::Path) {

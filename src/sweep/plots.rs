@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::{Path, PathBuf};
 
-static FONT: &[u8] = include_bytes!("../experiment/assets/DejaVuSans-subset.ttf");
+use colcos_sim::output::draw::FONT;
 
 fn ensure_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();

@@ -8,9 +8,10 @@ use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
 use glam::Vec2;
 use image::{Rgb, RgbImage};
 
-/// DejaVu Sans (Bitstream Vera licence with public-domain DejaVu changes) cut down to printable ASCII,
-/// compiled in so that legends need no system font.
-static FONT: &[u8] = include_bytes!("DejaVuSans-subset.ttf");
+/// DejaVu Sans (https://dejavu-fonts.github.io/, Bitstream Vera licence with public-domain DejaVu
+/// changes) cut down to printable ASCII and a few symbols with `pyftsubset`, compiled in so that
+/// legends and plots need no system font. The one copy: the experiment's and the sweep's plots use it.
+pub static FONT: &[u8] = include_bytes!("DejaVuSans-subset.ttf");
 
 /// Colours of robot groups 0, 1, 2, ... (then again): light and saturated, so that they read over
 /// black and over the red, green and blue of the pheromones, and differ from each other.
