@@ -1,6 +1,7 @@
-"""Reset options and render sizes as documented: a misspelt option key of the vector env is refused by
-name instead of being ignored (PettingZoo envs take any, as PettingZoo's API test expects), and
-`render(width=)` gives an image of that width."""
+"""Reset options, render sizes, patches and the native buffers as documented: a misspelt option key of
+the vector env is refused by name instead of being ignored (PettingZoo envs take any, as PettingZoo's
+API test expects), `render(width=)` gives an image of that width, patches reach the Gymnasium vector
+env, and the native buffers are read-only."""
 
 from __future__ import annotations
 
@@ -34,3 +35,11 @@ def test_patches_reach_the_gymnasium_vector_env():
     assert infos["patch"].shape == (2 * 3, 8, 8, 3) and infos["patch"].dtype == np.uint8
     _, _, _, _, infos = env.step(env.action_space.sample())
     assert infos["patch"].shape == (6, 8, 8, 3)
+
+
+def test_the_native_buffers_are_read_only():
+    v = colcos.vector.VecEnv("aggregation", num_envs=2)
+    v.reset(seed=0)
+    for a in (v.obs, v.rewards, v.terminated, v.truncated):
+        with pytest.raises(ValueError, match="read-only"):
+            a[...] = 0

@@ -182,3 +182,11 @@ class BackendInfo:
     def backend_info(self) -> str:
         """One line on the field backend: `gpu: <adapter>` or `cpu (<why>)`."""
         return self._core.backend_info
+
+
+def readonly_views(views: dict[str, Any]) -> dict[str, Any]:
+    """The native output buffers as read-only arrays: the core rewrites them at every step, and a
+    write from Python would be lost (or read back as the env's own output) without a word."""
+    for a in views.values():
+        a.flags.writeable = False
+    return views

@@ -20,6 +20,7 @@ from colcos._options import (
     core_kwargs,
     log_backend,
     make_space,
+    readonly_views,
     share_signature,
     twin_kwargs,
 )
@@ -170,7 +171,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self._width = int(np.prod(spec["action"]["shape"])) if self._continuous else 0
         if spec["state"] is not None:
             self.state_space = make_space(spec["state"])
-        self._views = self._core.views()
+        self._views = readonly_views(self._core.views())
         n = len(self.possible_agents)
         self._actions = np.zeros((1, n, self._width), np.float32) if self._continuous else np.zeros((1, n), np.int64)
         self._needs_reset = True

@@ -25,6 +25,7 @@ import numpy as np
 
 from colcos import _core
 from colcos._core import ActionError, TaskError
+from colcos._options import readonly_views
 
 OBS_DIM = 17
 
@@ -150,7 +151,7 @@ class TaskRunner:
         self.agent_robots = np.asarray(spec["agent_robots"], dtype=np.int64)
         e, n = int(spec["num_envs"]), int(spec["num_agents"])
         self.shape = (e, n)
-        self.native = core.views()
+        self.native = readonly_views(core.views())
         self.obs = np.zeros((e, n, OBS_DIM + self.k), np.float32)
         # Same-step autoreset's final observations (the batched env only).
         self.final_obs = np.zeros_like(self.obs)

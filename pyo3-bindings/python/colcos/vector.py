@@ -23,7 +23,15 @@ from gymnasium import spaces
 
 from colcos import _checks, _core
 from colcos._core import ActionError, ActionTypeError
-from colcos._options import BackendInfo, HumanWindow, core_kwargs, log_backend, make_box, make_space
+from colcos._options import (
+    BackendInfo,
+    HumanWindow,
+    core_kwargs,
+    log_backend,
+    make_box,
+    make_space,
+    readonly_views,
+)
 from colcos.task import Task, TaskRunner, core_task
 
 __all__ = ["VecEnv"]
@@ -98,7 +106,7 @@ class VecEnv(BackendInfo):
         self.single_action_space: spaces.Space = make_space(self.spec["action"])
         self.state_space: spaces.Box | None = make_box(self.spec["state"]) if self.spec["state"] else None
         self.patch_space: spaces.Box | None = make_box(self.spec["patch"]) if self.spec["patch"] else None
-        v = self._core.views()
+        v = readonly_views(self._core.views())
         self.obs: np.ndarray = v["obs"]
         self.rewards: np.ndarray = v["rewards"]
         self.terminated: np.ndarray = v["terminated"]
