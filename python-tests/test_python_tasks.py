@@ -66,6 +66,9 @@ class Probe(colcos.Task):
 
     def reward(self, view: colcos.View) -> np.ndarray:
         self.calls += 1
+        # The fields sampled in Rust at every agent's position: (E, N, F), finite.
+        levels = view.fields(view.agents(view.poses)[..., :2])
+        assert levels.shape == (*view.obs.shape[:2], len(view.pheromones)) and np.isfinite(levels).all()
         return np.ones(view.obs.shape[:2], np.float32) * view.steps[:, None]
 
     def terminated(self, view: colcos.View) -> np.ndarray:

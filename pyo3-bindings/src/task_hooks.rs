@@ -10,6 +10,7 @@ use crate::vec_env::{Owned, PyVecEnv, action_width, owned_actions};
 use colcos_bridge::plant::LiveEnv;
 use colcos_env::encoding::OBS_DIM;
 use colcos_env::{Actions, VecEnv};
+use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
@@ -234,47 +235,35 @@ fn sample_fields<'py>(
     guard(|| {
         let shape = points.shape().to_vec();
         let pts: Vec<f32> = points.as_array().iter().copied().collect();
-        let sample = |e: usize, field: &dyn Fn(usize) -> Option<Vec<f32>>| {
+        // Every pheromone's value at each world's points: (values, worlds, points, pheromones).
+        let sample = |worlds: &[&[Pheromone]]| {
+            let e = worlds.len();
             if shape.len() != 3 || shape[0] != e || shape[2] != 2 {
                 return Err(format!(
                     "points must have shape ({e}, P, 2) = (num_envs, points, xy), got {shape:?}"
                 ));
             }
-            let p = shape[1];
-            let mut out = Vec::new();
-            for w in 0..e {
-                out.extend(field(w).unwrap_or_default());
-            }
-            Ok((out, p))
-        };
-        let values = |phs: &[colcos_sim::field::Pheromone], w: usize, p: usize| -> Vec<f32> {
-            let xy = &pts[w * p * 2..(w + 1) * p * 2];
-            (xy.chunks_exact(2))
-                .flat_map(|q| {
+            let (p, f) = (shape[1], worlds.first().map_or(0, |w| w.len()));
+            let mut out = Vec::with_capacity(e * p * f);
+            for (phs, xy) in worlds.iter().zip(pts.chunks_exact(2 * p.max(1))) {
+                for q in xy.chunks_exact(2) {
                     let at = colcos_sim::Vec2::new(q[0], q[1]);
-                    phs.iter().map(move |ph| ph.value_at(at))
-                })
-                .collect()
+                    out.extend(phs.iter().map(|ph| ph.value_at(at)));
+                }
+            }
+            Ok((out, e, p, f))
         };
-        let p = shape.get(1).copied().unwrap_or(0);
-        let (out, e, f) = match core_of(env)? {
+        let sampled = match core_of(env)? {
             Core::Batch(env) => py.detach(|| {
                 let g = env.lock();
-                let (e, f) = (
-                    g.env.spec().num_envs,
-                    g.env.scenario().spec.pheromones.len(),
-                );
-                let field = |w: usize| g.env.world(w).map(|x| values(x.pheromones(), w, p));
-                sample(e, &field).map(|(o, _)| (o, e, f))
+                let worlds: Vec<&[Pheromone]> = (0..g.env.spec().num_envs)
+                    .filter_map(|w| g.env.world(w).map(|x| x.pheromones()))
+                    .collect();
+                sample(&worlds)
             }),
-            Core::Plant(pl) => py.detach(|| {
-                let g = pl.lock();
-                let f = g.scenario().spec.pheromones.len();
-                let field = |w: usize| Some(values(g.host().pheromones(), w, p));
-                sample(1, &field).map(|(o, _)| (o, 1, f))
-            }),
-        }
-        .map_err(|m| Kind::Action.err(m))?;
+            Core::Plant(pl) => py.detach(|| sample(&[pl.lock().host().pheromones()])),
+        };
+        let (out, e, p, f) = sampled.map_err(|m| Kind::Action.err(m))?;
         Ok(PyArray1::from_vec(py, out).reshape([e, p, f])?.into_any())
     })
 }
