@@ -118,8 +118,11 @@ fn init_logging() {
 
 fn real_main() -> Result<()> {
     let mut out = String::new();
-    run_command(Cli::parse().command, &mut out)?;
-    print_report(&out)
+    let result = run_command(Cli::parse().command, &mut out);
+    // What a refused or failed command measured before it stopped (pre-flight counts, a bridge's
+    // summary) is printed too, then the error.
+    print_report(&out)?;
+    result
 }
 
 fn run_command(command: Command, text: &mut String) -> Result<()> {

@@ -2,7 +2,7 @@
 //! before they drive the real robots.
 use anyhow::{Result, bail};
 use clap::{Args, Subcommand};
-use colcos_bridge::preflight::{self, PreflightLimits};
+use colcos_plant::preflight::{self, PreflightLimits};
 use colcos_sim::scenario::Scenario;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -31,9 +31,14 @@ pub struct CheckArgs {
     /// Largest fraction of robot-ticks whose wheel speeds the shield may cap.
     #[arg(long, default_value_t = 0.05)]
     pub max_capped: f64,
-    /// Largest number of ticks with a robot past the arena's edge.
+    /// Largest number of ticks with a robot's body past the arena's edge by more than
+    /// --edge-tolerance.
     #[arg(long, default_value_t = 0)]
     pub max_boundary: u64,
+    /// How far a body may reach past the edge before the tick counts, m [default: the tracker's
+    /// noise: 3 mm or five standard deviations of `[tracker] position_noise`, whichever is larger].
+    #[arg(long)]
+    pub edge_tolerance: Option<f32>,
     /// Largest fraction of ticks with two robots overlapping by more than 5 mm.
     #[arg(long, default_value_t = 0.02)]
     pub max_collisions: f64,
@@ -57,11 +62,17 @@ pub fn run(command: RigCommand, text: &mut String) -> Result<()> {
             bail!("{name} {v}: must be a fraction in [0, 1]");
         }
     }
+    if let Some(t) = args.edge_tolerance
+        && !(t.is_finite() && (0.0..=0.05).contains(&t))
+    {
+        bail!("--edge-tolerance {t}: must be in [0, 0.05] m");
+    }
     let sc = Scenario::from_file(&args.scenario)?;
     let limits = PreflightLimits {
         walled: args.max_walled,
         capped: args.max_capped,
         boundary: args.max_boundary,
+        edge_tolerance: args.edge_tolerance,
         collisions: args.max_collisions,
         overruns: args.max_overruns,
     };

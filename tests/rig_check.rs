@@ -33,3 +33,25 @@ fn wall_seeking_behaviours_are_refused_and_case_two_passes() {
     let (ok, text) = rig_check(std::path::Path::new(case2));
     assert!(ok && text.contains("pre-flight passed"), "{text}");
 }
+
+/// Every scenario shipped under `scenarios/` may drive a rig: its behaviours pass the pre-flight (a
+/// short episode each; `colcos rig check` with its defaults runs three of 20 s).
+#[test]
+fn every_shipped_scenario_passes_the_pre_flight() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+    let mut failed = Vec::new();
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    paths.sort();
+    assert!(paths.len() >= 10, "{paths:?}");
+    for path in paths {
+        let (ok, text) = rig_check(&path);
+        if !ok {
+            failed.push(format!("{}: {text}", path.display()));
+        }
+    }
+    assert!(failed.is_empty(), "{failed:#?}");
+}

@@ -15,8 +15,6 @@ pub mod host;
 pub mod link;
 pub mod live;
 pub mod onboard;
-pub mod plant;
-pub mod preflight;
 pub mod recorder;
 pub mod source;
 pub mod swarmcon;

@@ -435,3 +435,27 @@ fn a_robot_that_stops_answering_is_reported() {
         "{events:?}"
     );
 }
+
+/// A robot that never answers at all (switched off, wrong radio address) is reported as silent too,
+/// about a second after it was first asked.
+#[test]
+fn a_robot_that_never_answers_is_reported() {
+    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
+    let url = format!("udp://{}", channel.local_addr().unwrap());
+    // The last robot is asked last: deaf before the loop's first request reaches it.
+    let rig = run_rig(Box::new(channel), url, 2.5, |_, robots| {
+        robots.lock().unwrap().deaf = vec![5];
+    });
+    let _twin = rig.twin.join().unwrap();
+    assert_eq!(rig.report.silent_robots, vec![5], "{:?}", rig.report);
+    let events: Vec<String> = rig
+        .log
+        .iter()
+        .filter(|m| m.topic == Topic::Events)
+        .map(|m| String::from_utf8_lossy(&m.data).to_string())
+        .collect();
+    assert!(
+        events.iter().any(|e| e.contains("never answered")),
+        "{events:?}"
+    );
+}

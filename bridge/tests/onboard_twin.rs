@@ -480,17 +480,3 @@ fn a_robots_calibration_on_board_recovers_the_screen() {
     assert!(worst_own < 2e-4, "{worst_own}");
     assert!(worst_nominal > 0.03, "{worst_nominal}");
 }
-
-/// The shield cannot steer a policy on board, only stop it: robots driving at a wall are held at the
-/// virtual wall (and stay held, since their policy's last choice would still cross it), never reach the
-/// arena's edge, and the pre-flight check refuses the policy naming the limit.
-#[test]
-fn the_shield_holds_robots_on_board_at_the_virtual_wall() {
-    let sc = scenario_at(&fixture(), 1.3);
-    let limits = colcos_bridge::preflight::PreflightLimits::default();
-    let _turn = one_at_a_time();
-    let r = colcos_bridge::preflight::check(&sc, 1, 3.0, &limits).unwrap();
-    assert_eq!(r.boundary, 0, "{r:?}");
-    assert!(r.walled as f64 > 0.3 * r.robot_ticks as f64, "{r:?}");
-    assert!(r.broken.iter().any(|b| b.starts_with("walled")), "{r:?}");
-}

@@ -147,9 +147,13 @@ impl VecEnv {
             max_cycles,
             dt: scenario.spec.dt,
         };
-        let shield = cfg
-            .shield
-            .then(|| Shield::new(scenario.spec.rig.shield, scenario.arena_size()));
+        let shield = cfg.shield.then(|| {
+            Shield::new(
+                scenario.spec.rig.shield,
+                scenario.arena_size(),
+                scenario.spec.robot.max_wheel_speed,
+            )
+        });
         let slots = pool.install(|| {
             (0..e)
                 .into_par_iter()

@@ -4,8 +4,8 @@
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
 use crate::vec_env::{AgentBuffers, Owned, Ptrs, action_width, agent_views, owned_actions};
-use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions, TwinScenario};
 use colcos_env::Actions;
+use colcos_plant::{LiveEnv, PlantError, PlantKind, PlantOptions, TwinScenario};
 use colcos_sim::scenario::Scenario;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;

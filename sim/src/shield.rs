@@ -31,7 +31,8 @@ impl Default for ShieldParams {
 /// What the shield changed in one command.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Intervention {
-    /// A wheel speed was above the cap.
+    /// The cap lowered a wheel speed below what the robot itself would have driven (a command beyond
+    /// the robot's own `max_wheel_speed` is clamped by the robot anyway: that is no intervention).
     pub capped: bool,
     /// The command would have crossed a virtual wall.
     pub walled: bool,
@@ -61,12 +62,17 @@ impl ShieldCounts {
 pub struct Shield {
     pub params: ShieldParams,
     arena: Vec2,
+    robot_max_wheel_speed: f32,
 }
 
 impl Shield {
-    /// A shield for an arena of `arena` m.
-    pub fn new(params: ShieldParams, arena: Vec2) -> Shield {
-        Shield { params, arena }
+    /// A shield for an arena of `arena` m and robots whose wheels reach `robot_max_wheel_speed` m/s.
+    pub fn new(params: ShieldParams, arena: Vec2, robot_max_wheel_speed: f32) -> Shield {
+        Shield {
+            params,
+            arena,
+            robot_max_wheel_speed: robot_max_wheel_speed.abs(),
+        }
     }
 
     /// The command a robot at `pose` may take in place of `cmd` (a non-finite command is a stop).
@@ -77,7 +83,9 @@ impl Shield {
         }
         let cap = self.params.max_wheel_speed.max(0.0);
         let (left, right) = (cmd.left.clamp(-cap, cap), cmd.right.clamp(-cap, cap));
-        out.capped = left != cmd.left || right != cmd.right;
+        let robot = self.robot_max_wheel_speed;
+        out.capped =
+            left != cmd.left.clamp(-robot, robot) || right != cmd.right.clamp(-robot, robot);
         let forward = 0.5 * (left + right);
         let ahead = pose.pos + Vec2::from_angle(pose.heading) * forward * self.params.horizon;
         let m = self.params.margin.max(0.0);
@@ -107,7 +115,7 @@ mod tests {
     use super::*;
 
     fn shield() -> Shield {
-        Shield::new(ShieldParams::default(), Vec2::new(1.0, 0.5))
+        Shield::new(ShieldParams::default(), Vec2::new(1.0, 0.5), 0.5)
     }
 
     #[test]
@@ -136,6 +144,21 @@ mod tests {
         );
         assert_eq!(c, WheelCommand::STOP);
         assert!(!i.any());
+    }
+
+    #[test]
+    fn a_cap_at_the_robots_own_top_speed_is_no_intervention() {
+        let s = Shield::new(ShieldParams::default(), Vec2::new(1.0, 0.5), 0.35);
+        let fast = WheelCommand {
+            left: 1.0,
+            right: -1.0,
+        };
+        let (c, i) = s.apply(&Pose::new(0.5, 0.25, 0.0), fast);
+        assert_eq!(c, WheelCommand::new(0.35, -0.35));
+        assert!(!i.capped);
+        // A robot that could drive faster than the cap is held back: that counts.
+        let s = Shield::new(ShieldParams::default(), Vec2::new(1.0, 0.5), 0.4);
+        assert!(s.apply(&Pose::new(0.5, 0.25, 0.0), fast).1.capped);
     }
 
     #[test]

@@ -66,6 +66,8 @@ pub struct LoopCore {
     next_telemetry: f64,
     telemetry_robot: usize,
     answered: Vec<Option<f64>>,
+    /// When each robot was first asked for data: one that never answers is silent too.
+    first_asked: Vec<Option<f64>>,
     silent: Vec<bool>,
     counters: CoreCounters,
     // The last tick's outputs, reused.
@@ -108,7 +110,11 @@ impl LoopCore {
             f64::INFINITY
         };
         Ok(LoopCore {
-            shield: Shield::new(rig.shield, scenario.arena_size()),
+            shield: Shield::new(
+                rig.shield,
+                scenario.arena_size(),
+                scenario.spec.robot.max_wheel_speed,
+            ),
             radio,
             tracker_ids: (0..n).map(|i| rig.tracker_id(i)).collect(),
             firmware: rig.firmware,
@@ -122,6 +128,7 @@ impl LoopCore {
             next_telemetry: 0.0,
             telemetry_robot: 0,
             answered: vec![None; n],
+            first_asked: vec![None; n],
             silent: vec![false; n],
             counters: CoreCounters::default(),
             fresh: Vec::with_capacity(n),
@@ -222,21 +229,30 @@ impl LoopCore {
                 }
             }
         }
-        // A robot that has answered before and not for `answer_timeout`: its radio is gone, so it can
-        // no longer be stopped from here (its firmware's timeout must); said once, and its readings
-        // are no longer trusted.
+        // A robot that has not answered for `answer_timeout` (since its last answer, or since it was
+        // first asked): its radio is gone, so it can no longer be stopped from here (its firmware's
+        // timeout must); said once, and its readings are no longer trusted.
         for i in 0..self.radio.len() {
-            if let Some(at) = self.answered[i]
+            let since = self.answered[i].or(self.first_asked[i]);
+            if let Some(at) = since
                 && !self.silent[i]
                 && t - at > self.answer_timeout
             {
                 self.silent[i] = true;
                 self.counters.silent_robots.push(self.radio[i]);
-                let detail = format!(
-                    "radio {} has not answered for {:.2} s",
-                    self.radio[i],
-                    t - at
-                );
+                let detail = if self.answered[i].is_some() {
+                    format!(
+                        "radio {} has not answered for {:.2} s",
+                        self.radio[i],
+                        t - at
+                    )
+                } else {
+                    format!(
+                        "radio {} has never answered ({:.2} s since asked)",
+                        self.radio[i],
+                        t - at
+                    )
+                };
                 self.events.push(
                     serde_json::json!({"kind": "robot_silent", "robot": i, "detail": detail})
                         .to_string(),
@@ -300,7 +316,9 @@ impl LoopCore {
         }
         self.host.drive(&self.sent, step as f32);
         if t >= self.next_telemetry && !self.radio.is_empty() {
-            let robot = self.radio[self.telemetry_robot % self.radio.len()];
+            let k = self.telemetry_robot % self.radio.len();
+            self.first_asked[k].get_or_insert(t);
+            let robot = self.radio[k];
             self.packets.push(CommandPacket::new(
                 robot,
                 stamp,

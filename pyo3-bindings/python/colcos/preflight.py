@@ -46,8 +46,10 @@ class PreflightLimits:
     overruns: float = 0.02
     """Loop ticks that ended after their 20 ms slot."""
     overlap: float = 0.005
-    edge_tolerance: float = 0.003
-    """How far past the edge a tracked body may seem to be without counting (the tracker's noise)."""
+    edge_tolerance: float | None = None
+    """How far past the edge a tracked body may seem to be without counting, m; `None`: the tracker's
+    noise, 3 mm or five standard deviations of `[tracker] position_noise`, whichever is larger (a
+    robot pushed against the wall shows a few millimetres past it in that noise)."""
 
 
 @dataclass
@@ -91,7 +93,8 @@ def preflight(
     for episode in range(episodes):
         env = ColcosParallelEnv(task=task, max_cycles=max_cycles, **env_kwargs)
         with env:
-            radius, arena = _geometry(env)
+            radius, arena, noise = _geometry(env)
+            tolerance = limits.edge_tolerance if limits.edge_tolerance is not None else max(0.003, 5.0 * noise)
             obs, _ = env.reset(seed=episode)
             total = 0.0
             while env.agents:
@@ -105,7 +108,7 @@ def preflight(
                 poses = env.poses()
                 past = _past_edge(poses, radius, arena)
                 worst = int(np.argmax(past))
-                if past[worst] > limits.edge_tolerance:
+                if past[worst] > tolerance:
                     report.boundary += 1
                 if report.worst_boundary is None or past[worst] > report.worst_boundary["past"]:
                     report.worst_boundary = dict(
@@ -142,11 +145,13 @@ def preflight(
     return report
 
 
-def _geometry(env: ColcosParallelEnv) -> tuple[float, tuple[float, float]]:
+def _geometry(env: ColcosParallelEnv) -> tuple[float, tuple[float, float], float]:
+    """Robot radius, arena size and the tracker's position noise (m) of the env's scenario."""
     scenario = tomllib.loads(env._core.scenario_toml())
     radius = float(scenario.get("robot", {}).get("radius", 0.02))
     size = scenario["screen"]["size"]
-    return radius, (float(size[0]), float(size[1]))
+    noise = float(scenario.get("tracker", {}).get("position_noise", 0.001))
+    return radius, (float(size[0]), float(size[1])), noise
 
 
 def _past_edge(poses: np.ndarray, radius: float, arena: tuple[float, float]) -> np.ndarray:

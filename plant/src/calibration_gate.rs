@@ -1,6 +1,6 @@
 //! The rig plant's gate: real robots are driven only with a current, precise screen calibration.
-use super::{PlantError, PlantOptions};
-use crate::calibrate::RigCalibration;
+use crate::{PlantError, PlantOptions};
+use colcos_bridge::calibrate::RigCalibration;
 
 /// The rig plant drives real robots only with a screen calibration younger than
 /// `calibration_max_age` whose error is under `calibration_max_error_mm`.

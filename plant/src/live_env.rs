@@ -1,31 +1,13 @@
-//! Plants for the RL environments: the same task, spaces, outputs and safety shield as one world of the
-//! simulated batch (`colcos_env::VecEnv`), with the arena a real rig, the digital twin, or a recorded
-//! rig run. A policy written against one runs unchanged on the others.
-//!
-//! - `twin`: the digital twin over loopback (started in this process when no addresses are given);
-//! - `rig`: the lab's tracker and robots, by URL;
-//! - `replay`: a rig log (`rig.mcap`) fed tick by tick: the recorded poses, telemetry and tick times,
-//!   with the policy's commands in place of the recorded behaviours' (nothing moves in response).
-//!
-//! `step` is paced to the screen's 20 ms on the twin and the rig; `reset` drives the robots to the
-//! episode's start poses with a tracker-guided [`GoTo`], bounded in time, unless asked not to.
-mod calibration_gate;
-mod deferred;
-pub(crate) mod driver;
-mod goto;
-mod options;
-mod twin_scenario;
-
-pub use goto::GoTo;
-pub use options::{PlantError, PlantKind, PlantOptions};
-pub use twin_scenario::TwinScenario;
-
-use crate::calibrate::RigCalibration;
-use crate::colias::LegacyDrive;
-use crate::frames::FrameServer;
-use crate::host::Host;
-use crate::live::{LiveOptions, LiveSession, LoopCore, replay};
-use crate::{SourceOptions, open_pose_source, open_robot_link};
+//! [`LiveEnv`]: one arena of a plant as an RL environment, with the buffers of one world of `VecEnv`.
+use crate::calibration_gate;
+use crate::driver::{self, Driver, TwinThread};
+use crate::{GoTo, PlantError, PlantKind, PlantOptions};
+use colcos_bridge::calibrate::RigCalibration;
+use colcos_bridge::colias::LegacyDrive;
+use colcos_bridge::frames::FrameServer;
+use colcos_bridge::host::Host;
+use colcos_bridge::live::{LiveOptions, LiveSession, LoopCore, replay};
+use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_env::encoding::OBS_DIM;
 use colcos_env::task::registry;
 use colcos_env::world_output::{render_world, write_obs, write_patch, write_state};
@@ -37,7 +19,6 @@ use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::{Scenario, SensorSource};
 use colcos_sim::world::WorldParts;
-use driver::{Driver, TwinThread};
 use std::time::Instant;
 
 /// The frames the host streams to a twin started here whose robots read their own sensors: wide
@@ -57,7 +38,7 @@ pub struct GoToReport {
 /// One arena of a plant as an RL environment: the buffers of one world of `VecEnv` (`[1, N, ...]`),
 /// allocated once and overwritten by every `reset` and `step`.
 pub struct LiveEnv {
-    spec: EnvSpec,
+    pub(crate) spec: EnvSpec,
     task: Box<dyn Task>,
     scenario: Scenario,
     kind: PlantKind,
@@ -67,14 +48,14 @@ pub struct LiveEnv {
     patch: Option<colcos_env::PatchConfig>,
     max_speed: f32,
     overrides: Vec<Option<WheelCommand>>,
-    decoder: ActionDecoder,
+    pub(crate) decoder: ActionDecoder,
     /// Scratch: the agents' decoded commands and deposit rates.
     commands: Vec<WheelCommand>,
     deposit_rates: Vec<f32>,
     episode: Episode,
     needs_reset: bool,
     /// A deferred step (a task written in Python) waits for `conclude` with how it ended.
-    awaiting: Option<StepEnd>,
+    pub(crate) awaiting: Option<StepEnd>,
     obs: Vec<f32>,
     rewards: Vec<f32>,
     terminated: Vec<bool>,
@@ -83,7 +64,7 @@ pub struct LiveEnv {
     patch_buf: Vec<u8>,
     shield: Vec<u8>,
     /// The live loop's report as it was when the plant was closed.
-    closed: Option<Option<crate::live::LiveReport>>,
+    closed: Option<Option<colcos_bridge::live::LiveReport>>,
 }
 
 impl LiveEnv {
@@ -155,7 +136,7 @@ impl LiveEnv {
             let bytes = std::fs::read(path)
                 .map_err(|e| PlantError::option("replay", format!("{}: {e}", path.display())))?;
             refuse_another_scenario(&bytes, path, scenario)?;
-            let log = crate::recorder::read_log(&bytes);
+            let log = colcos_bridge::recorder::read_log(&bytes);
             let ticks = replay::ticks_of(&log, scenario.robot_count())?;
             let episodes = driver::episode_ranges(&log, &ticks);
             return Ok(Driver::Replay {
@@ -401,7 +382,7 @@ impl LiveEnv {
     }
 
     /// The arena's part of a step: the actions decoded and sent, one tick.
-    fn advance(&mut self, actions: Actions) -> Result<StepEnd, PlantError> {
+    pub(crate) fn advance(&mut self, actions: Actions) -> Result<StepEnd, PlantError> {
         self.refuse_closed()?;
         if self.awaiting.is_some() {
             return Err(PlantError::State(
@@ -443,7 +424,7 @@ impl LiveEnv {
 
     /// The end of a step: the task's (or the `given`) rewards and terminations, the shield's
     /// flags, the outputs.
-    fn finish(&mut self, end: StepEnd, given: Option<(&[f32], &[bool])>) {
+    pub(crate) fn finish(&mut self, end: StepEnd, given: Option<(&[f32], &[bool])>) {
         let out = AgentOut {
             rewards: &mut self.rewards,
             terminated: &mut self.terminated,
@@ -524,7 +505,7 @@ impl LiveEnv {
 
     /// The live loop's measurements so far (ticks, overruns, shield, stops, `shutdown` for each
     /// stop on closing or asked for); None for a replay.
-    pub fn live_report(&self) -> Option<crate::live::LiveReport> {
+    pub fn live_report(&self) -> Option<colcos_bridge::live::LiveReport> {
         if let Some(r) = &self.closed {
             return r.clone();
         }
@@ -557,7 +538,7 @@ fn refuse_another_scenario(
     path: &std::path::Path,
     scenario: &Scenario,
 ) -> Result<(), PlantError> {
-    let rig = crate::recorder::read_metadata(bytes)
+    let rig = colcos_bridge::recorder::read_metadata(bytes)
         .into_iter()
         .find(|(name, _)| name == "rig");
     let Some((_, meta)) = rig else {

@@ -1,7 +1,7 @@
 //! A plant's safety edges: once closed it never drives again, and a tracker that cannot be reached is
 //! named (its URL and the reason) within seconds instead of an episode of made-up poses.
-use colcos_bridge::plant::{LiveEnv, PlantError, PlantKind, PlantOptions};
 use colcos_env::{Actions, EnvConfig};
+use colcos_plant::{LiveEnv, PlantError, PlantKind, PlantOptions};
 use std::time::Instant;
 
 fn config() -> EnvConfig {

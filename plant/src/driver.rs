@@ -1,13 +1,13 @@
 //! What moves a plant's arena: a live loop against a rig or a twin (paced by the real clock), or a
 //! recorded rig run fed tick by tick; and the twin a `plant="twin"` starts in this process when it is
 //! given no addresses.
-use super::PlantError;
-use crate::colias::LegacyDrive;
-use crate::host::Host;
-use crate::live::replay::{RecordedTick, feed};
-use crate::live::{LiveSession, LoopCore};
-use crate::swarmcon::HeaderForm;
-use crate::twin::{TrackerServer, Twin, UdpChannel};
+use crate::PlantError;
+use colcos_bridge::colias::LegacyDrive;
+use colcos_bridge::host::Host;
+use colcos_bridge::live::replay::{RecordedTick, feed};
+use colcos_bridge::live::{LiveSession, LoopCore};
+use colcos_bridge::swarmcon::HeaderForm;
+use colcos_bridge::twin::{TrackerServer, Twin, UdpChannel};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::shield::Intervention;
@@ -238,7 +238,7 @@ impl Driver {
 /// `episode_end` events: a reset's go-to drive lies between two episodes), or, in a log without
 /// them, one episode from the first tick with poses to the end.
 pub(crate) fn episode_ranges(
-    log: &[crate::recorder::Recorded],
+    log: &[colcos_bridge::recorder::Recorded],
     ticks: &[RecordedTick],
 ) -> Vec<(usize, usize)> {
     let at = |tick: u64| {
@@ -248,7 +248,7 @@ pub(crate) fn episode_ranges(
             .unwrap_or(ticks.len())
     };
     let events: Vec<(bool, usize)> = (log.iter())
-        .filter(|m| m.topic == crate::recorder::Topic::Events)
+        .filter(|m| m.topic == colcos_bridge::recorder::Topic::Events)
         .filter_map(|m| serde_json::from_slice::<serde_json::Value>(&m.data).ok())
         .filter_map(|v| {
             let start = match v["kind"].as_str()? {

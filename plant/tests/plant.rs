@@ -1,8 +1,8 @@
 //! The RL plants over loopback: the digital twin started in-process and a recorded run replayed, with
 //! the spaces and outputs of the simulated environment, and the shield keeping a policy that drives at
 //! the walls inside the arena.
-use colcos_bridge::plant::{LiveEnv, PlantKind, PlantOptions, TwinScenario};
 use colcos_env::{Actions, EnvConfig, VecEnv};
+use colcos_plant::{LiveEnv, PlantKind, PlantOptions, TwinScenario};
 use colcos_sim::world::ArenaView;
 
 /// The twins of these tests run in real time, and one of them measures a latency in ticks: one test

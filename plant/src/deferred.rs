@@ -1,7 +1,7 @@
 //! A plant's step in two halves, for a task written in Python (`colcos.Task`): the arena moves and
 //! waits; the task's hooks run on its state (tracked poses on the twin and the rig); `conclude`
 //! hands out their rewards and terminations through the same episode bookkeeping as a plain step.
-use super::{LiveEnv, PlantError};
+use crate::{LiveEnv, PlantError};
 use colcos_env::{Actions, EnvError};
 
 impl LiveEnv {

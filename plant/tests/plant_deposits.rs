@@ -1,7 +1,7 @@
 //! Pheromone actions on the twin: what the agents choose to lay is laid by the host at their tracked
 //! poses, into the field it shows (and streams to the twin's robots), and nothing when they choose 0.
-use colcos_bridge::plant::{LiveEnv, PlantKind, PlantOptions};
 use colcos_env::{Actions, EnvConfig, ScenarioSource};
+use colcos_plant::{LiveEnv, PlantKind, PlantOptions};
 use colcos_sim::field::FieldModel;
 
 const TRAIL: &str = include_str!("../../env/scenarios/trail.toml");

@@ -1,8 +1,8 @@
 //! A replay plant plays the recorded episodes one by one: each `reset` starts the next episode at
 //! the tick the live plant started it (after its go-to drive), and runs as many steps as were taken;
 //! after the last, the first again.
-use colcos_bridge::plant::{LiveEnv, PlantKind, PlantOptions};
 use colcos_env::{Actions, EnvConfig};
+use colcos_plant::{LiveEnv, PlantKind, PlantOptions};
 
 #[test]
 fn a_replay_plays_the_recorded_episodes_not_the_whole_log() {

@@ -1,6 +1,6 @@
 //! What a plant is asked for ([`PlantKind`], [`PlantOptions`]) and what can go wrong ([`PlantError`]).
-use super::TwinScenario;
-use crate::live::replay;
+use crate::TwinScenario;
+use colcos_bridge::live::replay;
 use colcos_env::EnvError;
 use std::path::PathBuf;
 
@@ -73,9 +73,9 @@ pub enum PlantError {
     #[error(transparent)]
     Sim(#[from] colcos_sim::error::SimError),
     #[error("tracker: {0}")]
-    Source(#[from] crate::SourceError),
+    Source(#[from] colcos_bridge::SourceError),
     #[error("robot link: {0}")]
-    Link(#[from] crate::LinkError),
+    Link(#[from] colcos_bridge::LinkError),
     #[error(transparent)]
     Replay(#[from] replay::ReplayError),
     #[error("{0}")]

@@ -3,11 +3,11 @@
 //! may drive the real robots. Refused, with every limit broken named, when the shield had to turn or
 //! cap commands too often, a robot reached the arena's edge, robots ran into each other, or the loop
 //! overran its ticks. `colcos.preflight` does the same for a Python policy.
-use crate::calibrate::RigCalibration;
-use crate::live::{LiveOptions, LiveSession};
-use crate::plant::PlantError;
-use crate::plant::driver::TwinThread;
-use crate::{SourceOptions, open_pose_source, open_robot_link};
+use crate::PlantError;
+use crate::driver::TwinThread;
+use colcos_bridge::calibrate::RigCalibration;
+use colcos_bridge::live::{LiveOptions, LiveSession};
+use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
 use std::time::Instant;
@@ -19,8 +19,13 @@ pub struct PreflightLimits {
     pub walled: f64,
     /// Robot-ticks whose wheel speeds the shield capped, fraction.
     pub capped: f64,
-    /// Ticks with a robot's body past the arena's edge (tracked poses), count.
+    /// Ticks with a robot's body past the arena's edge by more than `edge_tolerance` (tracked
+    /// poses), count.
     pub boundary: u64,
+    /// How far a body may reach past the edge before it counts, m; `None`: 3 mm or five standard
+    /// deviations of the tracker's position noise, whichever is larger (a robot pushed against the
+    /// wall shows a few millimetres past it in that noise).
+    pub edge_tolerance: Option<f32>,
     /// Ticks with two robots overlapping by more than 5 mm (tracked poses), fraction.
     pub collisions: f64,
     /// Ticks that overran their slot, fraction.
@@ -33,6 +38,7 @@ impl Default for PreflightLimits {
             walled: 0.05,
             capped: 0.05,
             boundary: 0,
+            edge_tolerance: None,
             collisions: 0.02,
             overruns: 0.02,
         }
@@ -50,8 +56,20 @@ pub struct PreflightReport {
     pub collisions: u64,
     pub overruns: u64,
     pub stops: Vec<String>,
+    /// The farthest any body reached past the edge, if one did.
+    pub worst_boundary: Option<PastEdge>,
     /// Each limit broken, with its value.
     pub broken: Vec<String>,
+}
+
+/// Where a body reached farthest past the arena's edge.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct PastEdge {
+    pub robot: usize,
+    pub episode: usize,
+    pub tick: u64,
+    /// How far the body reached past the edge, m.
+    pub past: f32,
 }
 
 /// Runs `episodes` episodes of `seconds` s (seeds `seed, seed + 1, ...`) and checks `limits`.
@@ -64,6 +82,9 @@ pub fn check(
     let mut r = PreflightReport::default();
     let radius = scenario.spec.robot.radius;
     let arena = scenario.arena_size();
+    let tolerance = limits
+        .edge_tolerance
+        .unwrap_or_else(|| (5.0 * scenario.spec.tracker.position_noise).max(0.003));
     for k in 0..episodes {
         let mut sc = scenario.clone();
         sc.spec.seed = scenario.spec.seed.wrapping_add(k as u64);
@@ -77,14 +98,16 @@ pub fn check(
         let link = open_robot_link(&twin.robots_url)?;
         let mut session = LiveSession::new(&sc, source, link, None, LiveOptions::default())?;
         let start = Instant::now();
+        let mut tick = 0u64;
         while start.elapsed().as_secs_f64() < seconds {
             session.tick(&[])?;
             let core = session.core();
             let host = core.host();
-            let seen: Vec<_> = (host.tracked().iter())
+            let seen: Vec<(usize, glam::Vec2)> = (host.tracked().iter())
                 .zip(ArenaView::poses(host))
-                .filter(|(t, _)| t.seen)
-                .map(|(_, p)| p.pos)
+                .enumerate()
+                .filter(|(_, (t, _))| t.seen)
+                .map(|(i, (_, p))| (i, p.pos))
                 .collect();
             r.ticks += 1;
             r.robot_ticks += seen.len() as u64;
@@ -92,17 +115,30 @@ pub fn check(
                 r.walled += i.walled as u64;
                 r.capped += i.capped as u64;
             }
-            let past = |p: &glam::Vec2| {
-                p.x < radius || p.y < radius || p.x > arena.x - radius || p.y > arena.y - radius
-            };
-            r.boundary += seen.iter().any(past) as u64;
-            let touching = seen.iter().enumerate().any(|(i, a)| {
+            // How far the body reaches past the nearest edge (negative: inside).
+            let past = |p: glam::Vec2| radius - p.min(arena - p).min_element();
+            let mut beyond = false;
+            for &(robot, p) in &seen {
+                let d = past(p);
+                beyond |= d > tolerance;
+                if d > 0.0 && r.worst_boundary.is_none_or(|w| d > w.past) {
+                    r.worst_boundary = Some(PastEdge {
+                        robot,
+                        episode: k,
+                        tick,
+                        past: d,
+                    });
+                }
+            }
+            r.boundary += beyond as u64;
+            let touching = seen.iter().enumerate().any(|(i, (_, a))| {
                 seen[..i]
                     .iter()
-                    .any(|b| a.distance(*b) < 2.0 * radius - 0.005)
+                    .any(|(_, b)| a.distance(*b) < 2.0 * radius - 0.005)
             });
             r.collisions += touching as u64;
             session.wait_next();
+            tick += 1;
         }
         let report = session.report();
         r.overruns += report.overruns;
@@ -121,8 +157,17 @@ pub fn check(
     ];
     for (name, value, limit) in checks {
         if value > limit {
-            r.broken
-                .push(format!("{name} = {value:.4} over the limit {limit}"));
+            let mut text = format!("{name} = {value:.4} over the limit {limit}");
+            if let ("boundary", Some(w)) = (name, r.worst_boundary) {
+                text.push_str(&format!(
+                    " (farthest: robot {} in episode {} at tick {}, {:.1} mm past the edge)",
+                    w.robot,
+                    w.episode,
+                    w.tick,
+                    w.past * 1e3
+                ));
+            }
+            r.broken.push(text);
         }
     }
     Ok(r)

@@ -1,7 +1,7 @@
 //! The scenario the in-process twin plays when it differs from the host's: the twin holds the "true"
 //! values (tracker latency, sensor gain and crosstalk, robot body) that the host only assumes, as a
 //! real rig would. Only values that leave the two sides talking about the same arena may differ.
-use super::PlantError;
+use crate::PlantError;
 use colcos_sim::scenario::Scenario;
 
 /// What the twin plays instead of the host's scenario.
