@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import importlib.metadata as md
 import re
-import tomllib
 from pathlib import Path
 
 import colcos
@@ -16,12 +15,13 @@ REPO = Path(__file__).resolve().parents[1]
 
 def test_one_version():
     # Written once, as the crate's version: the native module, the package and its metadata agree.
-    with open(REPO / "pyo3-bindings" / "Cargo.toml", "rb") as f:
-        crate = tomllib.load(f)["package"]["version"]
-    assert colcos.__version__ == _core.__version__ == md.version("colcos") == crate
-    with open(REPO / "pyo3-bindings" / "pyproject.toml", "rb") as f:
-        project = tomllib.load(f)["project"]
-    assert "version" not in project and project["dynamic"] == ["version"]
+    # Read with patterns rather than tomllib, which Python 3.10 (the oldest the wheel serves) lacks.
+    cargo = (REPO / "pyo3-bindings" / "Cargo.toml").read_text()
+    crate = re.search(r'^\[package\][^\[]*?^version = "([^"]+)"', cargo, re.M | re.S)
+    assert crate is not None
+    assert colcos.__version__ == _core.__version__ == md.version("colcos") == crate.group(1)
+    project = (REPO / "pyo3-bindings" / "pyproject.toml").read_text().split("[project]", 1)[1].split("\n[", 1)[0]
+    assert 'dynamic = ["version"]' in project and not re.search(r"^version\s*=", project, re.M)
 
 
 def test_metadata_complete():
