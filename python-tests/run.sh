@@ -8,9 +8,13 @@
 # PyPI's torch without its CUDA libraries, made loadable by torch_cpu_stubs.py (see requirements.txt).
 # The first run builds the wheel from a cold cargo target and fills both venvs (tens of minutes on
 # two cores, ~760 MB downloaded, ~2.4 GB on disk); a rerun reuses the venvs and the cargo target.
+# The wheel is the one users install: abi3 (CPython >= 3.10), its manylinux tag checked by maturin's
+# compliance check; it is installed and tested with every cargo and rustc dropped from PATH, as on a
+# machine without Rust. The sdist is built too and checked to hold what a build from it needs.
 # Usage: python-tests/run.sh [pytest args]       (from anywhere; uses python3 from PATH)
 # Env: COLCOS_PY_WORK (default: <repo>/target/python) holds the venvs, wheel and cargo target dir.
 #      COLCOS_PY_PEERS=0 runs only the core suites in a small venv (requirements-core.txt, ~1 min).
+#      COLCOS_WHEEL_COMPAT (default manylinux_2_35): the wheel's platform tag (maturin --compatibility).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 repo="$(cd "$here/.." && pwd)"
@@ -22,15 +26,36 @@ t0=$(stamp)
 t=$t0
 lap() { local now; now=$(stamp); echo "   $1 in $((now - t)) s"; t=$now; }
 
-echo "== building the colcos wheel (pip wheel ./pyo3-bindings)"
+compat="${COLCOS_WHEEL_COMPAT:-manylinux_2_35}"
+echo "== building the colcos wheel (pip wheel ./pyo3-bindings, maturin --compatibility $compat)"
 [ -x "$work/build-venv/bin/python" ] || "$py" -m venv "$work/build-venv"
 "$work/build-venv/bin/pip" install -q --upgrade pip "maturin==1.16.0"
-rm -rf "$work/wheels"
+rm -rf "$work/wheels" "$work/sdist"
 # The bindings build shares the workspace target dir: the sim crates it depends on are then built once
 # for both (crates built with other features sit beside each other; nothing is rebuilt back and forth).
-(cd "$repo" && CARGO_TARGET_DIR="${COLCOS_PY_CARGO_TARGET:-$repo/target}" "$work/build-venv/bin/pip" wheel ./pyo3-bindings --no-deps -w "$work/wheels")
+# --compatibility makes maturin check the library against that manylinux policy (glibc symbol
+# versions, linked libraries) and tag the wheel with it; the lowest policy a build passes depends on
+# the building machine's glibc (docs/python.md, "Install").
+(cd "$repo" && CARGO_TARGET_DIR="${COLCOS_PY_CARGO_TARGET:-$repo/target}" MATURIN_PEP517_ARGS="--compatibility $compat" \
+    "$work/build-venv/bin/pip" wheel ./pyo3-bindings --no-deps -w "$work/wheels")
 wheel="$(ls "$work/wheels"/colcos-*.whl)"
-lap "wheel built ($wheel)"
+case "$(basename "$wheel")" in
+    colcos-*-cp310-abi3-"$compat"_*.whl) ;;
+    *) echo "error: $wheel is not the cp310-abi3-$compat wheel (pyo3's abi3-py310 feature, maturin --compatibility)"; exit 1 ;;
+esac
+lap "wheel built ($wheel, $(du -h "$wheel" | cut -f1))"
+"$work/build-venv/bin/maturin" sdist -m "$repo/pyo3-bindings/Cargo.toml" -o "$work/sdist"
+"$work/build-venv/bin/python" "$here/check_sdist.py" "$work/sdist"/colcos-*.tar.gz
+lap "sdist built and checked"
+
+# Every PATH entry holding cargo or rustc is dropped where the wheel is installed and tested, and
+# rustup's and cargo's variables are unset: the package must not need Rust once built.
+norust_path=""
+IFS=: read -r -a path_dirs <<<"$PATH"
+for d in "${path_dirs[@]}"; do
+    [ -e "$d/cargo" ] || [ -e "$d/rustc" ] || norust_path="${norust_path:+$norust_path:}$d"
+done
+no_rust() { env -u CARGO_HOME -u RUSTUP_HOME -u RUSTUP_TOOLCHAIN -u CARGO_TARGET_DIR PATH="$norust_path" "$@"; }
 
 make_venv() { # name requirements [pip install options]
     local v="$work/$1" req="$2"
@@ -40,7 +65,8 @@ make_venv() { # name requirements [pip install options]
     # --no-compile: byte-compiling every module of torch and ray up front costs minutes on 2 cores;
     # Python compiles (and caches) the modules the tests import when they first run.
     "$v/bin/pip" install -q --no-compile "$@" -r "$req"
-    "$v/bin/pip" install -q --no-compile --force-reinstall --no-deps "$wheel"
+    no_rust "$v/bin/pip" install -q --no-compile --force-reinstall --no-deps "$wheel"
+    no_rust "$v/bin/python" -c 'import shutil, sys; found = {t: shutil.which(t) for t in ("cargo", "rustc") if shutil.which(t)}; sys.exit(f"error: Rust is still on PATH: {found}" if found else 0)'
 }
 
 # A --no-deps lock that misses a dependency fails here rather than in a test. torch's CUDA requirements
@@ -58,14 +84,15 @@ check_venv() { # name
 cd "$here"
 status=0
 if [ "${COLCOS_PY_PEERS:-1}" = 0 ]; then
-    echo "== core venv (PettingZoo, errors, vector env, determinism; without COLCOS_PY_PEERS=0 also the peer libraries)"
+    echo "== core venv (PettingZoo, errors, vector env, determinism, ids, package; without COLCOS_PY_PEERS=0 also the peer libraries)"
     make_venv venv-core "$here/requirements-core.txt" --no-deps --only-binary=:all:
     check_venv venv-core
     lap "installed"
-    "$work/venv-core/bin/python" -m pytest -q -p no:cacheprovider \
+    no_rust "$work/venv-core/bin/python" -m pytest -q -p no:cacheprovider \
         test_pettingzoo.py test_errors.py test_misuse.py test_misuse_adapters.py test_hypothesis.py \
         test_vector.py test_determinism.py test_backend.py test_render_human.py test_behaviours.py \
-        test_sweep.py test_plants.py test_preflight.py test_tutorial.py test_obstacles.py test_physics.py "$@" || status=1
+        test_sweep.py test_plants.py test_preflight.py test_tutorial.py test_obstacles.py test_physics.py \
+        test_env_ids.py test_package.py "$@" || status=1
     lap "core suites"
     echo "== python part done in $(($(stamp) - t0)) s (status $status)"
     exit $status
@@ -85,10 +112,10 @@ check_venv venv-rllib
 lap "installed ($(du -sh "$work/venv-rllib" | cut -f1))"
 
 echo "== pytest (main venv)"
-"$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --durations=5 --ignore=test_rllib.py --ignore=test_sweep_ray.py --ignore=test_tune_example.py "$@" || status=1
+no_rust "$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --durations=5 --ignore=test_rllib.py --ignore=test_sweep_ray.py --ignore=test_tune_example.py "$@" || status=1
 lap "main suites"
 echo "== pytest (rllib venv)"
-"$work/venv-rllib/bin/python" -m pytest -q -p no:cacheprovider test_rllib.py test_sweep_ray.py test_tune_example.py "$@" || status=1
+no_rust "$work/venv-rllib/bin/python" -m pytest -q -p no:cacheprovider test_rllib.py test_sweep_ray.py test_tune_example.py "$@" || status=1
 lap "rllib suite"
 echo "== python part done in $(($(stamp) - t0)) s (status $status)"
 exit $status

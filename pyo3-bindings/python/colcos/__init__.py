@@ -14,6 +14,10 @@ wheel speeds.
 | `foraging`    | foragers (2)          | Box((17,)) f32  | same                            |
 | `trail`       | trail robots (4)      | Box((17,)) f32  | same                            |
 
+Versioned by task, as PettingZoo's and Gymnasium's environments are: `from colcos.tasks import
+aggregation_v0; aggregation_v0.parallel_env()`, `gymnasium.make_vec("colcos/aggregation-v0", num_envs=64)`
+(see `colcos.tasks`).
+
 Observation bounds per entry: colour intensities and bumpers in [0, 1], the last wheel command in
 [-1, 1]. Every error raised is a `colcos.ColcosError` (see docs/python.md, "Errors").
 """
@@ -21,8 +25,10 @@ Observation bounds per entry: colour intensities and bumpers in [0, 1], the last
 from __future__ import annotations
 
 # `colcos.vector` and `colcos.gymnasium_vector` come with `import colcos` (they need only numpy and
-# gymnasium); the SB3 and TorchRL adapters import their libraries and stay opt-in.
-from colcos import _core, gymnasium_vector, sweep, vector
+# gymnasium); the SB3 and TorchRL adapters import their libraries and stay opt-in. `colcos.tasks()`
+# lists the tasks, `colcos.tasks.aggregation_v0` etc. make them, and importing `colcos.tasks`
+# registers the Gymnasium ids `colcos/<task>-v<version>`.
+from colcos import _core, gymnasium_vector, sweep, tasks, vector
 from colcos import preflight as preflight  # noqa: E402  (after pettingzoo_env, which it imports)
 from colcos._core import (
     ActionError,
@@ -78,11 +84,6 @@ __all__ = [
     "tasks",
     "vector",
 ]
-
-
-def tasks() -> dict[str, str]:
-    """Every task: name -> one-line description."""
-    return dict(_core.tasks())
 
 
 def behaviours() -> dict[str, str]:

@@ -187,10 +187,12 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
     def __getstate__(self) -> dict[str, Any]:
         # Pickling (SuperSuit, multiprocessing) rebuilds the env from its arguments: a fresh copy that
         # needs a reset, as after construction.
-        return {"init_kwargs": self._init_kwargs}
+        # An instance's own metadata (the versioned modules of `colcos.tasks` name theirs) goes too.
+        return {"init_kwargs": self._init_kwargs, "metadata": self.metadata}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         ColcosParallelEnv.__init__(self, **state["init_kwargs"])
+        self.metadata = state.get("metadata", self.metadata)
 
     def observation_space(self, agent: str) -> spaces.Space:
         if agent not in self.observation_spaces:

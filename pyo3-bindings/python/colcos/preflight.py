@@ -10,12 +10,18 @@ loop overran its ticks.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
-import tomllib
+
+# tomllib is Python >= 3.11's; on 3.10 the package depends on tomli, the same parser.
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
 
 from colcos import _core
 from colcos.pettingzoo_env import ColcosParallelEnv
