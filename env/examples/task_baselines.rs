@@ -1,5 +1,6 @@
 //! The hand-written policies of `colony`, `coverage` and `alarm` against uniform random actions, on
-//! the same seeded episodes: the table of docs/tasks.md ("Baselines").
+//! the same seeded episodes, and each policy with its deposit rates forced to 0 (what its
+//! pheromone is worth to it): the table of docs/tasks.md ("Baselines").
 //!
 //!     cargo run --release -p colcos-env --example task_baselines -- [worlds] [seeds]
 //!
@@ -10,8 +11,17 @@ use colcos_env::baseline::BaselinePolicy;
 use colcos_env::{Actions, EnvConfig, VecEnv, policy};
 use rand::{RngExt, SeedableRng, rngs::SmallRng};
 
+/// Who acts.
+#[derive(Clone, Copy, PartialEq)]
+enum Who {
+    Hand,
+    /// The hand-written policy, laying nothing.
+    Silent,
+    Random,
+}
+
 /// Mean episode return per agent of every world's first episode after `reset(seed)`.
-fn returns(task: &str, worlds: usize, seed: u64, hand: bool) -> Vec<f64> {
+fn returns(task: &str, worlds: usize, seed: u64, who: Who) -> Vec<f64> {
     let mut cfg = EnvConfig::new(task);
     cfg.num_envs = worlds;
     cfg.seed = seed;
@@ -28,8 +38,13 @@ fn returns(task: &str, worlds: usize, seed: u64, hand: bool) -> Vec<f64> {
     let mut a = vec![0.0f32; worlds * n * width];
     let mut total = vec![0.0f64; worlds];
     for _ in 0..steps {
-        if hand {
+        if who != Who::Random {
             baseline.act(&env, &mut a).unwrap();
+            if who == Who::Silent {
+                (a.iter_mut().enumerate())
+                    .filter(|(j, _)| j % width >= 2)
+                    .for_each(|(_, v)| *v = 0.0);
+            }
         } else {
             for (j, v) in a.iter_mut().enumerate() {
                 *v = if j % width < 2 {
@@ -59,16 +74,17 @@ fn main() {
     println!("| task | policy | return (mean ± sd) | episodes |");
     println!("| --- | --- | --- | --- |");
     for task in ["colony", "coverage", "alarm"] {
-        for hand in [true, false] {
+        for who in [Who::Hand, Who::Silent, Who::Random] {
             let all: Vec<f64> = (0..seeds as u64)
-                .flat_map(|s| returns(task, worlds, s, hand))
+                .flat_map(|s| returns(task, worlds, s, who))
                 .collect();
             let mean = all.iter().sum::<f64>() / all.len() as f64;
             let var = all.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / all.len() as f64;
-            let who = if hand {
-                policy::for_task(task).unwrap()
-            } else {
-                "random"
+            let name = policy::for_task(task).unwrap();
+            let who = match who {
+                Who::Hand => name.to_string(),
+                Who::Silent => format!("{name}, rates forced to 0"),
+                Who::Random => "random".into(),
             };
             println!(
                 "| `{task}` | {who} | {mean:.2} ± {:.2} | {} |",
