@@ -19,7 +19,8 @@ wheel speeds.
 
 Observation bounds per entry: colour intensities and bumpers in [0, 1], the last wheel command in
 [-1, 1]; `colony` appends a carrying flag and `alarm` a predator-near flag, each in [0, 1]. The
-last three tasks' agents also choose how much pheromone to lay (docs/tasks.md). Every error raised is a `colcos.ColcosError` (see docs/python.md, "Errors").
+last three tasks' agents also choose how much pheromone to lay (docs/tasks.md). Every error raised
+is a `colcos.ColcosError` (see docs/python.md, "Errors").
 """
 
 from __future__ import annotations
