@@ -46,3 +46,16 @@ def test_spaces_and_baseline(task):
     with pytest.raises(colcos.ColcosError, match="takes no parameters"):
         Baseline(venv, name, speed=0.1)
     RandomPolicy(venv).act()
+
+
+def test_colony_on_the_twin_has_the_carrying_entry():
+    """The plants write the task's extra entry too: a twin's observations fill the simulator's space."""
+    sim = colcos.parallel_env(task="colony", max_cycles=40)
+    with colcos.parallel_env(task="colony", plant="twin", goto=False, max_cycles=40) as env:
+        assert env.observation_space("robot_0") == sim.observation_space("robot_0")
+        obs, _ = env.reset(seed=3)
+        while env.agents:
+            for o in obs.values():
+                assert o.shape == (18,) and o[17] in (0.0, 1.0)
+                assert env.observation_space("robot_0").contains(o)
+            obs, *_ = env.step({a: np.array([0.5, 0.5, 1.0, 0.0], np.float32) for a in env.agents})
