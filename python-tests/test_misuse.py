@@ -276,7 +276,10 @@ def test_observation_spaces_bound_the_values(task):
     env = colcos.parallel_env(task=task, max_cycles=150, patch=4)
     space = env.observation_space("robot_0")
     vec = space["vector"]
-    assert (vec.low[:15] == 0).all() and (vec.low[15:] == -1).all() and (vec.high == 1).all()
+    # 17 sensor values, then the task's extra entries (a carrying or predator-near flag in [0, 1]).
+    assert (vec.low[:15] == 0).all() and (vec.low[15:17] == -1).all() and (vec.high == 1).all()
+    assert (vec.low[17:] == 0).all()
+    width = env.action_space("robot_0").shape[0]
     state = env.state_space
     assert state.low[-1] == 0 and (state.low[:-1] == -1).all()
     rng = np.random.default_rng(0)
@@ -289,7 +292,7 @@ def test_observation_spaces_bound_the_values(task):
         assert state.contains(env.state())
         if not env.agents:
             break
-        obs, *_ = env.step({a: rng.uniform(-1.5, 1.5, 2).astype(np.float32) for a in env.agents})
+        obs, *_ = env.step({a: rng.uniform(-1.5, 1.5, width).astype(np.float32) for a in env.agents})
     venv = VecEnv(task, num_envs=2, max_cycles=20)
     assert venv.single_observation_space.contains(venv.obs[0, 0])
     assert np.array_equal(venv.single_observation_space.low, vec.low)

@@ -1,11 +1,22 @@
-//! The hand-written behaviours as baseline policies over a batch: one behaviour per (world, agent),
-//! deciding from the same raw sensor readings the agent's observation vector is made of.
+//! The hand-written behaviours as baseline policies over a batch: one controller per (world, agent),
+//! either a sim behaviour deciding the wheels from the raw sensor readings the agent's observation
+//! vector is made of, or one of the tasks' own policies ([`crate::policy`]) deciding the whole action,
+//! deposit rates included, from the agent's observation row.
 use crate::encoding::command_to_action;
 use crate::error::{EnvError, Result};
+use crate::policy::{self, AgentPolicy};
 use crate::vec_env::VecEnv;
 use colcos_sim::behaviour::{Behaviour, registry};
 use colcos_sim::rng::{self, SimRng, Stream};
 use colcos_sim::robot::ColiasParams;
+
+/// One agent's controller.
+enum Controller {
+    /// A sim behaviour: wheels only, no deposit.
+    Behaviour(Box<dyn Behaviour>),
+    /// A task's policy: the whole action.
+    Agent(Box<dyn AgentPolicy>),
+}
 
 pub struct BaselinePolicy {
     name: String,
@@ -13,14 +24,17 @@ pub struct BaselinePolicy {
     /// The body of the env's robots (the scenario's `[robot]`).
     robot: ColiasParams,
     seed: u64,
-    /// Per (world, agent): behaviour, random stream; rebuilt when the world starts a new episode.
-    slots: Vec<(Box<dyn Behaviour>, SimRng)>,
+    /// Entries of an agent's action (2 wheels and the deposit rates).
+    width: usize,
+    /// Per (world, agent): controller, random stream; rebuilt when the world starts a new episode.
+    slots: Vec<(Controller, SimRng)>,
     /// (episode, steps) each world was at when its behaviours were last used.
     seen: Vec<(u64, u64)>,
 }
 
 impl BaselinePolicy {
-    /// Behaviour `name` from the sim registry with `params` (a JSON object), for every agent of `env`.
+    /// Behaviour `name` from the sim registry with `params` (a JSON object), or the task policy
+    /// `name` (no parameters), for every agent of `env`.
     pub fn new(env: &VecEnv, name: &str, params: &serde_json::Value, seed: u64) -> Result<Self> {
         let params: toml::Table = match params {
             serde_json::Value::Null => toml::Table::new(),
@@ -32,13 +46,23 @@ impl BaselinePolicy {
             })?,
         };
         let robot = env.scenario().spec.robot;
-        // Build once to check the name and parameters.
-        registry::build_with(name, &params, "baseline", &robot)?;
+        if policy::build(name).is_some() {
+            if let Some(key) = params.keys().next() {
+                return Err(EnvError::param(
+                    format!("params.{key}"),
+                    format!("policy {name:?} takes no parameters"),
+                ));
+            }
+        } else {
+            // Build once to check the name and parameters.
+            registry::build_with(name, &params, "baseline", &robot)?;
+        }
         let mut policy = BaselinePolicy {
             name: name.into(),
             params,
             robot,
             seed,
+            width: env.action_decoder().width(),
             slots: Vec::new(),
             seen: Vec::new(),
         };
@@ -52,23 +76,39 @@ impl BaselinePolicy {
         Ok(policy)
     }
 
-    fn make(&self, w: usize, i: usize, episode: u64) -> Result<(Box<dyn Behaviour>, SimRng)> {
-        let b = registry::build_with(&self.name, &self.params, "baseline", &self.robot)?;
-        let world = crate::world_slot::world_index(w, episode);
-        Ok((b, rng::stream_of(self.seed, world, Stream::Baseline(i))))
+    /// Entries of each agent's action this policy writes: the env's continuous action width.
+    pub fn width(&self) -> usize {
+        self.width
     }
 
-    /// Continuous actions `[E, N, 2]` for the env's current observations.
+    fn make(&self, w: usize, i: usize, episode: u64) -> Result<(Controller, SimRng)> {
+        let c = match policy::build(&self.name) {
+            Some(p) => Controller::Agent(p),
+            None => Controller::Behaviour(registry::build_with(
+                &self.name,
+                &self.params,
+                "baseline",
+                &self.robot,
+            )?),
+        };
+        let world = crate::world_slot::world_index(w, episode);
+        Ok((c, rng::stream_of(self.seed, world, Stream::Baseline(i))))
+    }
+
+    /// Continuous actions `[E, N, width]` for the env's current observations (a behaviour lays
+    /// nothing: its deposit rates are 0).
     pub fn act(&mut self, env: &VecEnv, out: &mut [f32]) -> Result<()> {
         let spec = env.spec();
-        let (e, n) = (spec.num_envs, spec.num_agents);
-        if self.seen.len() != e || out.len() != e * n * 2 {
+        let (e, n, a) = (spec.num_envs, spec.num_agents, self.width);
+        if self.seen.len() != e || out.len() != e * n * a {
             return Err(EnvError::Action(format!(
                 "baseline policy built for {} worlds; output must hold {} values",
                 self.seen.len(),
-                e * n * 2
+                e * n * a
             )));
         }
+        let d = env.obs_dim();
+        let obs = env.obs();
         for w in 0..e {
             let now = (env.episode(w), env.episode_steps(w));
             if now.0 != self.seen[w].0 || now.1 < self.seen[w].1 {
@@ -80,10 +120,17 @@ impl BaselinePolicy {
             let world = env.world(w).expect("w < num_envs");
             let max = world.robot_params().max_wheel_speed;
             for (i, &robot) in spec.agent_robots.iter().enumerate() {
-                let (b, rng) = &mut self.slots[w * n + i];
-                let cmd = b.act(&world.observations()[robot], rng);
-                out[(w * n + i) * 2..(w * n + i) * 2 + 2]
-                    .copy_from_slice(&command_to_action(cmd, max));
+                let k = w * n + i;
+                let (c, rng) = &mut self.slots[k];
+                let row = &mut out[k * a..(k + 1) * a];
+                match c {
+                    Controller::Behaviour(b) => {
+                        let cmd = b.act(&world.observations()[robot], rng);
+                        row[..2].copy_from_slice(&command_to_action(cmd, max));
+                        row[2..].fill(0.0);
+                    }
+                    Controller::Agent(p) => p.act(&obs[k * d..(k + 1) * d], rng, row),
+                }
             }
         }
         Ok(())

@@ -1,7 +1,7 @@
 //! One episode's bookkeeping, shared by every environment of a task (each world of the batch, the
 //! plants' arena): how many steps it has taken, which agents have terminated, and how a step ends.
 //! "What happens when an agent terminates" is written here once.
-use crate::task::Task;
+use crate::task::{Task, TaskState};
 use colcos_sim::world::ArenaView;
 
 /// The per-agent outputs a step ends with.
@@ -36,6 +36,8 @@ pub struct Episode {
     pub was_terminated: Vec<bool>,
     /// Every agent is terminated or truncated.
     pub done: bool,
+    /// The task's memory of this episode ([`Task::initial_state`]), made at its first step.
+    pub state: Option<TaskState>,
 }
 
 impl Episode {
@@ -47,6 +49,7 @@ impl Episode {
             terminated: vec![false; agents],
             was_terminated: vec![false; agents],
             done: false,
+            state: None,
         }
     }
 
@@ -57,6 +60,12 @@ impl Episode {
         self.terminated.fill(false);
         self.was_terminated.fill(false);
         self.done = false;
+        self.state = None;
+    }
+
+    /// The task's memory of this episode so far (empty before its first step).
+    pub fn task_state(&self) -> &[u32] {
+        self.state.as_deref().unwrap_or(&[])
     }
 
     /// The end of a step of `world`: the task's rewards and terminations, no reward for an agent
@@ -70,7 +79,11 @@ impl Episode {
         end: StepEnd,
         out: AgentOut,
     ) -> bool {
-        self.finish_with(|r, t| task.evaluate(world, r, t), max_cycles, end, out)
+        let mut state = self.state.take().unwrap_or_else(|| task.initial_state());
+        let evaluate = |r: &mut [f32], t: &mut [bool]| task.evaluate(world, &mut state, r, t);
+        let done = self.finish_with(evaluate, max_cycles, end, out);
+        self.state = Some(state);
+        done
     }
 
     /// [`Self::finish_step`] with rewards and terminations given (a task written in Python, whose

@@ -21,6 +21,7 @@ pub mod encoding;
 pub mod episode;
 pub mod error;
 pub mod patch;
+pub mod policy;
 pub mod spaces;
 pub mod task;
 mod vec_env;

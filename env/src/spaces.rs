@@ -43,6 +43,8 @@ pub struct EnvSpec {
     pub agent_robots: Vec<usize>,
     /// Per-agent observation vector.
     pub observation: Space,
+    /// The task's entries after the sensor values in the observation vector.
+    pub extra_obs: Vec<crate::task::ExtraObs>,
     pub action: Space,
     /// Global state for centralised critics (if enabled).
     pub state: Option<Space>,
@@ -79,7 +81,10 @@ impl EnvSpec {
     /// Per-entry bounds `(low, high)` of the observation vector (tighter than the `observation`
     /// box's scalar envelope).
     pub fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
-        observation_bounds()
+        let (mut low, mut high) = observation_bounds();
+        low.extend(self.extra_obs.iter().map(|x| x.low));
+        high.extend(self.extra_obs.iter().map(|x| x.high));
+        (low, high)
     }
 
     /// Per-entry bounds `(low, high)` of a continuous action with deposit actions: wheels in

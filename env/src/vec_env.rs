@@ -1,6 +1,6 @@
 //! The batched core: `E` worlds of `N` agents stepped with rayon into flat buffers allocated once.
 //!
-//! Ownership model: the environment owns every output buffer (`[E, N, OBS_DIM]` observations,
+//! Ownership model: the environment owns every output buffer (`[E, N, obs_dim]` observations,
 //! `[E, N]` rewards and flags, ...); they are allocated at construction and never reallocated, so a
 //! binding may hand out views of them that stay valid for the environment's lifetime. Each `step` and
 //! `reset` overwrites them in place.
@@ -8,12 +8,11 @@ use crate::actions::{ActionDecoder, Actions};
 use crate::backend::EnvBackend;
 use crate::batch_step::{Buffers, Chunks, Lengths, conclude_batch, step_batch};
 use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
-use crate::encoding::OBS_DIM;
 use crate::error::{EnvError, Result};
 use crate::spaces::{EnvSpec, Space};
 use crate::task::{Task, registry};
 pub use crate::world_output::render_world;
-use crate::world_output::{write_obs, write_patch, write_state};
+use crate::world_output::{obs_dim, write_patch, write_state, write_task_obs};
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
 use crate::world_step::{Ctx, Evaluation, step_world};
@@ -107,6 +106,7 @@ impl VecEnv {
             .thread_name(|i| format!("colcos-env-{i}"))
             .build()
             .map_err(|err| EnvError::param("num_threads", err.to_string()))?;
+        let obs_dim = obs_dim(task.as_ref());
         let spec = EnvSpec {
             task: cfg.task.clone(),
             env_name: format!("colcos_{}_v0", cfg.task),
@@ -118,9 +118,10 @@ impl VecEnv {
             observation: Space::Box {
                 low: -1.0,
                 high: 1.0,
-                shape: vec![OBS_DIM],
+                shape: vec![obs_dim],
                 dtype: "float32",
             },
+            extra_obs: task.extra_observations().to_vec(),
             action: match cfg.action {
                 ActionKind::Continuous => Space::Box {
                     low: -1.0,
@@ -174,14 +175,14 @@ impl VecEnv {
             pool,
             slots,
             chunks,
-            obs: vec![0.0; e * n * OBS_DIM],
+            obs: vec![0.0; e * n * obs_dim],
             rewards: vec![0.0; e * n],
             terminated: vec![false; e * n],
             truncated: vec![false; e * n],
             // At least one element per world so that every buffer splits into E chunks.
             state: vec![0.0; e * state_dim.max(1)],
             patch: vec![0; e * n * patch_len.max(1)],
-            final_obs: vec![0.0; e * n * OBS_DIM],
+            final_obs: vec![0.0; e * n * obs_dim],
             final_mask: vec![false; e],
             shield_flags: vec![0; e * n],
             shield,
@@ -199,6 +200,14 @@ impl VecEnv {
 
     pub fn spec(&self) -> &EnvSpec {
         &self.spec
+    }
+    /// Entries of an agent's observation: the 17 sensor values and the task's extras.
+    pub fn obs_dim(&self) -> usize {
+        self.spec.observation.flat_len()
+    }
+    /// The task's memory of world `e`'s episode (empty before its first step; see [`Task`]).
+    pub fn task_state(&self, e: usize) -> &[u32] {
+        self.slots[e].episode.task_state()
     }
     /// How this environment reads actions (the plants decode theirs with the same).
     pub fn action_decoder(&self) -> &ActionDecoder {
@@ -242,7 +251,7 @@ impl VecEnv {
         self.slots[e].episode.done
     }
 
-    /// Observations `[E, N, OBS_DIM]`.
+    /// Observations `[E, N, obs_dim]` (`OBS_DIM` sensor values, then the task's extras).
     pub fn obs(&self) -> &[f32] {
         &self.obs
     }
@@ -271,7 +280,7 @@ impl VecEnv {
             &self.patch
         }
     }
-    /// Final observations of worlds that ended in the last step (same-step autoreset) `[E, N, OBS_DIM]`.
+    /// Final observations of worlds that ended in the last step (same-step autoreset) `[E, N, obs_dim]`.
     pub fn final_obs(&self) -> &[f32] {
         &self.final_obs
     }
@@ -439,7 +448,7 @@ impl VecEnv {
         };
         let len = Lengths {
             agents: n,
-            obs: n * OBS_DIM,
+            obs: n * self.obs_dim(),
             state: self.state_dim.max(1),
             patch: n * self.patch_len.max(1),
             deposits: self.decoder.deposits(),
@@ -488,12 +497,14 @@ impl VecEnv {
         let ctx_max = self.scenario.spec.robot.max_wheel_speed;
         let (sd, pl) = (self.state_dim, self.patch_len);
         let agents = self.task.agents();
+        let d = self.obs_dim();
         for (w, slot) in self.slots.iter().enumerate() {
-            write_obs(
+            write_task_obs(
                 &slot.world,
-                agents,
+                self.task.as_ref(),
+                slot.episode.task_state(),
                 ctx_max,
-                &mut self.obs[w * n * OBS_DIM..(w + 1) * n * OBS_DIM],
+                &mut self.obs[w * n * d..(w + 1) * n * d],
             );
             if sd > 0 {
                 write_state(

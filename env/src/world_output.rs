@@ -2,12 +2,43 @@
 //! the rendered screen with the robots on it; for a simulated world of the batch or a rig's host alike.
 use crate::config::PatchConfig;
 use crate::encoding::{self, OBS_DIM};
+use crate::task::Task;
 use colcos_sim::world::ArenaView;
 
 pub fn write_obs(world: &dyn ArenaView, agents: &[usize], max_speed: f32, out: &mut [f32]) {
     let obs = world.observations();
     for (&i, o) in agents.iter().zip(out.chunks_exact_mut(OBS_DIM)) {
         encoding::encode(&obs[i], max_speed, o);
+    }
+}
+
+/// Entries of each agent's observation under `task`: the sensor values and the task's extras.
+pub fn obs_dim(task: &dyn Task) -> usize {
+    OBS_DIM + task.extra_observations().len()
+}
+
+/// The observation rows of `task`'s agents, [`obs_dim`] entries each: the sensor values, then the
+/// task's extra entries ([`Task::observe`] with the episode's memory `state`).
+pub fn write_task_obs(
+    world: &dyn ArenaView,
+    task: &dyn Task,
+    state: &[u32],
+    max_speed: f32,
+    out: &mut [f32],
+) {
+    let dim = obs_dim(task);
+    if dim == OBS_DIM {
+        return write_obs(world, task.agents(), max_speed, out);
+    }
+    let obs = world.observations();
+    for (k, (&i, row)) in task
+        .agents()
+        .iter()
+        .zip(out.chunks_exact_mut(dim))
+        .enumerate()
+    {
+        encoding::encode(&obs[i], max_speed, &mut row[..OBS_DIM]);
+        task.observe(world, state, k, &mut row[OBS_DIM..]);
     }
 }
 

@@ -6,7 +6,7 @@ use crate::config::{AutoresetMode, PatchConfig};
 use crate::episode::{AgentOut, StepEnd};
 use crate::error::Result;
 use crate::task::Task;
-use crate::world_output::{write_obs, write_patch, write_state};
+use crate::world_output::{write_patch, write_state, write_task_obs};
 use crate::world_slot::WorldSlot;
 use colcos_sim::robot::RapierHost;
 use colcos_sim::scenario::Scenario;
@@ -232,7 +232,8 @@ fn next_episode(
 
 pub(crate) fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut Out) {
     let agents = ctx.task.agents();
-    write_obs(&slot.world, agents, ctx.max_speed, out.obs);
+    let state = slot.episode.task_state();
+    write_task_obs(&slot.world, ctx.task, state, ctx.max_speed, out.obs);
     if ctx.state_dim > 0 {
         write_state(&slot.world, slot.episode.steps, ctx.max_cycles, out.state);
     }

@@ -32,6 +32,12 @@ fn record(env: &VecEnv, h: &mut Fnv) {
     h.floats(env.state());
     h.floats(env.final_obs());
     h.flags(env.final_mask());
+    // The task's per-episode memory (none for the first three tasks: nothing hashed).
+    for w in 0..env.spec().num_envs {
+        env.task_state(w)
+            .iter()
+            .for_each(|x| h.bytes(&x.to_le_bytes()));
+    }
 }
 
 fn config(task: &str, shield: bool, physics: Option<PhysicsBackend>) -> EnvConfig {
@@ -51,7 +57,8 @@ fn scripted_actions(task: &str, shield: bool, physics: Option<PhysicsBackend>) -
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
     env.reset(Some(11), None).unwrap();
     record(&env, &mut h);
-    let len = env.spec().num_envs * env.spec().num_agents * 2;
+    // Wheels and, where the task's agents lay pheromone, deposit rates (negative ones lay nothing).
+    let len = env.spec().num_envs * env.spec().num_agents * env.action_decoder().width();
     for t in 0..90 {
         let a: Vec<f32> = (0..len)
             .map(|k| ((k * 7 + t * 3) as f32 * 0.37).sin())
@@ -74,7 +81,7 @@ fn baseline(
     env.reset(Some(5), None).unwrap();
     let mut policy = BaselinePolicy::new(&env, behaviour, &params, 5).unwrap();
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
-    let mut a = vec![0.0; env.spec().num_envs * env.spec().num_agents * 2];
+    let mut a = vec![0.0; env.spec().num_envs * env.spec().num_agents * policy.width()];
     for _ in 0..90 {
         policy.act(&env, &mut a).unwrap();
         h.floats(&a);
@@ -179,4 +186,63 @@ fn baselines_discs() {
             (0x137cf18b419c7b0f, 0x74607472e76cbfa4),
         ],
     );
+}
+
+/// The tasks whose agents lay pheromone, under fixed actions and under their own hand-written
+/// policies, shield off and on (rapier): the rewards, the extra observation entry and the
+/// per-episode memory included.
+#[test]
+fn the_pheromone_laying_tasks() {
+    let want = [
+        (
+            "colony",
+            "colony_ant",
+            [
+                0xa19175c4e2f4c3d3,
+                0xa19175c4e2f4c3d3,
+                0xe3e94bb67c44bf91,
+                0x96d6a91e08185246,
+            ],
+        ),
+        (
+            "coverage",
+            "coverage_walk",
+            [
+                0x01886a2c1929c08f,
+                0x9639b1833e1fe670,
+                0x31233c6cdf874b7f,
+                0x40056bc330303893,
+            ],
+        ),
+        (
+            "alarm",
+            "alarm_flee",
+            [
+                0xf92d3342a7318b8e,
+                0x0acf8fd6161b401c,
+                0xb07caec582be7ce8,
+                0x242a09afedc6794c,
+            ],
+        ),
+    ];
+    let null = serde_json::Value::Null;
+    for (task, policy, [fixed, fixed_shield, hand, hand_shield]) in want {
+        check(task, scripted_actions(task, false, None), fixed);
+        check(
+            &format!("{task} (shield)"),
+            scripted_actions(task, true, None),
+            fixed_shield,
+        );
+        let label = format!("{task}/{policy}");
+        check(
+            &label,
+            baseline(task, policy, null.clone(), false, None),
+            hand,
+        );
+        check(
+            &format!("{label} (shield)"),
+            baseline(task, policy, null.clone(), true, None),
+            hand_shield,
+        );
+    }
 }

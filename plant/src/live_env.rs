@@ -8,9 +8,8 @@ use colcos_bridge::frames::FrameServer;
 use colcos_bridge::host::Host;
 use colcos_bridge::live::{LiveOptions, LiveSession, LoopCore, replay};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
-use colcos_env::encoding::OBS_DIM;
 use colcos_env::task::registry;
-use colcos_env::world_output::{render_world, write_obs, write_patch, write_state};
+use colcos_env::world_output::{render_world, write_patch, write_state, write_task_obs};
 use colcos_env::{
     ActionDecoder, Actions, AgentOut, EnvConfig, EnvSpec, Episode, StepEnd, Task, VecEnv,
     shield_bits,
@@ -115,7 +114,8 @@ impl LiveEnv {
             episode: Episode::new(0, n),
             needs_reset: true,
             awaiting: None,
-            obs: vec![0.0; n * OBS_DIM],
+            // The task's extra entries (a carrying flag) included, as the spec says.
+            obs: vec![0.0; n * spec.observation.flat_len()],
             rewards: vec![0.0; n],
             terminated: vec![false; n],
             truncated: vec![false; n],
@@ -455,7 +455,14 @@ impl LiveEnv {
     fn write_outputs(&mut self) {
         let host = self.driver.host();
         let agents = self.task.agents();
-        write_obs(host, agents, self.max_speed, &mut self.obs);
+        let state = self.episode.task_state();
+        write_task_obs(
+            host,
+            self.task.as_ref(),
+            state,
+            self.max_speed,
+            &mut self.obs,
+        );
         if self.spec.state.is_some() {
             write_state(
                 host,

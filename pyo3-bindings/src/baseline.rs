@@ -21,8 +21,8 @@ pub struct PyBaseline {
 
 #[pymethods]
 impl PyBaseline {
-    /// Behaviour `name` (see `colcos.behaviours()`) with `params_json` (a JSON object) for every agent
-    /// of `env`.
+    /// Behaviour `name` (see `colcos.behaviours()`) with `params_json` (a JSON object), or a task's
+    /// own policy (`colcos.task_policies()`), for every agent of `env`.
     #[new]
     #[pyo3(signature = (env, name, params_json=None, seed=None))]
     fn new(
@@ -50,8 +50,9 @@ impl PyBaseline {
                 .detach(|| {
                     let g = me.lock();
                     let s = g.env.spec();
-                    let shape = [s.num_envs, s.num_agents, 2];
-                    BaselinePolicy::new(&g.env, &name, &params, seed).map(|p| (p, shape))
+                    BaselinePolicy::new(&g.env, &name, &params, seed)
+                        .map(|p| (p.width(), p))
+                        .map(|(w, p)| (p, [s.num_envs, s.num_agents, w]))
                 })
                 .map_err(to_py)?;
             Ok(PyBaseline {
@@ -64,7 +65,8 @@ impl PyBaseline {
         })
     }
 
-    /// Continuous actions `(E, N, 2)` float32 for the env's current sensor readings.
+    /// Continuous actions `(E, N, 2 + D)` float32 for the env's current sensor readings (wheels, then
+    /// the deposit rates: 0 for a sim behaviour, chosen by a task's own policy).
     fn act<'py>(&self, py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
             let env = env_of(env)?;
@@ -74,7 +76,8 @@ impl PyBaseline {
                     let g = me.lock();
                     let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
                     let State { policy, out } = &mut *st;
-                    if out.len() != g.env.spec().num_envs * g.env.spec().num_agents * 2 {
+                    let s = g.env.spec();
+                    if out.len() != s.num_envs * s.num_agents * g.env.action_decoder().width() {
                         return Err(colcos_env::EnvError::State(
                             "this policy was made for another environment (its sizes differ)"
                                 .into(),

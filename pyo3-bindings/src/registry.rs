@@ -15,6 +15,13 @@ fn behaviours() -> PyResult<Vec<(&'static str, &'static str)>> {
     guard(|| Ok(colcos_sim::behaviour::registry::list().collect()))
 }
 
+/// `[(name, task, description)]` of every task's own hand-written policy (wheels and deposit rates,
+/// from the agent's observation row; usable as baseline policies).
+#[pyfunction]
+fn task_policies() -> PyResult<Vec<(&'static str, &'static str, &'static str)>> {
+    guard(|| Ok(colcos_env::policy::POLICIES.to_vec()))
+}
+
 /// `[(key, type, default, meaning)]` of every key of behaviour `name`'s `params` table.
 #[pyfunction]
 fn behaviour_params(
@@ -70,6 +77,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_test_panic, m)?)?;
     m.add_function(wrap_pyfunction!(tasks, m)?)?;
     m.add_function(wrap_pyfunction!(behaviours, m)?)?;
+    m.add_function(wrap_pyfunction!(task_policies, m)?)?;
     m.add_function(wrap_pyfunction!(behaviour_params, m)?)?;
     m.add_function(wrap_pyfunction!(default_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(observation_names, m)?)?;

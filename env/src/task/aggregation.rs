@@ -133,7 +133,13 @@ impl Task for Aggregation {
     fn agents(&self) -> &[usize] {
         &self.agents
     }
-    fn evaluate(&self, world: &dyn ArenaView, rewards: &mut [f32], _terminated: &mut [bool]) {
+    fn evaluate(
+        &self,
+        world: &dyn ArenaView,
+        _state: &mut super::TaskState,
+        rewards: &mut [f32],
+        _terminated: &mut [bool],
+    ) {
         let poses = world.poses();
         let robots = world.robots();
         let obs = world.observations();
@@ -217,7 +223,7 @@ mod tests {
             world.step_with_commands(&commands);
         }
         let mut rewards = [0.0];
-        task.evaluate(&world, &mut rewards, &mut [false]);
+        task.evaluate(&world, &mut Vec::new(), &mut rewards, &mut [false]);
         rewards[0]
     }
 

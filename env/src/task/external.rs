@@ -57,7 +57,13 @@ impl Task for External {
     }
     /// Nothing of its own: a deferred step's rewards and terminations are given to
     /// `VecEnv::conclude`; a plain step hands out none.
-    fn evaluate(&self, _world: &dyn ArenaView, rewards: &mut [f32], _terminated: &mut [bool]) {
+    fn evaluate(
+        &self,
+        _world: &dyn ArenaView,
+        _state: &mut super::TaskState,
+        rewards: &mut [f32],
+        _terminated: &mut [bool],
+    ) {
         rewards.fill(0.0);
     }
 }

@@ -112,7 +112,13 @@ impl Task for Foraging {
         }
         super::prefill_static_maps(pheromones)
     }
-    fn evaluate(&self, world: &dyn ArenaView, rewards: &mut [f32], terminated: &mut [bool]) {
+    fn evaluate(
+        &self,
+        world: &dyn ArenaView,
+        _state: &mut super::TaskState,
+        rewards: &mut [f32],
+        terminated: &mut [bool],
+    ) {
         let poses = world.poses();
         let r2 = self.reach_distance * self.reach_distance;
         for ((r, t), &i) in rewards

@@ -4,6 +4,9 @@
 //! fields) to hand out rewards and end episodes. Agents still observe only their own sensors.
 
 pub mod aggregation;
+pub mod alarm;
+pub mod colony;
+pub mod coverage;
 pub mod external;
 pub mod foraging;
 pub mod registry;
@@ -14,6 +17,20 @@ use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
 use serde::de::DeserializeOwned;
+
+/// A task's memory of one episode of one world (food left, who carries, cells covered): plain
+/// counters laid out by the task. The world's [`crate::Episode`] holds it, made afresh by
+/// [`Task::initial_state`] at the episode's first step, so it resets with the world and never
+/// depends on the number of threads.
+pub type TaskState = Vec<u32>;
+
+/// One observation entry a task appends to the agents' 17 sensor values, with its bounds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExtraObs {
+    pub name: &'static str,
+    pub low: f32,
+    pub high: f32,
+}
 
 /// An RL problem over a scenario.
 pub trait Task: Send + Sync {
@@ -26,9 +43,26 @@ pub trait Task: Send + Sync {
     fn on_reset(&self, _pheromones: &mut [Pheromone]) -> bool {
         false
     }
+    /// A new episode's [`TaskState`] (empty for a task without memory).
+    fn initial_state(&self) -> TaskState {
+        Vec::new()
+    }
+    /// The entries each agent's observation gains after its sensor values (none by default).
+    fn extra_observations(&self) -> &'static [ExtraObs] {
+        &[]
+    }
+    /// Writes agent `k`'s extra observation entries (`out`: one per [`Self::extra_observations`]).
+    /// `state` is empty before the episode's first step.
+    fn observe(&self, _world: &dyn ArenaView, _state: &[u32], _k: usize, _out: &mut [f32]) {}
     /// Rewards after a step, one per agent, and which agents have reached a terminal state. Entries of
-    /// `terminated` are only ever set to true here, never cleared.
-    fn evaluate(&self, world: &dyn ArenaView, rewards: &mut [f32], terminated: &mut [bool]);
+    /// `terminated` are only ever set to true here, never cleared. `state` is this episode's memory.
+    fn evaluate(
+        &self,
+        world: &dyn ArenaView,
+        state: &mut TaskState,
+        rewards: &mut [f32],
+        terminated: &mut [bool],
+    );
 }
 
 /// Deserialises a task's parameter object, naming the key at fault; unknown keys are refused.
@@ -86,6 +120,29 @@ pub fn check_non_negative(key: &str, v: f32) -> Result<f32> {
         Ok(v)
     } else {
         Err(EnvError::param(key, format!("{v} must be finite and >= 0")))
+    }
+}
+
+/// A point `q` of parameter `key`, refused unless it lies in the scenario's arena.
+pub fn point_in_arena(scenario: &Scenario, key: &str, q: [f32; 2]) -> Result<glam::Vec2> {
+    let arena = scenario.arena_size();
+    let q = glam::Vec2::from(q);
+    if q.is_finite() && q.x >= 0.0 && q.y >= 0.0 && q.x <= arena.x && q.y <= arena.y {
+        Ok(q)
+    } else {
+        Err(EnvError::param(
+            key,
+            format!("{q} lies outside the arena {arena}"),
+        ))
+    }
+}
+
+/// A finite, positive parameter.
+pub fn check_positive(key: &str, v: f32) -> Result<f32> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(EnvError::param(key, format!("{v} must be finite and > 0")))
     }
 }
 

@@ -1,5 +1,5 @@
 //! Tasks by name.
-use super::{Task, aggregation, external, foraging, trail};
+use super::{Task, aggregation, alarm, colony, coverage, external, foraging, trail};
 use crate::config::ScenarioSource;
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
@@ -25,6 +25,24 @@ const REGISTRY: &[(&str, &str, &str, Builder)] = &[
         trail::DESCRIPTION,
         trail::DEFAULT_SCENARIO,
         trail::build,
+    ),
+    (
+        "colony",
+        colony::DESCRIPTION,
+        colony::DEFAULT_SCENARIO,
+        colony::build,
+    ),
+    (
+        "coverage",
+        coverage::DESCRIPTION,
+        coverage::DEFAULT_SCENARIO,
+        coverage::build,
+    ),
+    (
+        "alarm",
+        alarm::DESCRIPTION,
+        alarm::DEFAULT_SCENARIO,
+        alarm::build,
     ),
     // Last, and left out of `list`: built for a `colcos.Task` written in Python, on the scenario it
     // names (the `trail` task's by default).

@@ -96,7 +96,13 @@ impl Task for Trail {
     fn on_reset(&self, pheromones: &mut [Pheromone]) -> bool {
         super::prefill_static_maps(pheromones)
     }
-    fn evaluate(&self, world: &dyn ArenaView, rewards: &mut [f32], _terminated: &mut [bool]) {
+    fn evaluate(
+        &self,
+        world: &dyn ArenaView,
+        _state: &mut super::TaskState,
+        rewards: &mut [f32],
+        _terminated: &mut [bool],
+    ) {
         let obs = world.observations();
         let params = world.robot_params();
         for (r, &i) in rewards.iter_mut().zip(&self.agents) {

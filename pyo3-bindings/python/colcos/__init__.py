@@ -13,13 +13,18 @@ wheel speeds.
 | `aggregation` | followers (3)         | Box((17,)) f32  | Box(-1, 1, (2,)) or Discrete(6) |
 | `foraging`    | foragers (2)          | Box((17,)) f32  | same                            |
 | `trail`       | trail robots (4)      | Box((17,)) f32  | same                            |
+| `colony`      | ants (6)              | Box((18,)) f32  | Box((4,)) or Discrete(24)       |
+| `coverage`    | explorers (4)         | Box((17,)) f32  | Box((3,)) or Discrete(12)       |
+| `alarm`       | prey (6)              | Box((18,)) f32  | Box((3,)) or Discrete(12)       |
 
 Versioned by task, as PettingZoo's and Gymnasium's environments are: `from colcos.tasks import
 aggregation_v0; aggregation_v0.parallel_env()`, `gymnasium.make_vec("colcos/aggregation-v0", num_envs=64)`
 (see `colcos.tasks`).
 
 Observation bounds per entry: colour intensities and bumpers in [0, 1], the last wheel command in
-[-1, 1]. Every error raised is a `colcos.ColcosError` (see docs/python.md, "Errors").
+[-1, 1]; `colony` appends a carrying flag and `alarm` a predator-near flag, each in [0, 1]. The
+last three tasks' agents also choose how much pheromone to lay (docs/tasks.md). Every error raised
+is a `colcos.ColcosError` (see docs/python.md, "Errors").
 """
 
 from __future__ import annotations
@@ -81,6 +86,7 @@ __all__ = [
     "preflight",
     "raw_env",
     "sweep",
+    "task_policies",
     "tasks",
     "vector",
 ]
@@ -92,6 +98,13 @@ def behaviours() -> dict[str, str]:
     `behaviour_params(name)` lists the parameters of each.
     """
     return dict(_core.behaviours())
+
+
+def task_policies() -> dict[str, tuple[str, str]]:
+    """The hand-written policies of the tasks whose agents lay pheromone (usable with
+    `colcos.baselines.Baseline`, which then sets the deposit rates too): name -> (task, description).
+    """
+    return {name: (task, about) for name, task, about in _core.task_policies()}
 
 
 def behaviour_params(name: str) -> list[dict[str, str]]:

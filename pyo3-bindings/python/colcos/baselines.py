@@ -19,7 +19,8 @@ __all__ = ["Baseline", "RandomPolicy"]
 
 
 class Baseline:
-    """Behaviour `name` (see `colcos.behaviours()`) driving every agent of `env`.
+    """Behaviour `name` (see `colcos.behaviours()`) driving every agent of `env`, or a task's own
+    policy (`colcos.task_policies()`, e.g. `"colony_ant"`: it also chooses the deposit rates).
 
     >>> venv = VecEnv("aggregation", num_envs=8)
     >>> policy = Baseline(venv, "avoid", speed=0.1)
@@ -38,7 +39,8 @@ class Baseline:
         self._policy = _core.Baseline(env._core, name, json.dumps(plain) if plain else None, _checks.seed(seed))
 
     def act(self, obs: np.ndarray | None = None) -> np.ndarray:
-        """Actions (E, N, 2) float32 for the env's current sensor readings (`obs` is ignored)."""
+        """Actions (E, N, 2 + D) float32 for the env's current sensor readings (`obs` is ignored): the
+        wheels, then the deposit rates (0 from a behaviour; a task policy chooses them)."""
         return self._policy.act(self.env._core)
 
 
