@@ -4,7 +4,8 @@
 #   main venv  (requirements.txt):       PettingZoo suite, errors, vector env, determinism,
 #                                        SuperSuit -> SB3 PPO, our SB3 adapter, TorchRL
 #   rllib venv (requirements-rllib.txt): RLlib ParallelPettingZooEnv (ray pins gymnasium 1.2.2); sweeps on a local Ray cluster, the Ray Tune example
-# Both requirement files are complete locks installed with --no-deps (no resolver); the main venv gets
+#   benchmarl venv (requirements-benchmarl.txt): colcos's BenchMARL task family, one tiny run per algorithm
+# The requirement files are complete locks installed with --no-deps (no resolver); the main venv gets
 # PyPI's torch without its CUDA libraries, made loadable by torch_cpu_stubs.py (see requirements.txt).
 # The first run builds the wheel from a cold cargo target and fills both venvs (tens of minutes on
 # two cores, ~760 MB downloaded, ~2.4 GB on disk); a rerun reuses the venvs and the cargo target.
@@ -83,7 +84,7 @@ make_venv() { # name requirements [pip install options]
 # are deliberately left out of the main venv (the stubs stand in for them).
 check_venv() { # name
     local out
-    out="$("$work/$1/bin/pip" check 2>&1 | grep -v -E '^torch [^ ]+ requires (nvidia-|cuda-|triton)' || true)"
+    out="$("$work/$1/bin/pip" check 2>&1 | grep -v -E '^torch [^ ]+ requires (nvidia-|cuda-|triton)|^benchmarl [^ ]+ requires (torchvision|av)' || true)"
     if [ -n "$out" ] && [ "$out" != "No broken requirements found." ]; then
         echo "$out"
         echo "error: the $1 lock is incomplete (python-tests/requirements*.txt)"
@@ -120,12 +121,21 @@ make_venv venv-rllib "$here/requirements-rllib.txt" --no-deps --only-binary=:all
 check_venv venv-rllib
 "$work/venv-rllib/bin/python" -c "import ray.rllib"
 lap "installed ($(du -sh "$work/venv-rllib" | cut -f1))"
+echo "== benchmarl venv (requirements-benchmarl.txt)"
+make_venv venv-benchmarl "$here/requirements-benchmarl.txt" --no-deps --only-binary=:all: --no-binary=benchmarl,antlr4-python3-runtime
+"$work/venv-benchmarl/bin/python" "$here/torch_cpu_stubs.py"
+check_venv venv-benchmarl
+"$work/venv-benchmarl/bin/python" -c "import benchmarl.experiment, colcos.benchmarl"
+lap "installed ($(du -sh "$work/venv-benchmarl" | cut -f1))"
 
 echo "== pytest (main venv)"
-no_rust "$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --durations=5 --ignore=test_rllib.py --ignore=test_sweep_ray.py --ignore=test_tune_example.py "$@" || status=1
+no_rust "$work/venv-main/bin/python" -m pytest -q -p no:cacheprovider --durations=5 --ignore=test_rllib.py --ignore=test_sweep_ray.py --ignore=test_tune_example.py --ignore=test_benchmarl.py "$@" || status=1
 lap "main suites"
 echo "== pytest (rllib venv)"
 no_rust "$work/venv-rllib/bin/python" -m pytest -q -p no:cacheprovider test_rllib.py test_sweep_ray.py test_tune_example.py "$@" || status=1
 lap "rllib suite"
+echo "== pytest (benchmarl venv)"
+no_rust "$work/venv-benchmarl/bin/python" -m pytest -q -p no:cacheprovider test_benchmarl.py "$@" || status=1
+lap "benchmarl suite"
 echo "== python part done in $(($(stamp) - t0)) s (status $status)"
 exit $status

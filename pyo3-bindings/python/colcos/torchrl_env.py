@@ -1,7 +1,6 @@
 """`colcos.vector.VecEnv` as a TorchRL `EnvBase`: batch size `[E]`, agents grouped under `"robot"`
 (as TorchRL's `PettingZooWrapper` groups `robot_0..`). Observations reach torch through
-`torch.from_numpy` on the Rust buffers (no copy on the way in; TorchRL's own tensordict handling may
-copy afterwards).
+one copy of the Rust buffers each (they are read-only views, overwritten by the next step).
 
 Keys: `("robot", "observation")` `[E, N, 17]`, `("robot", "action")` `[E, N, 2]`,
 `("robot", "reward")` `[E, N, 1]`, `("robot", "terminated"|"truncated"|"done")` `[E, N, 1]`, and
@@ -79,13 +78,13 @@ class ColcosTorchEnv(EnvBase):
     def _obs_td(self) -> dict[str, Any]:
         v = self.venv
         group = TensorDict(
-            {"observation": torch.from_numpy(v.obs).to(self.device, copy=True)},
+            {"observation": torch.tensor(v.obs, device=self.device)},
             batch_size=(v.num_envs, v.num_agents),
             device=self.device,
         )
         out: dict[str, Any] = {"robot": group}
         if v.state is not None:
-            out["state"] = torch.from_numpy(v.state).to(self.device, copy=True)
+            out["state"] = torch.tensor(v.state, device=self.device)
         return out
 
     def _flags(self, out: dict[str, Any]) -> None:
@@ -93,7 +92,7 @@ class ColcosTorchEnv(EnvBase):
         term = torch.from_numpy(v.terminated.copy()).to(self.device).unsqueeze(-1)
         trunc = torch.from_numpy(v.truncated.copy()).to(self.device).unsqueeze(-1)
         done = term | trunc
-        out["robot"].update(terminated=term, truncated=trunc, done=done)
+        out["robot"].update({"terminated": term, "truncated": trunc, "done": done})
         out["terminated"] = term.all(dim=1)
         out["truncated"] = trunc.any(dim=1) & done.all(dim=1)
         out["done"] = done.all(dim=1)

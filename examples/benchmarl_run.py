@@ -1,0 +1,175 @@
+"""Train a BenchMARL algorithm on a colcos task, then compare it with the task's hand-written policy
+and random actions on the same measure (mean over agents and episodes of an agent's episode return).
+
+    python examples/benchmarl_run.py --algorithm mappo --task aggregation --frames 600000 --seeds 0 1 2
+    python examples/benchmarl_run.py --algorithm qmix --task aggregation --discrete --frames 300000
+    python examples/benchmarl_run.py --algorithm masac --task colony --tiny          # one small iteration
+
+Algorithms: BenchMARL's (`mappo`, `ippo`, `masac`, `isac`, `maddpg`, `iddpg`, `qmix`, `vdn`, `iql`,
+...); tasks: `colcos.tasks()`. Each run writes BenchMARL's own outputs (CSV logs, marl-eval JSON,
+checkpoints) under `--out`, and `summary.json` there with every run's final evaluation return, its
+wall time and the references. Needs `benchmarl` (python-tests/requirements-benchmarl.txt).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import time
+from typing import Any
+
+import numpy as np
+import torch
+from benchmarl.algorithms import (
+    IddpgConfig,
+    IppoConfig,
+    IqlConfig,
+    IsacConfig,
+    MaddpgConfig,
+    MappoConfig,
+    MasacConfig,
+    QmixConfig,
+    VdnConfig,
+)
+from benchmarl.experiment import Experiment, ExperimentConfig
+from benchmarl.models.mlp import MlpConfig
+
+import colcos
+from colcos.baselines import Baseline, RandomPolicy
+from colcos.benchmarl import task as benchmarl_task
+from colcos.vector import VecEnv
+
+ALGORITHMS: dict[str, Any] = {
+    "mappo": MappoConfig,
+    "ippo": IppoConfig,
+    "masac": MasacConfig,
+    "isac": IsacConfig,
+    "maddpg": MaddpgConfig,
+    "iddpg": IddpgConfig,
+    "qmix": QmixConfig,
+    "vdn": VdnConfig,
+    "iql": IqlConfig,
+}
+# The hand-written reference of each task (colcos.behaviours() / colcos.task_policies()).
+REFERENCE = {"aggregation": "aggregation_follower"}
+
+
+def reference_policy(task: str) -> str | None:
+    if task in REFERENCE:
+        return REFERENCE[task]
+    for name, (owner, _) in colcos.task_policies().items():
+        if owner == task:
+            return name
+    return None
+
+
+def episode_return(task: str, make_policy: Any, max_steps: int, episodes: int, seed: int) -> float:
+    """Mean over agents and episodes of an agent's summed reward over an episode of `max_steps` steps."""
+    venv = VecEnv(task, num_envs=episodes, max_cycles=max_steps, autoreset_mode="disabled")
+    venv.reset(seed=seed)
+    policy = make_policy(venv)
+    total = np.zeros((episodes, venv.num_agents))
+    for _ in range(max_steps):
+        _, rewards, _, _, _ = venv.step(policy())
+        total += rewards
+    return float(total.mean())
+
+
+def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> ExperimentConfig:
+    cfg = ExperimentConfig.get_from_yaml()
+    cfg.max_n_frames = args.frames
+    cfg.loggers = ["csv"]
+    cfg.create_json = True  # marl-eval's JSON, which BenchMARL's plotting reads
+    cfg.save_folder = str(out)
+    cfg.checkpoint_at_end = False
+    cfg.checkpoint_interval = 0
+    cfg.prefer_continuous_actions = not args.discrete
+    cfg.evaluation_episodes = args.eval_episodes
+    # colcos steps all worlds of a batch in Rust: large batches of worlds, one collector.
+    cfg.on_policy_n_envs_per_worker = cfg.off_policy_n_envs_per_worker = args.worlds
+    cfg.on_policy_collected_frames_per_batch = cfg.off_policy_collected_frames_per_batch = args.worlds * args.max_steps
+    cfg.evaluation_interval = cfg.on_policy_collected_frames_per_batch * args.eval_every
+    if args.tiny:
+        cfg.max_n_iters = 1
+        cfg.max_n_frames = cfg.on_policy_collected_frames_per_batch
+        cfg.evaluation_interval = cfg.on_policy_collected_frames_per_batch
+        cfg.on_policy_n_minibatch_iters = 1
+        cfg.on_policy_minibatch_size = 64
+        cfg.off_policy_n_optimizer_steps = 2
+        cfg.off_policy_train_batch_size = 32
+        cfg.off_policy_init_random_frames = 0
+    return cfg
+
+
+def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any]:
+    task = benchmarl_task(args.task)
+    task.config["max_steps"] = args.max_steps
+    algorithm = ALGORITHMS[args.algorithm].get_from_yaml()
+    t0 = time.time()
+    experiment = Experiment(
+        task=task,
+        algorithm_config=algorithm,
+        model_config=MlpConfig.get_from_yaml(),
+        critic_model_config=MlpConfig.get_from_yaml(),
+        seed=seed,
+        config=experiment_config(args, out),
+    )
+    experiment.run()
+    wall = time.time() - t0
+    files = sorted(pathlib.Path(experiment.folder_name).rglob("*.json"))
+    final = None
+    if files:
+        data = json.loads(files[-1].read_text())
+        steps = data["colcos"][args.task][args.algorithm][f"seed_{seed}"]
+        last = max((k for k in steps if k.startswith("step_")), key=lambda k: int(k.split("_")[1]))
+        # "return": per evaluation episode, an agent's summed reward averaged over the agents.
+        final = float(np.mean(steps[last]["return"]))
+    return {"seed": seed, "final_return": final, "wall_s": wall, "frames": experiment.total_frames, "folder": str(experiment.folder_name)}
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--algorithm", default="mappo", help=f"one of {sorted(ALGORITHMS)}")
+    p.add_argument("--task", default="aggregation", help="a colcos task (colcos.tasks())")
+    p.add_argument("--seeds", type=int, nargs="+", default=[0])
+    p.add_argument("--frames", type=int, default=600_000, help="agent-world steps of training (BenchMARL's frames)")
+    p.add_argument("--worlds", type=int, default=32, help="worlds stepped as one batch")
+    p.add_argument("--max-steps", type=int, default=500, help="steps per episode")
+    p.add_argument("--eval-every", type=int, default=5, help="evaluate every this many collected batches")
+    p.add_argument("--eval-episodes", type=int, default=8)
+    p.add_argument("--discrete", action="store_true", help="the discrete action variant (continuous=False)")
+    p.add_argument("--tiny", action="store_true", help="one small iteration (a check that it runs)")
+    p.add_argument("--threads", type=int, default=1, help="torch threads")
+    p.add_argument("--out", default="runs/benchmarl")
+    args = p.parse_args()
+    if args.algorithm not in ALGORITHMS:
+        p.error(f"--algorithm {args.algorithm!r}: one of {sorted(ALGORITHMS)}")
+    if args.task not in colcos.tasks():
+        p.error(f"--task {args.task!r}: one of {sorted(colcos.tasks())}")
+    if args.tiny:
+        args.worlds, args.max_steps, args.eval_episodes = 2, 20, 1
+    torch.set_num_threads(args.threads)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    runs = [run(args, seed, out) for seed in args.seeds]
+    episodes = 32
+    refs: dict[str, float] = {}
+    name = reference_policy(args.task)
+    if name is not None:
+        refs[name] = episode_return(args.task, lambda v: Baseline(v, name).act, args.max_steps, episodes, 12345)
+    refs["random"] = episode_return(args.task, lambda v: RandomPolicy(v, seed=1).act, args.max_steps, episodes, 12345)
+    finals = [r["final_return"] for r in runs if r["final_return"] is not None]
+    summary = {"algorithm": args.algorithm, "task": args.task, "continuous": not args.discrete, "runs": runs, "references": refs}
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    print(f"{args.algorithm} on {args.task} ({'discrete' if args.discrete else 'continuous'}), {args.frames} frames:")
+    for r in runs:
+        print(f"  seed {r['seed']}: final evaluation return {r['final_return']}, {r['wall_s']:.0f} s")
+    if finals:
+        print(f"  median {np.median(finals):.1f}, spread {np.min(finals):.1f} .. {np.max(finals):.1f}")
+    for k, v in refs.items():
+        print(f"  {k}: {v:.1f} (same measure, {episodes} episodes)")
+
+
+if __name__ == "__main__":
+    main()
