@@ -10,6 +10,7 @@
 
 pub mod arena;
 pub mod behaviour;
+pub mod channel;
 pub mod error;
 pub mod field;
 pub mod metrics;

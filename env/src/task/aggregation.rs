@@ -17,8 +17,8 @@
 //! action only, which is what makes the task learnable in minutes; the others are the state's cost.
 //! No termination: episodes end by truncation.
 use super::{Task, check_non_negative, parse_params, require_role};
-use crate::error::{EnvError, Result};
-use colcos_sim::behaviour::channel_index;
+use crate::error::Result;
+use colcos_sim::channel::Channel;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
 use glam::Vec2;
@@ -50,7 +50,7 @@ struct Params {
     /// Alarm level (0..1) above which a follower is in the alarm phase (the followers' default).
     alarm_threshold: f32,
     /// Screen channel of the alarm pheromone: "r", "g" or "b".
-    alarm_channel: String,
+    alarm_channel: Channel,
 }
 
 impl Default for Params {
@@ -65,7 +65,7 @@ impl Default for Params {
             progress_weight: 1.0,
             alarm_weight: 1.0,
             alarm_threshold: 0.05,
-            alarm_channel: "r".into(),
+            alarm_channel: Channel::R,
         }
     }
 }
@@ -90,12 +90,7 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
     let leader = require_role(scenario, &p.leader_role, "aggregation.leader_role")?[0];
     // A scenario without a predator is allowed: pure aggregation.
     let predators = super::robots_with_role(scenario, &p.predator_role);
-    let alarm_channel = channel_index(&p.alarm_channel).ok_or_else(|| {
-        EnvError::param(
-            "aggregation.alarm_channel",
-            format!("{:?} is not \"r\", \"g\" or \"b\"", p.alarm_channel),
-        )
-    })?;
+    let alarm_channel = p.alarm_channel.index();
     Ok(Box::new(Aggregation {
         agents,
         leader,

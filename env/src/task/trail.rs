@@ -8,7 +8,7 @@
 //! an outer wall, `[[obstacles]]`); the bumper penalty then also counts the walls.
 use super::{Task, check_non_negative, parse_params, require_role};
 use crate::error::{EnvError, Result};
-use colcos_sim::behaviour::channel_index;
+use colcos_sim::channel::Channel;
 use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
@@ -34,7 +34,7 @@ pub fn default_scenario(params: &serde_json::Value) -> &'static str {
 struct Params {
     agent_role: String,
     /// Channel of the trail to follow: "r", "g" or "b".
-    channel: String,
+    channel: Channel,
     bump_penalty: f32,
     /// The walled corridor: the built-in `trail_maze` scenario, or a scenario of one's own that
     /// lists `[[obstacles]]`.
@@ -45,7 +45,7 @@ impl Default for Params {
     fn default() -> Self {
         Params {
             agent_role: "agent".into(),
-            channel: "b".into(),
+            channel: Channel::B,
             bump_penalty: 0.1,
             maze: false,
         }
@@ -71,12 +71,7 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
         ));
     }
     let agents = require_role(scenario, &p.agent_role, "trail.agent_role")?;
-    let channel = channel_index(&p.channel).ok_or_else(|| {
-        EnvError::param(
-            "trail.channel",
-            format!("{:?} is not \"r\", \"g\" or \"b\"", p.channel),
-        )
-    })?;
+    let channel = p.channel.index();
     let max = scenario.spec.robot.max_wheel_speed;
     Ok(Box::new(Trail {
         agents,

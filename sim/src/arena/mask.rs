@@ -1,6 +1,7 @@
 //! Obstacles from an image mask: solid pixels -> the fewest simple boxes (runs of a row, merged with
 //! the same run in the rows below), so a maze drawn as a PNG costs a few hundred boxes, not a
 //! million pixels.
+use crate::channel::ImageChannel;
 use crate::error::{Result, SimError};
 use std::collections::HashMap;
 use std::path::Path;
@@ -14,34 +15,18 @@ pub struct MaskRect {
     pub y1: f32,
 }
 
-/// The solid rectangles of the PNG at `path`: pixels whose `channel` ("r", "g", "b", "a" or "luma",
-/// default "luma") is at least `threshold`. `pixels`, when given, is the size the image must have.
+/// The solid rectangles of the PNG at `path`: pixels whose `channel` (default luma) is at least
+/// `threshold`. `pixels`, when given, is the size the image must have.
 /// `key` names the image key in errors, `key_of` builds the names of its sibling keys.
 pub fn solid_rects(
     key: &str,
     path: &Path,
-    channel: Option<&str>,
+    channel: Option<ImageChannel>,
     threshold: u8,
     pixels: Option<[u32; 2]>,
     key_of: &dyn Fn(&str) -> String,
 ) -> Result<Vec<MaskRect>> {
-    let channel = channel.unwrap_or("luma");
-    let pick: fn(&[u8; 4]) -> u8 = match channel {
-        "r" => |p| p[0],
-        "g" => |p| p[1],
-        "b" => |p| p[2],
-        "a" => |p| p[3],
-        "luma" => {
-            |p| ((299 * p[0] as u32 + 587 * p[1] as u32 + 114 * p[2] as u32) / 1000).min(255) as u8
-        }
-        other => {
-            return Err(SimError::invalid(
-                key_of("channel"),
-                format!("\"{other}\""),
-                "must be \"r\", \"g\", \"b\", \"a\" or \"luma\"",
-            ));
-        }
-    };
+    let channel = channel.unwrap_or(ImageChannel::Luma);
     let img = image::open(path)
         .map_err(|e| {
             SimError::invalid(
@@ -68,7 +53,7 @@ pub fn solid_rects(
             "the mask image is empty",
         ));
     }
-    let solid = |x: u32, y: u32| pick(&img.get_pixel(x, y).0) >= threshold;
+    let solid = |x: u32, y: u32| channel.pick(&img.get_pixel(x, y).0) >= threshold;
     Ok(merge_runs(w, h, solid)
         .into_iter()
         .map(|(x0, y0, x1, y1)| MaskRect {

@@ -185,7 +185,7 @@ pub(super) fn add(
             let rects = mask::solid_rects(
                 &key("image"),
                 &base_dir.join(image),
-                spec.channel.as_deref(),
+                spec.channel,
                 spec.threshold.unwrap_or(128),
                 spec.pixels,
                 &key,

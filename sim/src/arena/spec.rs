@@ -64,7 +64,7 @@ pub struct ObstacleSpec {
     pub image: Option<String>,
     /// Channel read from the image: "r", "g", "b", "a" or "luma" (`mask`; default "luma").
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub channel: Option<String>,
+    pub channel: Option<crate::channel::ImageChannel>,
     /// Level (0-255) from which a pixel is solid (`mask`; default 128).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threshold: Option<u8>,

@@ -2,6 +2,7 @@
 //! off the trail.
 use super::param_doc::ParamDoc;
 use super::{Behaviour, Observation, Wander, WheelCommand};
+use crate::channel::Channel;
 use crate::rng::SimRng;
 use serde::{Deserialize, Serialize};
 
@@ -9,8 +10,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FollowParams {
-    /// Channel to follow: "r", "g" or "b".
-    pub channel: String,
+    /// Channel to follow.
+    pub channel: Channel,
     /// Base wheel speed, m/s.
     pub speed: f32,
     /// Wheel speed difference per unit of left-right intensity difference, m/s.
@@ -22,7 +23,7 @@ pub struct FollowParams {
 impl Default for FollowParams {
     fn default() -> Self {
         FollowParams {
-            channel: "b".into(),
+            channel: Channel::B,
             speed: 0.1,
             sensitivity: 0.6,
             threshold: 0.05,
@@ -58,16 +59,6 @@ impl FollowParams {
             meaning: "mean intensity of the channel below which the robot is off the trail and wanders",
         },
     ];
-}
-
-/// Parses "r" / "g" / "b" into a channel index.
-pub fn channel_index(name: &str) -> Option<usize> {
-    match name {
-        "r" | "red" => Some(0),
-        "g" | "green" => Some(1),
-        "b" | "blue" => Some(2),
-        _ => None,
-    }
 }
 
 pub struct Follow {

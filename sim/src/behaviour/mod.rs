@@ -11,7 +11,7 @@ pub mod registry;
 mod wander;
 
 pub use avoid::Avoid;
-pub use follow::{Follow, FollowParams, channel_index};
+pub use follow::{Follow, FollowParams};
 pub use observation::{
     BUMPER_FRONT, BUMPER_FRONT_LEFT, BUMPER_FRONT_RIGHT, Observation, WheelCommand,
 };

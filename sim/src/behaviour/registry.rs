@@ -1,6 +1,6 @@
 //! Behaviours by name, as scenario files refer to them. Every behaviour reads its parameters from the
 //! group's `params` table and rejects unknown keys.
-use super::follow::{FollowParams, channel_index};
+use super::follow::FollowParams;
 use super::paper::{FollowerParams, ForagingParams, LeaderParams};
 pub use super::param_doc::ParamDoc;
 use super::{Avoid, Behaviour, Follow, Wander};
@@ -199,13 +199,7 @@ fn build_avoid(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box<
 
 fn build_follow(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box<dyn Behaviour>> {
     let p: FollowParams = parse_params(params, key)?;
-    let channel = channel_index(&p.channel).ok_or_else(|| {
-        SimError::invalid(
-            format!("{key}.params.channel"),
-            format!("{:?}", p.channel),
-            "must be \"r\", \"g\" or \"b\"",
-        )
-    })?;
+    let channel = p.channel.index();
     let speed = speed_checked(key, p.speed)?;
     if !p.sensitivity.is_finite() {
         return Err(SimError::invalid(

@@ -1,5 +1,6 @@
 //! Static injection maps J from polylines and images.
 use super::GridSpec;
+use crate::channel::Channel;
 use crate::error::{Result, SimError};
 use glam::Vec2;
 
@@ -37,23 +38,20 @@ pub fn polyline_map(spec: &GridSpec, points: &[Vec2], width: f32, value: f32) ->
 }
 
 /// A PNG resampled onto the grid (stretched over the arena, top row of the image at y = height):
-/// `scale * level / 255` of the given channel (0 r, 1 g, 2 b; `None`: luma).
+/// `scale * level / 255` of the given colour channel (`None`: luma).
 ///
 /// Resampling is bilinear between pixel centres (clamped at the edges); luma is Rec. 601
 /// (`0.299 r + 0.587 g + 0.114 b`).
 pub fn image_map(
     spec: &GridSpec,
     path: &std::path::Path,
-    channel: Option<usize>,
+    channel: Option<Channel>,
     scale: f32,
 ) -> Result<Vec<f32>> {
     let err = |message: String| SimError::Image {
         path: path.display().to_string(),
         message,
     };
-    if let Some(c) = channel.filter(|&c| c > 2) {
-        return Err(err(format!("channel {c} does not exist (0 r, 1 g, 2 b)")));
-    }
     let img = image::open(path).map_err(|e| err(e.to_string()))?.to_rgb8();
     let (w, h) = (img.width() as usize, img.height() as usize);
     if w == 0 || h == 0 {
@@ -62,7 +60,7 @@ pub fn image_map(
     let level = |x: usize, y: usize| -> f32 {
         let p = img.get_pixel(x as u32, y as u32).0;
         match channel {
-            Some(c) => p[c] as f32,
+            Some(c) => p[c.index()] as f32,
             None => 0.299 * p[0] as f32 + 0.587 * p[1] as f32 + 0.114 * p[2] as f32,
         }
     };

@@ -178,8 +178,8 @@ pub struct MapSpec {
     pub width: Option<f32>,
     /// PNG path, relative to the scenario file.
     pub image: Option<String>,
-    /// Image channel to read: "r", "g", "b" or "luma".
-    pub channel: Option<String>,
+    /// Image channel to read: "r", "g", "b" or "luma" (default).
+    pub channel: Option<crate::channel::ImageChannel>,
     /// Injection rate J, units per second (at full image level).
     pub rate: f32,
 }

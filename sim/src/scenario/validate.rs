@@ -345,12 +345,11 @@ fn validate_map(key: &str, map: &MapSpec) -> Result<()> {
             }
         }
         (None, Some(_)) => {
-            if let Some(c) = &map.channel
-                && !["r", "g", "b", "luma"].contains(&c.as_str())
-            {
+            // Maps are read as RGB: their alpha is not a level.
+            if let Some(c @ crate::channel::ImageChannel::A) = map.channel {
                 return Err(SimError::invalid(
                     format!("{key}.channel"),
-                    format!("{c:?}"),
+                    format!("{:?}", c.name()),
                     "must be \"r\", \"g\", \"b\" or \"luma\"",
                 ));
             }

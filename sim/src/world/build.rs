@@ -275,11 +275,13 @@ fn build_map(scenario: &Scenario, _key: &str, map: &MapSpec, grid: &GridSpec) ->
     let path = scenario
         .base_dir
         .join(map.image.as_deref().unwrap_or_default());
-    let channel = match map.channel.as_deref() {
-        Some("r") => Some(0),
-        Some("g") => Some(1),
-        Some("b") => Some(2),
-        _ => None,
+    use crate::channel::{Channel, ImageChannel};
+    // Validation refused alpha for maps; luma is the default.
+    let channel = match map.channel {
+        Some(ImageChannel::R) => Some(Channel::R),
+        Some(ImageChannel::G) => Some(Channel::G),
+        Some(ImageChannel::B) => Some(Channel::B),
+        Some(ImageChannel::A | ImageChannel::Luma) | None => None,
     };
     image_map(grid, &path, channel, map.rate)
 }
