@@ -5,9 +5,14 @@ use glam::Vec2;
 use serde::{Deserialize, Serialize};
 
 mod expand;
+mod footprint;
 mod render;
 mod rows;
 mod simd;
+pub use footprint::{
+    FootprintLevels, FootprintSamples, LANES as FOOTPRINT_LANES, SAMPLES as FOOTPRINT_SAMPLES,
+    footprint_levels,
+};
 pub use render::ScreenRenderer;
 pub use rows::Instructions;
 

@@ -12,7 +12,7 @@ use super::pow_unit;
 use crate::arena::Printed;
 use crate::field::{FrozenSources, Pheromone};
 use crate::rng::SimRng;
-use crate::screen::ScreenSpec;
+use crate::screen::{FOOTPRINT_LANES, FootprintSamples, ScreenSpec, footprint_levels};
 use glam::Vec2;
 use serde::{Deserialize, Serialize};
 use std::sync::{Arc, Mutex};
@@ -68,6 +68,9 @@ pub struct ColourSensor {
     params: ColourSensorParams,
     /// Sample offsets of the footprint, m, relative to the sensor centre.
     offsets: [Vec2; RING_POINTS + 1],
+    /// `offsets` of four footprints as [`FootprintSamples`] lanes (x, y): lane `j < 36` holds
+    /// `offsets[j % 9]`, the padding lanes `offsets[0]`.
+    offset_lanes: ([f32; FOOTPRINT_LANES], [f32; FOOTPRINT_LANES]),
     /// `light` of the mean level, indexed by the sum of the footprint's 8-bit levels (the transfer
     /// curve costs a table lookup instead of a `powf` per channel and reading). Shared by every
     /// sensor with the same `gamma`: a batch of a thousand worlds reads one table that stays in cache,
@@ -137,9 +140,20 @@ impl ColourSensor {
         for (k, o) in offsets.iter_mut().skip(1).enumerate() {
             *o = ring * Vec2::from_angle(std::f32::consts::TAU * k as f32 / RING_POINTS as f32);
         }
+        let offset_of_lane = |j: usize| {
+            offsets[if j < 4 * FOOTPRINT_POINTS {
+                j % FOOTPRINT_POINTS
+            } else {
+                0
+            }]
+        };
         ColourSensor {
             params,
             offsets,
+            offset_lanes: (
+                std::array::from_fn(|j| offset_of_lane(j).x),
+                std::array::from_fn(|j| offset_of_lane(j).y),
+            ),
             light_by_sum: shared_light_table(params.gamma),
             crosstalk_lanes: matrix_lanes(&params.crosstalk),
             inverse_lanes: matrix_lanes(&inverse),
@@ -212,16 +226,32 @@ impl ColourSensor {
         let mut sums = [[0u32; 3]; S];
         for (sensors, sums) in sensors.chunks(BATCH).zip(sums.chunks_mut(BATCH)) {
             // Missing sensors of a short batch repeat the first: the batch stays one compact group of
-            // points (Gaussian sources take one `exp` per group, at its centroid).
-            let mut points = [Vec2::ZERO; BATCH * FOOTPRINT_POINTS];
-            for (k, points) in points.chunks_mut(FOOTPRINT_POINTS).enumerate() {
-                points.copy_from_slice(&self.sample_points(*sensors.get(k).unwrap_or(&sensors[0])));
+            // points (Gaussian sources take one `exp` per group, at its centroid). The padding lanes
+            // past the 36 samples repeat the first sample (see `FootprintSamples`).
+            // Each lane's sensor position (`fill` stores whole vectors), then `sample_points`' sum
+            // `offset + p` over whole vectors.
+            let (mut px, mut py) = (
+                [sensors[0].x; FOOTPRINT_LANES],
+                [sensors[0].y; FOOTPRINT_LANES],
+            );
+            for (s, p) in sensors.iter().enumerate().skip(1) {
+                px[s * FOOTPRINT_POINTS..(s + 1) * FOOTPRINT_POINTS].fill(p.x);
+                py[s * FOOTPRINT_POINTS..(s + 1) * FOOTPRINT_POINTS].fill(p.y);
             }
-            let mut levels =
-                crate::screen::levels_at(pheromones, frozen, screen, &points, points.len());
+            let (ox, oy) = &self.offset_lanes;
+            let samples = FootprintSamples {
+                xs: std::array::from_fn(|j| ox[j] + px[j]),
+                ys: std::array::from_fn(|j| oy[j] + py[j]),
+            };
+            let mut levels = footprint_levels(pheromones, frozen, screen, &samples);
             if let Some(printed) = printed {
-                for (k, p) in points.iter().enumerate() {
-                    if let Some(c) = printed.colour_at(screen, *p) {
+                let points = samples
+                    .xs
+                    .iter()
+                    .zip(&samples.ys)
+                    .take(BATCH * FOOTPRINT_POINTS);
+                for (k, (&x, &y)) in points.enumerate() {
+                    if let Some(c) = printed.colour_at(screen, Vec2::new(x, y)) {
                         for (ch, v) in c.iter().enumerate() {
                             levels[ch][k] = *v as u32;
                         }
