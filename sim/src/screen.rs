@@ -9,6 +9,8 @@ mod footprint;
 mod render;
 mod rows;
 mod simd;
+#[cfg(target_arch = "x86_64")]
+pub use footprint::footprint_levels_avx2;
 pub use footprint::{
     FootprintLevels, FootprintSamples, LANES as FOOTPRINT_LANES, SAMPLES as FOOTPRINT_SAMPLES,
     footprint_levels,

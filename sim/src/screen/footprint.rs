@@ -40,10 +40,13 @@ pub fn footprint_levels(
 }
 
 /// [`footprint_levels`] in AVX2 registers: no fused multiply-add, so the same bits as the portable
-/// code (as for [`super::levels_at`]).
+/// code (as for [`super::levels_at`]). For callers already compiled for AVX2 (no second dispatch).
+///
+/// # Safety
+/// The CPU has AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn footprint_levels_avx2(
+pub unsafe fn footprint_levels_avx2(
     pheromones: &[Pheromone],
     frozen: &FrozenSources,
     screen: &ScreenSpec,

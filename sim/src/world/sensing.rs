@@ -158,7 +158,7 @@ pub fn sense(
                 }
             }
             None => {
-                o.counts = sensor.read_all_printed(
+                (o.counts, o.intensity) = sensor.read_robot(
                     pheromones,
                     frozen,
                     screen,
@@ -166,7 +166,6 @@ pub fn sense(
                     &sensor_points[i],
                     &mut slot.rng,
                 );
-                o.intensity = sensor.intensities(&o.counts);
             }
         }
         o.bumpers = neighbours.bumpers_with(i, poses, radius, arena, bumper, obstacles);
