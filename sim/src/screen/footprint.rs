@@ -148,9 +148,14 @@ mod tests {
             cell: 0.024,
         };
         let mut g = GridField::new(spec, GridParams::default());
-        g.values_mut()
-            .iter_mut()
-            .for_each(|v| *v = rng.random_range(0.0..1.5));
+        // A few infinite and NaN cells: a channel no pheromone colours (blue) still reads 0 there.
+        g.values_mut().iter_mut().for_each(|v| {
+            *v = match rng.random_range(0..200) {
+                0 => f32::INFINITY,
+                1 => f32::NAN,
+                _ => rng.random_range(0.0..1.5),
+            }
+        });
         let source = |sigma: f32, rho: f32, centre: Vec2| GaussianSource {
             k: 0.8,
             sigma_x: sigma,
@@ -176,7 +181,7 @@ mod tests {
             },
             Pheromone {
                 name: "gauss".into(),
-                colour: [0.0, 255.0, 90.0],
+                colour: [0.0, 255.0, 0.0],
                 model: FieldModel::Gaussian(gaussian),
             },
         ];
