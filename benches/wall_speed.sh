@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Wall-time agent-steps/s of two builds of `throughput` (an older commit's and this one's), run
+# Wall-time (and CPU-time) agent-steps/s of two builds of `throughput` (an older commit's and this one's), run
 # alternately so that both see the same load, for the disc solver and rapier; prints every run and
 # the medians. The machine's own thread count unless RAYON_NUM_THREADS says otherwise.
 #
@@ -29,7 +29,20 @@ while [ $# -gt 0 ]; do
     esac
 done
 
-rate() { "$1" aggregation "$worlds" "$steps" - "$2" | grep -o '[0-9]* agent-steps/s' | grep -o '^[0-9]*'; }
+# Agent-steps per second of wall time, and per second of CPU time (user + system, from
+# /usr/bin/time): on a machine shared with other jobs the wall time scatters with their load, the CPU
+# time much less.
+cpu_file=$(mktemp)
+trap 'rm -f "$cpu_file"' EXIT
+rate() {
+    local out
+    out=$(/usr/bin/time -f '%U %S' -o "$cpu_file" "$1" aggregation "$worlds" "$steps" - "$2")
+    local agents
+    agents=$(grep -o 'worlds x [0-9]* agents' <<<"$out" | grep -o '[0-9]* agents' | grep -o '[0-9]*')
+    local per_cpu
+    per_cpu=$(awk -v n=$((worlds * agents * steps)) '{ printf "%.0f", n / ($1 + $2) }' "$cpu_file")
+    echo "$(grep -o '[0-9]* agent-steps/s' <<<"$out" | grep -o '^[0-9]*')/$per_cpu"
+}
 median() { tr ' ' '\n' | grep . | sort -n | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 echo "throughput aggregation $worlds $steps, $runs runs each, alternated; $(nproc) cores"
@@ -40,10 +53,13 @@ for physics in discs rapier; do
         o="$o $(rate "$old" "$physics")"
         n="$n $(rate "$new" "$physics")"
     done
-    mo=$(echo "$o" | median)
-    mn=$(echo "$n" | median)
-    echo "$physics old:$o"
-    echo "$physics new:$n"
-    awk -v p="$physics" -v a="$mo" -v b="$mn" \
-        'BEGIN { printf "%s median agent-steps/s: old %.0f, new %.0f, new/old %.3f\n", p, a, b, b / a }'
+    echo "$physics old (wall/cpu):$o"
+    echo "$physics new (wall/cpu):$n"
+    for k in 1 2; do
+        what=$([ $k = 1 ] && echo "agent-steps/s of wall time" || echo "agent-steps per CPU-second")
+        mo=$(echo "$o" | tr ' ' '\n' | grep . | cut -d/ -f$k | tr '\n' ' ' | median)
+        mn=$(echo "$n" | tr ' ' '\n' | grep . | cut -d/ -f$k | tr '\n' ' ' | median)
+        awk -v p="$physics" -v w="$what" -v a="$mo" -v b="$mn" \
+            'BEGIN { printf "%s median %s: old %.0f, new %.0f, new/old %.3f\n", p, w, a, b, b / a }'
+    done
 done
