@@ -67,8 +67,14 @@ pub fn stream_of(seed: u64, world: u64, which: Stream) -> SimRng {
 /// colour sensors draw twelve per step.
 #[inline]
 pub fn normal(rng: &mut SimRng) -> f32 {
+    normal_with(ziggurat(), rng)
+}
+
+/// [`normal`] with the tables fetched once by the caller ([`ziggurat`]): a robot's twelve draws check
+/// the tables' one-time initialisation once.
+#[inline(always)]
+pub fn normal_with(z: &Ziggurat, rng: &mut SimRng) -> f32 {
     use rand::Rng;
-    let z = ziggurat();
     let bits = rng.next_u64();
     // Layer from the low 7 bits, value from the high 32: independent bits (Doornik 2005: taking both
     // from one 32-bit word correlates them).
@@ -97,7 +103,8 @@ const ZIG_R: f64 = 3.442619855899;
 /// Area of each layer (and of the base strip with the tail).
 const ZIG_V: f64 = 9.91256303526217e-3;
 
-fn ziggurat() -> &'static Ziggurat {
+/// The ziggurat's tables, built once per process.
+pub fn ziggurat() -> &'static Ziggurat {
     static TABLES: std::sync::OnceLock<Ziggurat> = std::sync::OnceLock::new();
     TABLES.get_or_init(Ziggurat::new)
 }

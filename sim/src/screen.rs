@@ -5,9 +5,16 @@ use glam::Vec2;
 use serde::{Deserialize, Serialize};
 
 mod expand;
+mod footprint;
 mod render;
 mod rows;
 mod simd;
+#[cfg(target_arch = "x86_64")]
+pub use footprint::footprint_levels_avx2;
+pub use footprint::{
+    FootprintLevels, FootprintSamples, LANES as FOOTPRINT_LANES, SAMPLES as FOOTPRINT_SAMPLES,
+    footprint_levels,
+};
 pub use render::ScreenRenderer;
 pub use rows::Instructions;
 

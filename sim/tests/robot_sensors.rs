@@ -1,8 +1,8 @@
 //! IR bumpers, neighbour index, and the colour-sensor layout.
 use colcos_sim::robot::Pose;
 use colcos_sim::sensors::{
-    BumperParams, BumperRays, NeighbourIndex, SENSOR_RADIUS, ray_disc, reading_for_distance,
-    sensor_positions,
+    BumperParams, BumperRays, NeighbourIndex, SENSOR_RADIUS, ray_disc, ray_walls,
+    reading_for_distance, sensor_positions, sensor_positions_facing,
 };
 use glam::Vec2;
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4};
@@ -155,4 +155,36 @@ fn sensor_positions_follow_the_heading() {
     assert!(close(s[1], Vec2::new(1.0, 2.0 + r)));
     assert!(close(s[2], Vec2::new(1.0 - r, 2.0)));
     assert!(close(s[3], Vec2::new(1.0, 2.0 - r)));
+}
+
+/// A lone robot's wall readings (which skip the wall test far from every wall) equal the readings of
+/// `ray_walls` itself, bit for bit, over the whole arena and every heading; and the sensor positions
+/// from a precomputed heading vector are `sensor_positions`'.
+#[test]
+fn wall_readings_equal_ray_walls_everywhere() {
+    let params = BumperParams::default();
+    let arena = Vec2::new(1.2, 0.8);
+    let mut lit = 0;
+    for i in 0..=240 {
+        for j in 0..=160 {
+            let pose = Pose::new(
+                -0.002 + i as f32 * 0.005,
+                -0.002 + j as f32 * 0.005,
+                (i * 7 + j * 13) as f32 * 0.1,
+            );
+            let got = readings(&[pose], arena, 0);
+            let want = params.angles.map(|a| {
+                let d = pose.forward().rotate(Vec2::from_angle(a));
+                let t = ray_walls(pose.pos + R * d, d, arena);
+                reading_for_distance(params.range.min(t), params.range)
+            });
+            assert_eq!(got, want, "at {pose:?}");
+            lit += usize::from(got.iter().any(|&r| r > 0.0));
+            assert_eq!(
+                sensor_positions_facing(&pose, pose.forward(), SENSOR_RADIUS),
+                sensor_positions(&pose, SENSOR_RADIUS)
+            );
+        }
+    }
+    assert!(lit > 1000, "only {lit} poses see a wall");
 }

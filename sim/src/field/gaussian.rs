@@ -1,5 +1,6 @@
 //! Gaussian-source model, eq. (5).
 #![allow(clippy::neg_cmp_op_on_partial_ord)] // NaN-aware test
+use super::NearbyPoints;
 use glam::Vec2;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -214,68 +215,6 @@ impl FrozenSource {
 
 /// The most points that share one `exp` per source (a robot's 36 footprint samples fit).
 pub const MAX_GROUP: usize = 64;
-
-/// A group of at most `G` points close together (a robot's footprints), seen from their centroid:
-/// the offsets, their squares and products, and their largest magnitudes, computed once and shared
-/// by every Gaussian source ([`FrozenSource::add_values_near`]).
-pub struct NearbyPoints<const G: usize> {
-    len: usize,
-    centroid: (f32, f32),
-    max_offset: (f32, f32),
-    ex: [f32; G],
-    ey: [f32; G],
-    exx: [f32; G],
-    eyy: [f32; G],
-    exy: [f32; G],
-}
-
-impl<const G: usize> NearbyPoints<G> {
-    /// The first `G` of the points `(xs[k], ys[k])`.
-    #[inline(always)]
-    pub fn new(xs: &[f32], ys: &[f32]) -> Self {
-        let n = xs.len().min(ys.len()).min(G);
-        let (xs, ys) = (&xs[..n], &ys[..n]);
-        // The centroid summed in eight interleaved lanes (vectorises; a plain running sum is one long
-        // chain of dependent additions). A single point is its own centroid.
-        let (mut sx, mut sy) = ([0f32; 8], [0f32; 8]);
-        for (xs, ys) in xs.chunks(8).zip(ys.chunks(8)) {
-            for (k, (&x, &y)) in xs.iter().zip(ys).enumerate() {
-                sx[k] += x;
-                sy[k] += y;
-            }
-        }
-        let inv_n = 1.0 / n.max(1) as f32;
-        let (cx, cy) = (
-            sx.iter().sum::<f32>() * inv_n,
-            sy.iter().sum::<f32>() * inv_n,
-        );
-        let mut near = NearbyPoints {
-            len: n,
-            centroid: (cx, cy),
-            max_offset: (0.0, 0.0),
-            ex: [0.0; G],
-            ey: [0.0; G],
-            exx: [0.0; G],
-            eyy: [0.0; G],
-            exy: [0.0; G],
-        };
-        // Largest magnitudes as integers: the bits of non-negative floats order as the floats (and a
-        // NaN offset, above infinity, makes the bound NaN: the per-point path).
-        let (mut mx, mut my) = (0u32, 0u32);
-        for k in 0..n {
-            let (ex, ey) = (xs[k] - cx, ys[k] - cy);
-            near.ex[k] = ex;
-            near.ey[k] = ey;
-            near.exx[k] = ex * ex;
-            near.eyy[k] = ey * ey;
-            near.exy[k] = ex * ey;
-            mx = mx.max(ex.abs().to_bits());
-            my = my.max(ey.abs().to_bits());
-        }
-        near.max_offset = (f32::from_bits(mx), f32::from_bits(my));
-        near
-    }
-}
 
 /// Changes of the exponent (the sum of its terms' magnitudes) up to which [`exp_series`] stands in
 /// for `exp`: the exponent of a source of sigma 0.4 m changes by at most ~0.16 over a robot's

@@ -9,6 +9,7 @@ mod grid;
 mod grid_prefetch;
 mod grid_sampler;
 mod kernel;
+mod nearby;
 mod pheromone;
 mod static_map;
 mod step_plan;
@@ -16,7 +17,7 @@ mod step_plan;
 pub use backend::{BackendChoice, FieldBackend};
 pub use cells::CellBuffer;
 pub use frozen::FrozenSources;
-pub use gaussian::{FrozenSource, GaussianField, GaussianSource, MAX_GROUP, NearbyPoints};
+pub use gaussian::{FrozenSource, GaussianField, GaussianSource, MAX_GROUP};
 pub(crate) use grid::lerp_index;
 pub use grid::{
     Bilinear, DiffusionScheme, GridBand, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,
@@ -25,6 +26,7 @@ pub use grid::{
 pub use grid_prefetch::GridPrefetcher;
 pub(crate) use grid_sampler::GridSampler;
 pub use kernel::Kernel;
+pub use nearby::NearbyPoints;
 pub use pheromone::{FieldModel, Pheromone};
 pub use static_map::{image_map, polyline_map};
 pub use step_plan::{Diffusion, EXPLICIT_MAX_R, ONE_SIDED_MAX_S, StepPlan, WIND_MAX_CFL, Wind};

@@ -9,10 +9,19 @@
 //! sums to 1.16), well below saturation with room for noise; at 40 ms or more white saturates every
 //! channel (`1500 * 40 * 1.11 > 65,535`), as a real TCS34725 does with too long an integration time.
 use super::pow_unit;
+#[cfg(test)]
+use lanes::round_count;
+use lanes::{LANES, matrix_lanes};
+
+mod lanes;
 use crate::arena::Printed;
 use crate::field::{FrozenSources, Pheromone};
 use crate::rng::SimRng;
-use crate::screen::ScreenSpec;
+#[cfg(target_arch = "x86_64")]
+use crate::screen::footprint_levels_avx2;
+use crate::screen::{
+    FOOTPRINT_LANES, FootprintLevels, FootprintSamples, ScreenSpec, footprint_levels,
+};
 use glam::Vec2;
 use serde::{Deserialize, Serialize};
 use std::sync::{Arc, Mutex};
@@ -68,6 +77,9 @@ pub struct ColourSensor {
     params: ColourSensorParams,
     /// Sample offsets of the footprint, m, relative to the sensor centre.
     offsets: [Vec2; RING_POINTS + 1],
+    /// `offsets` of four footprints as [`FootprintSamples`] lanes (x, y): lane `j < 36` holds
+    /// `offsets[j % 9]`, the padding lanes `offsets[0]`.
+    offset_lanes: ([f32; FOOTPRINT_LANES], [f32; FOOTPRINT_LANES]),
     /// `light` of the mean level, indexed by the sum of the footprint's 8-bit levels (the transfer
     /// curve costs a table lookup instead of a `powf` per channel and reading). Shared by every
     /// sensor with the same `gamma`: a batch of a thousand worlds reads one table that stays in cache,
@@ -137,9 +149,20 @@ impl ColourSensor {
         for (k, o) in offsets.iter_mut().skip(1).enumerate() {
             *o = ring * Vec2::from_angle(std::f32::consts::TAU * k as f32 / RING_POINTS as f32);
         }
+        let offset_of_lane = |j: usize| {
+            offsets[if j < 4 * FOOTPRINT_POINTS {
+                j % FOOTPRINT_POINTS
+            } else {
+                0
+            }]
+        };
         ColourSensor {
             params,
             offsets,
+            offset_lanes: (
+                std::array::from_fn(|j| offset_of_lane(j).x),
+                std::array::from_fn(|j| offset_of_lane(j).y),
+            ),
             light_by_sum: shared_light_table(params.gamma),
             crosstalk_lanes: matrix_lanes(&params.crosstalk),
             inverse_lanes: matrix_lanes(&inverse),
@@ -206,31 +229,65 @@ impl ColourSensor {
         printed: Option<&Printed>,
         sensors: &[Vec2; S],
     ) -> [[u32; 3]; S] {
+        let levels =
+            |samples: &FootprintSamples| footprint_levels(pheromones, frozen, screen, samples);
+        self.footprint_sums_with(screen, printed, sensors, levels)
+    }
+
+    /// [`ColourSensor::footprint_sums_printed`] with the screen's levels from `levels` (one of
+    /// [`footprint_levels`]'s implementations), inlined into its caller.
+    #[inline(always)]
+    fn footprint_sums_with<const S: usize>(
+        &self,
+        screen: &ScreenSpec,
+        printed: Option<&Printed>,
+        sensors: &[Vec2; S],
+        levels: impl Fn(&FootprintSamples) -> FootprintLevels,
+    ) -> [[u32; 3]; S] {
         // Const-generic array lengths cannot be computed (`S * 9`) on stable Rust: up to four sensors
         // go through one fixed-size batch, more in batches of four.
         const BATCH: usize = 4;
         let mut sums = [[0u32; 3]; S];
         for (sensors, sums) in sensors.chunks(BATCH).zip(sums.chunks_mut(BATCH)) {
             // Missing sensors of a short batch repeat the first: the batch stays one compact group of
-            // points (Gaussian sources take one `exp` per group, at its centroid).
-            let mut points = [Vec2::ZERO; BATCH * FOOTPRINT_POINTS];
-            for (k, points) in points.chunks_mut(FOOTPRINT_POINTS).enumerate() {
-                points.copy_from_slice(&self.sample_points(*sensors.get(k).unwrap_or(&sensors[0])));
+            // points (Gaussian sources take one `exp` per group, at its centroid). The padding lanes
+            // past the 36 samples repeat the first sample (see `FootprintSamples`).
+            // Each lane's sensor position (`fill` stores whole vectors), then `sample_points`' sum
+            // `offset + p` over whole vectors.
+            let (mut px, mut py) = (
+                [sensors[0].x; FOOTPRINT_LANES],
+                [sensors[0].y; FOOTPRINT_LANES],
+            );
+            for (s, p) in sensors.iter().enumerate().skip(1) {
+                px[s * FOOTPRINT_POINTS..(s + 1) * FOOTPRINT_POINTS].fill(p.x);
+                py[s * FOOTPRINT_POINTS..(s + 1) * FOOTPRINT_POINTS].fill(p.y);
             }
-            let mut levels =
-                crate::screen::levels_at(pheromones, frozen, screen, &points, points.len());
+            let (ox, oy) = &self.offset_lanes;
+            let samples = FootprintSamples {
+                xs: std::array::from_fn(|j| ox[j] + px[j]),
+                ys: std::array::from_fn(|j| oy[j] + py[j]),
+            };
+            let mut levels = levels(&samples);
             if let Some(printed) = printed {
-                for (k, p) in points.iter().enumerate() {
-                    if let Some(c) = printed.colour_at(screen, *p) {
+                let points = samples
+                    .xs
+                    .iter()
+                    .zip(&samples.ys)
+                    .take(BATCH * FOOTPRINT_POINTS);
+                for (k, (&x, &y)) in points.enumerate() {
+                    if let Some(c) = printed.colour_at(screen, Vec2::new(x, y)) {
                         for (ch, v) in c.iter().enumerate() {
                             levels[ch][k] = *v as u32;
                         }
                     }
                 }
             }
+            // A footprint's nine levels as eight (one vector reduction) and one.
             for (c, levels) in levels.iter().enumerate() {
-                for (sum, levels) in sums.iter_mut().zip(levels.chunks(FOOTPRINT_POINTS)) {
-                    sum[c] = levels.iter().sum();
+                for (s, sum) in sums.iter_mut().enumerate() {
+                    let first = s * FOOTPRINT_POINTS;
+                    let eight: &[u32; 8] = levels[first..first + 8].try_into().expect("8 lanes");
+                    sum[c] = eight.iter().sum::<u32>() + levels[first + 8];
                 }
             }
         }
@@ -291,6 +348,70 @@ impl ColourSensor {
         self.counts_for_lights(&light, rng)
     }
 
+    /// A robot's four sensors read as [`ColourSensor::read_all_printed`] does (the same random draws
+    /// and counts), with their calibrated [`ColourSensor::intensities`]: the whole read compiled for
+    /// AVX2 where the processor has it (no fused multiply-add, so the same bits), its twelve channels
+    /// in wider registers.
+    pub fn read_robot(
+        &self,
+        pheromones: &[Pheromone],
+        frozen: &FrozenSources,
+        screen: &ScreenSpec,
+        printed: Option<&Printed>,
+        sensors: &[Vec2; 4],
+        rng: &mut SimRng,
+    ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            return unsafe {
+                self.read_robot_avx2(pheromones, frozen, screen, printed, sensors, rng)
+            };
+        }
+        let levels =
+            |samples: &FootprintSamples| footprint_levels(pheromones, frozen, screen, samples);
+        self.read_robot_inline(screen, printed, sensors, rng, levels)
+    }
+
+    /// [`ColourSensor::read_robot`] for AVX2.
+    ///
+    /// # Safety
+    /// The CPU has AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn read_robot_avx2(
+        &self,
+        pheromones: &[Pheromone],
+        frozen: &FrozenSources,
+        screen: &ScreenSpec,
+        printed: Option<&Printed>,
+        sensors: &[Vec2; 4],
+        rng: &mut SimRng,
+    ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
+        let levels = |samples: &FootprintSamples| {
+            // SAFETY: the CPU has AVX2 (this function's contract).
+            unsafe { footprint_levels_avx2(pheromones, frozen, screen, samples) }
+        };
+        self.read_robot_inline(screen, printed, sensors, rng, levels)
+    }
+
+    /// [`ColourSensor::read_robot`] with the screen's levels from `levels`.
+    #[inline(always)]
+    fn read_robot_inline(
+        &self,
+        screen: &ScreenSpec,
+        printed: Option<&Printed>,
+        sensors: &[Vec2; 4],
+        rng: &mut SimRng,
+        levels: impl Fn(&FootprintSamples) -> FootprintLevels,
+    ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
+        let sums = self.footprint_sums_with(screen, printed, sensors, levels);
+        let lut = &self.light_by_sum;
+        let light = sums.map(|sum| sum.map(|s| lut[s as usize]));
+        let counts = self.counts_for_lights(&light, rng);
+        (counts, self.intensities_inline(&counts))
+    }
+
     /// Counts of one sensor whose footprint level sum is `sum` (one of
     /// [`ColourSensor::footprint_sums_printed`]'s), drawing what `read_all_printed` of that sensor
     /// draws: sensors with models of their own share one batched footprint pass.
@@ -309,119 +430,6 @@ impl ColourSensor {
     pub fn counts(&self, levels: [f32; 3], rng: &mut SimRng) -> [u16; 3] {
         self.counts_for_lights(&[self.light(levels)], rng)[0]
     }
-
-    /// Counts of `S` sensors from their light per primary. The noise is drawn first, sensor by sensor
-    /// in r, g, b order; the arithmetic then runs over the lanes of up to four sensors (vectorises).
-    fn counts_for_lights<const S: usize>(
-        &self,
-        light: &[[f32; 3]; S],
-        rng: &mut SimRng,
-    ) -> [[u16; 3]; S] {
-        let p = &self.params;
-        let scale = p.gain * p.integration_ms;
-        let mut out = [[0u16; 3]; S];
-        for (light, out) in light.chunks(LANE_SENSORS).zip(out.chunks_mut(LANE_SENSORS)) {
-            let mut noise = [0.0f32; LANES];
-            if p.noise > 0.0 {
-                for s in 0..light.len() {
-                    for c in 0..3 {
-                        noise[lane(s, c)] = p.noise * crate::rng::normal(rng);
-                    }
-                }
-            }
-            let [r, g, b] = spread(light);
-            let m = &self.crosstalk_lanes;
-            let mut counts = [0u16; LANES];
-            for i in 0..LANES {
-                let signal = m[0][i] * r[i] + m[1][i] * g[i] + m[2][i] * b[i];
-                let dark = self.dark[i / LANE_SENSORS];
-                counts[i] = round_count(dark + scale * signal + noise[i]);
-            }
-            for (s, out) in out.iter_mut().enumerate() {
-                *out = std::array::from_fn(|c| counts[lane(s, c)]);
-            }
-        }
-        out
-    }
-
-    /// Calibrated inverse: counts back to screen intensity in [0, 1] per channel.
-    ///
-    /// Subtracts the dark counts, divides by gain and integration time, undoes the crosstalk, clamps
-    /// the light to [0, 1] and inverts the transfer curve: `intensity = light^(1 / gamma)`, which is
-    /// `level / 255`. A saturated channel (65535) reads 1.
-    pub fn intensity(&self, counts: [u16; 3]) -> [f32; 3] {
-        self.intensities(&[counts])[0]
-    }
-
-    /// [`ColourSensor::intensity`] of `S` sensors, computed over the lanes of up to four sensors (the
-    /// transfer curve's inverse by [`pow_unit`], so that it vectorises): the same values as `S` calls.
-    pub fn intensities<const S: usize>(&self, counts: &[[u16; 3]; S]) -> [[f32; 3]; S] {
-        let p = &self.params;
-        let scale = p.gain * p.integration_ms;
-        let inv_gamma = if p.gamma > 0.0 { 1.0 / p.gamma } else { 1.0 };
-        let mut out = [[0.0f32; 3]; S];
-        for (counts, out) in counts
-            .chunks(LANE_SENSORS)
-            .zip(out.chunks_mut(LANE_SENSORS))
-        {
-            let mut signal = [[0.0f32; 3]; LANE_SENSORS];
-            if scale > 0.0 {
-                for (signal, counts) in signal.iter_mut().zip(counts) {
-                    *signal = std::array::from_fn(|c| (counts[c] as f32 - self.dark[c]) / scale);
-                }
-            }
-            let [r, g, b] = spread(&signal);
-            let m = &self.inverse_lanes;
-            let mut v = [0.0f32; LANES];
-            for i in 0..LANES {
-                let light = m[0][i] * r[i] + m[1][i] * g[i] + m[2][i] * b[i];
-                // NaN (from an infinite gain) reads as no light.
-                let light = if light > 0.0 { light.min(1.0) } else { 0.0 };
-                v[i] = pow_unit(light, inv_gamma);
-            }
-            for (s, (out, counts)) in out.iter_mut().zip(counts).enumerate() {
-                *out = std::array::from_fn(|c| {
-                    if counts[c] == u16::MAX {
-                        1.0
-                    } else {
-                        v[lane(s, c)]
-                    }
-                });
-            }
-        }
-        out
-    }
-}
-
-/// Sensors whose channels are computed together: a robot's four.
-const LANE_SENSORS: usize = 4;
-/// Their channels, channel-major: lane `4 c + s` is channel `c` of sensor `s`, so that a 3x3 channel
-/// matrix applies as three multiply-adds over whole lanes.
-const LANES: usize = 3 * LANE_SENSORS;
-
-#[inline(always)]
-fn lane(sensor: usize, channel: usize) -> usize {
-    LANE_SENSORS * channel + sensor
-}
-
-/// Each input channel of up to four sensors repeated in every channel's lanes: `[k][lane(s, c)]` is
-/// `values[s][k]` (0 past the last sensor).
-#[inline(always)]
-fn spread(values: &[[f32; 3]]) -> [[f32; LANES]; 3] {
-    let mut out = [[0.0f32; LANES]; 3];
-    for (k, out) in out.iter_mut().enumerate() {
-        for (s, v) in values.iter().enumerate().take(LANE_SENSORS) {
-            for c in 0..3 {
-                out[lane(s, c)] = v[k];
-            }
-        }
-    }
-    out
-}
-
-/// A 3x3 channel matrix as lanes: `[k][lane(s, c)]` is `m[c][k]`.
-fn matrix_lanes(m: &[[f32; 3]; 3]) -> [[f32; LANES]; 3] {
-    std::array::from_fn(|k| std::array::from_fn(|i| m[i / LANE_SENSORS][k]))
 }
 
 /// The display's transfer curve: light in [0, 1] of one primary at an 8-bit `level` (NaN gives 0).
@@ -437,18 +445,6 @@ fn light_of_level(level: f32, gamma: f32) -> f32 {
 /// Mean level of a footprint from the sum of its samples' levels.
 fn mean_level(sum: u32) -> f32 {
     sum as f32 / FOOTPRINT_POINTS as f32
-}
-
-/// `raw.clamp(0, 65535).round() as u16` (NaN gives 0) without a libm `roundf` call: below 2^16 the
-/// truncation and the fraction are exact in f32.
-#[inline(always)]
-fn round_count(raw: f32) -> u16 {
-    let c = if raw > 0.0 { raw.min(65535.0) } else { 0.0 };
-    // SAFETY: `c` is in [0, 65535] (NaN went to 0 above), so the truncation is in range; the plain
-    // conversion (not the saturating `as`) is what vectorises. Rounding up never passes 65535: a
-    // fraction of one half needs `c >= t + 0.5`, so `t <= 65534`.
-    let t = unsafe { c.to_int_unchecked::<i32>() };
-    (t + i32::from(c - t as f32 >= 0.5)) as u16
 }
 
 #[cfg(test)]

@@ -14,3 +14,15 @@ pub fn sensor_positions(pose: &Pose, r: f32) -> [Vec2; 4] {
         pose.to_world(Vec2::new(-r, 0.0)),
     ]
 }
+
+/// [`sensor_positions`] with the pose's heading vector (`pose.forward()`) computed by the caller:
+/// the same positions (`to_world` is `pos + forward.rotate(local)`).
+pub fn sensor_positions_facing(pose: &Pose, forward: Vec2, r: f32) -> [Vec2; 4] {
+    [
+        Vec2::new(0.0, -r),
+        Vec2::new(r, 0.0),
+        Vec2::new(0.0, r),
+        Vec2::new(-r, 0.0),
+    ]
+    .map(|local| pose.pos + forward.rotate(local))
+}

@@ -8,7 +8,7 @@ use crate::robot::Pose;
 use crate::screen::ScreenSpec;
 use crate::sensors::{
     BumperParams, BumperRays, ColourCalibration, ColourSensor, ColourSensorParams, NeighbourIndex,
-    SENSOR_RADIUS, sensor_positions,
+    SENSOR_RADIUS, sensor_positions_facing,
 };
 use glam::Vec2;
 use rayon::prelude::*;
@@ -32,6 +32,9 @@ pub struct Sensing {
     positions: Vec<Vec2>,
     /// The four sensor positions of every robot at the indexed poses.
     sensor_points: Vec<[Vec2; 4]>,
+    /// Every robot's heading vector at the indexed poses (one `sin_cos` for its colour sensors and
+    /// bumpers).
+    forwards: Vec<Vec2>,
     observations: Vec<Observation>,
 }
 
@@ -54,6 +57,7 @@ impl Sensing {
             obstacles: Arc::default(),
             positions: Vec::new(),
             sensor_points: Vec::new(),
+            forwards: Vec::new(),
             observations: vec![Observation::default(); robots],
         }
     }
@@ -101,10 +105,15 @@ pub fn index(sensing: &mut Sensing, poses: &[Pose]) {
         .neighbours
         .rebuild(sensing.arena, cell, &sensing.positions);
     // Sensor positions once per robot: sensing reads robot i's, prefetching robot i + 1's.
+    sensing.forwards.clear();
+    sensing.forwards.extend(poses.iter().map(Pose::forward));
     sensing.sensor_points.clear();
-    sensing
-        .sensor_points
-        .extend(poses.iter().map(|p| sensor_positions(p, SENSOR_RADIUS)));
+    sensing.sensor_points.extend(
+        poses
+            .iter()
+            .zip(&sensing.forwards)
+            .map(|(p, f)| sensor_positions_facing(p, *f, SENSOR_RADIUS)),
+    );
 }
 
 /// Stage `sense`: every robot's observation at `time` from the screen that `fields` draw, at the poses
@@ -121,7 +130,7 @@ pub fn sense(
     time: f32,
 ) {
     fields.freeze();
-    let sensor_points = &sensing.sensor_points;
+    let (sensor_points, forwards) = (&sensing.sensor_points, &sensing.forwards);
     let (pheromones, frozen) = (fields.pheromones(), fields.frozen());
     let (sensor, neighbours, bumper) = (&sensing.sensor, &sensing.neighbours, &sensing.bumper_rays);
     let robot_sensors = &sensing.robot_sensors;
@@ -158,7 +167,7 @@ pub fn sense(
                 }
             }
             None => {
-                o.counts = sensor.read_all_printed(
+                (o.counts, o.intensity) = sensor.read_robot(
                     pheromones,
                     frozen,
                     screen,
@@ -166,10 +175,10 @@ pub fn sense(
                     &sensor_points[i],
                     &mut slot.rng,
                 );
-                o.intensity = sensor.intensities(&o.counts);
             }
         }
-        o.bumpers = neighbours.bumpers_with(i, poses, radius, arena, bumper, obstacles);
+        o.bumpers =
+            neighbours.bumpers_facing(i, poses, forwards[i], radius, arena, bumper, obstacles);
         *obs = o;
     };
     if slots.len() >= PARALLEL_ROBOTS {
