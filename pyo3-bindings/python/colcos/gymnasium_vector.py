@@ -11,6 +11,10 @@ ends, so each sub-environment ends each episode exactly once (what Gymnasium's w
 `infos["_waiting"]`) marks the waiting sub-environments: their actions are ignored, and a learner
 may drop those steps. In the other built-in tasks a world's agents finish together.
 
+`render()` gives one frame per sub-environment, as Gymnasium's vector wrappers expect (an agent's
+frame is its world's screen with the robots; each world is drawn once per call, when first asked
+for), so `gymnasium.wrappers.vector.RecordVideo(env, folder, record_first_only=True)` records world 0.
+
 `reset(options={"reset_mask": m})` takes a bool array of shape `(E*N,)` and resets every world with
 a marked agent (a world resets as a whole). `reset(seed=[...])` uses the first seed (one base seed
 for the whole batch; None entries are allowed, the others must be valid seeds).
@@ -18,6 +22,7 @@ for the whole batch; None entries are allowed, the others must be valid seeds).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -42,7 +47,11 @@ class ColcosVectorEnv(VectorEnv):
         self.single_action_space = v.single_action_space
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.metadata = {"autoreset_mode": _MODES[v.autoreset_mode], "render_modes": ["rgb_array"]}
+        self.metadata = {
+            "autoreset_mode": _MODES[v.autoreset_mode],
+            "render_modes": ["rgb_array"],
+            "render_fps": round(1.0 / float(v.spec["dt"])),
+        }
         self.render_mode = "rgb_array"
         n = self.num_envs
         self._obs = v.obs.reshape(n, -1)
@@ -99,9 +108,37 @@ class ColcosVectorEnv(VectorEnv):
             infos["patch"] = v.patch.reshape(self.num_envs, *v.patch.shape[2:]).copy()
         return infos
 
-    def render(self) -> Any:
-        """World 0's screen with its robots, (H, W, 3) uint8."""
-        return self.venv.render(0)
+    # A lazy sequence, not the tuple Gymnasium's signature names: drawing every world at every call
+    # would cost a batch of thousands of worlds a render each (the wrappers ask for a Sequence).
+    def render(self) -> Sequence[np.ndarray]:  # type: ignore[override]
+        """One `(H, W, 3)` uint8 frame per sub-environment: its world's screen with the robots."""
+        return _Frames(self.venv)
 
     def close_extras(self, **kwargs: Any) -> None:
         self.venv.close()
+
+
+class _Frames(Sequence[np.ndarray]):
+    """The frames of every sub-environment, each world drawn once, when first asked for."""
+
+    def __init__(self, venv: VecEnv) -> None:
+        self._venv = venv
+        self._agents = venv.num_agents
+        self._worlds: dict[int, np.ndarray] = {}
+
+    def __len__(self) -> int:
+        return self._venv.num_envs * self._agents
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        if not isinstance(i, (int, np.integer)) or isinstance(i, bool):
+            raise ArgumentTypeError(f"frame index must be an integer, got {type(i).__name__}")
+        n = len(self)
+        k = int(i) + n if i < 0 else int(i)
+        if not 0 <= k < n:
+            raise IndexError(f"frame {i} out of range for {n} sub-environments")
+        w = k // self._agents
+        if w not in self._worlds:
+            self._worlds[w] = self._venv.render(w)
+        return self._worlds[w]
