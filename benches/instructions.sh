@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Instructions per agent-step of the batched environment on one thread (issue #35, item 1): callgrind
+# Instructions per agent-step of the batched environment on one thread: callgrind
 # counts every instruction of `throughput aggregation WORLDS STEPS - PHYSICS` (build and reset
-# included, as the issue's figures do), divided by the agent-steps (worlds x agents x steps), for the
+# included, as the reference figures do), divided by the agent-steps (worlds x agents x steps), for the
 # disc solver and rapier. Instruction counts do not depend on the machine's load, so this is the
 # figure to compare commits by; wall time is in benches/wall_speed.sh.
 #
@@ -36,7 +36,7 @@ dir=${keep:-$(mktemp -d)}
 mkdir -p "$dir"
 
 # Instructions per agent-step before this work (488ea55, measured by this script on a 2-core x86 VM,
-# 2026-11-27; the issue's 9.4 k / 11.6 k were fa963ea's on a Xeon) and the issue's bars.
+# 2026-11-27; fa963ea on a 16-core Xeon counted 9.4 k / 11.6 k) and the targets.
 declare -A floor=([discs]=9529 [rapier]=11724)
 declare -A bar=([discs]=3200 [rapier]=4000)
 
@@ -56,5 +56,5 @@ for physics in discs rapier; do
     awk -v p="$physics" -v t="$total" -v a="$agent_steps" -v f="${floor[$physics]}" -v b="${bar[$physics]}" \
         'BEGIN { per = t / a; printf "%-7s %14d %12d %14.0f %9.3fx %7.2fx\n", p, t, a, per, per / f, per / b }'
 done
-echo "(vs before: ratio to 9,529 discs / 11,724 rapier at 488ea55; vs bar: to the issue's 3.2 k / 4.0 k; lower is better)"
+echo "(vs before: ratio to 9,529 discs / 11,724 rapier at 488ea55; vs target: to 3.2 k / 4.0 k; lower is better)"
 [ -n "$keep" ] || rm -rf "$dir"
