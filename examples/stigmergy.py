@@ -2,16 +2,29 @@
 pheromone actions.
 
 For each task and seed the same PPO (parameter sharing, the actor and critic of
-`examples/train_aggregation.py`) trains twice with the same budget of agent-steps: once with its
-deposit outputs sent to the env ("with"), once with them forced to 0 before every step ("without":
-the ablation; the policy is the same network, its deposit outputs simply never lay anything). Then
-learned-with, learned-without, the task's hand-written policy (`colcos.task_policies()`) and uniform
-random actions run on the same seeded evaluation episodes. Prints a markdown table (mean return per
-agent, with the spread across training seeds), writes `result.json` and, with matplotlib, one
-learning-curve PNG per task.
+`examples/train_aggregation.py`) trains twice with the same budget of agent-steps (a whole number of
+updates, so the machine's load changes only the wall time): once with its deposit outputs sent to the
+env ("with"), once with them forced to 0 before every step ("without": the ablation; the policy is the
+same network, its deposit outputs simply never lay anything). Then learned-with, learned-without, the
+task's hand-written policy (`colcos.task_policies()`) and uniform random actions run on the same seeded
+evaluation episodes (every world's first episode after `reset(seed=--eval-seed)`); the learned-with
+policy is also evaluated with its rates forced to 0 (what its own trails are worth to it). Prints a
+markdown table (mean return per agent, ± the spread across training seeds), writes `result.json` (per
+seed and per episode) and, with matplotlib, one learning-curve PNG per task (mean over seeds, band:
+lowest to highest seed).
+
+Every run (task, with/without, seed) is saved as it finishes under `OUT/<task>/` (`with_seed0.json`
+and `.pt`, ...), as are the reference policies' evaluations; a run whose file exists is loaded, not
+trained again, so an interrupted study resumes, and several processes may share the work (split by
+`--tasks`, `--modes`, `--seeds`) before one last call with everything gathers the table.
 
     python examples/stigmergy.py --steps 2000000 --seeds 0 1 2 --out runs/stigmergy
     python examples/stigmergy.py --tasks coverage --steps 20000 --seeds 0 --episode 50   # a smoke run
+    python examples/stigmergy.py --tasks colony --seeds 0 --twin-episodes 2 --out runs/stigmergy   # + the twin
+
+`--twin-episodes K` then runs the learned-with policy of the first seed of the first task on the digital
+twin (`parallel_env(plant="twin")`, real time at 50 Hz) for K episodes and on the simulator's
+`parallel_env` with the same seeds, and reports both returns.
 
 Needs torch. The rewards are the tasks' own (docs/tasks.md); nothing is added here.
 """
@@ -21,9 +34,11 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import json
+import math
 import os
 import pathlib
 import time
+import tomllib
 
 import numpy as np
 import torch
@@ -34,6 +49,7 @@ from colcos.baselines import Baseline, RandomPolicy
 from colcos.vector import VecEnv
 
 TASKS = ("colony", "coverage", "alarm")
+MODES = ("with", "without")
 
 
 def _ppo_parts():
@@ -57,11 +73,25 @@ def to_env(a: np.ndarray, lay: bool) -> np.ndarray:
     return out
 
 
-def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn.Module, list[tuple[int, float]]]:
-    """PPO on `task` for `args.steps` agent-steps; the model and its learning curve (agent-steps, mean
-    return of the last finished training episodes)."""
+def episode_steps(task: str, args: argparse.Namespace) -> int:
+    """Steps per episode: `--episode`, or with 0 the task's scenario's own duration."""
+    if args.episode:
+        return args.episode
+    scenario = tomllib.loads(colcos.default_scenario(task))
+    return int(round(scenario["duration"] / scenario["dt"]))
+
+
+def updates_for(args: argparse.Namespace, num_agents: int) -> int:
+    """The budget as a whole number of PPO updates (rollouts of `horizon` steps of every agent)."""
+    return max(1, math.ceil(args.steps / (args.horizon * args.num_envs * num_agents)))
+
+
+def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn.Module, dict]:
+    """PPO on `task` for the budget's updates; the model and its log: the learning curve (per update:
+    agent-steps, mean reward per agent-step of the rollout; per finished batch of training episodes:
+    agent-steps, their mean return), the updates, agent-steps and wall time."""
     torch.manual_seed(seed)
-    env = VecEnv(task, num_envs=args.num_envs, seed=seed, max_cycles=args.episode, num_threads=args.threads)
+    env = VecEnv(task, num_envs=args.num_envs, seed=seed, max_cycles=episode_steps(task, args), num_threads=args.threads)
     e, n, d = env.num_envs, env.num_agents, env.single_observation_space.shape[0]
     w = env.single_action_space.shape[0]
     c = d + env.state_space.shape[0] + n
@@ -77,8 +107,12 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
     obs, infos = env.reset(seed=seed)
     state = infos["state"]
     prev_done = np.zeros(b, dtype=bool)
-    ep_return, finished, curve, steps = np.zeros(b), [], [], 0
-    while steps < args.steps:
+    ep_return = np.zeros(b)
+    rate_curve: list[tuple[int, float]] = []
+    episode_curve: list[tuple[int, float]] = []
+    steps, updates, start = 0, updates_for(args, n), time.time()
+    for update in range(updates):
+        rollout_reward, rollout_count = 0.0, 0
         for t in range(T):
             o = torch.from_numpy(obs.reshape(b, d).copy())
             ci = PPO.critic_input(obs, state)
@@ -97,12 +131,15 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
             ret_norm.update(torch.from_numpy(disc_ret[~prev_done].astype(np.float32))[:, None])
             rew_buf[t] = torch.from_numpy(r.astype(np.float32))
             done_buf[t] = torch.from_numpy(done.astype(np.float32))
+            rollout_reward += float(r[~prev_done].sum())
+            rollout_count += int((~prev_done).sum())
             ep_return += r
             if done.any():
-                finished.extend(ep_return[done].tolist())
+                episode_curve.append((steps + b, float(ep_return[done].mean())))
                 ep_return[done] = 0.0
             prev_done = done.copy()
             steps += b
+        rate_curve.append((steps, rollout_reward / max(1, rollout_count)))
         with torch.no_grad():
             val_buf[T] = model.value(PPO.critic_input(obs, state))
         scale = float(torch.sqrt(ret_norm.var[0] + 1e-8))
@@ -133,64 +170,126 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
                 (pg + 0.5 * vloss).backward()
                 nn.utils.clip_grad_norm_(model.parameters(), 0.5)
                 opt.step()
-        if finished:
-            curve.append((steps, float(np.mean(finished[-b:]))))
-    return model, curve
+        if args.verbose and (update + 1) % args.verbose == 0:
+            print(f"  {task} {'with' if lay else 'without'} seed {seed}: update {update + 1}/{updates}, "
+                  f"{steps:,} agent-steps, reward/agent-step {rate_curve[-1][1]:.5f}, "
+                  f"last episodes {episode_curve[-1][1] if episode_curve else float('nan'):.2f}, "
+                  f"{time.time() - start:.0f} s", flush=True)
+    log = {"updates": updates, "agent_steps": steps, "train_seconds": round(time.time() - start, 1),
+           "rate_curve": rate_curve, "episode_curve": episode_curve}
+    return model, log
 
 
-def evaluate(task: str, act, args: argparse.Namespace) -> float:
-    """Mean return per agent over `args.eval_worlds` seeded episodes of `args.episode` steps; `act(venv)`
-    gives the policy (observations -> actions)."""
-    v = VecEnv(task, num_envs=args.eval_worlds, max_cycles=args.episode, num_threads=args.threads)
+def evaluate(task: str, act, args: argparse.Namespace) -> list[float]:
+    """Return per agent of each of `args.eval_worlds` seeded episodes (every
+    world's first episode after `reset(seed=args.eval_seed)`); `act(venv)` gives the policy
+    (observations -> actions)."""
+    steps = episode_steps(task, args)
+    v = VecEnv(task, num_envs=args.eval_worlds, max_cycles=steps, num_threads=args.threads)
     policy = act(v)
     obs, _ = v.reset(seed=args.eval_seed)
     total = np.zeros((v.num_envs, v.num_agents))
-    for _ in range(args.episode):
+    for _ in range(steps):
         obs, rew, _, _, _ = v.step(policy(obs))
         total += rew
-    return float(total.mean())
+    return [float(x) for x in total.mean(axis=1)]
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--tasks", nargs="+", default=list(TASKS), choices=TASKS)
-    p.add_argument("--steps", type=int, default=2_000_000, help="training budget per run, agent-steps")
-    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-    p.add_argument("--num-envs", type=int, default=32)
-    p.add_argument("--horizon", type=int, default=64, help="steps per rollout")
-    p.add_argument("--episode", type=int, default=1000, help="steps per episode, training and evaluation")
-    p.add_argument("--threads", type=int, default=None)
-    p.add_argument("--lr", type=float, default=1e-3)
-    p.add_argument("--eval-worlds", type=int, default=32)
-    p.add_argument("--eval-seed", type=int, default=12345)
-    p.add_argument("--out", default="runs/stigmergy")
-    args = p.parse_args()
-    torch.set_num_threads(1)
-    os.makedirs(args.out, exist_ok=True)
-    policies = {task: name for name, (task, _) in colcos.task_policies().items()}
-    results: dict = {"args": vars(args), "tasks": {}}
-    start = time.time()
-    for task in args.tasks:
-        row: dict = {"with": [], "without": [], "curves": {}}
-        for lay in (True, False):
-            key = "with" if lay else "without"
-            for seed in args.seeds:
-                model, curve = train(task, lay, seed, args)
-                row["curves"][f"{key}/{seed}"] = curve
-                row[key].append(evaluate(task, lambda v, m=model, lay=lay: lambda o: to_env(m.act(o), lay), args))
-                print(f"{task} {key} seed {seed}: {row[key][-1]:.2f} ({time.time() - start:.0f} s)", flush=True)
-        row["baseline"] = evaluate(task, lambda v: Baseline(v, policies[task]).act, args)
-        row["random"] = evaluate(task, lambda v: RandomPolicy(v, seed=1).act, args)
-        results["tasks"][task] = row
-    print("\n| task | learned, with pheromone | learned, without | hand-written | random |")
-    print("| --- | --- | --- | --- | --- |")
-    for task, row in results["tasks"].items():
-        cell = lambda xs: f"{np.mean(xs):.2f} ± {np.std(xs):.2f}"  # noqa: E731
-        print(f"| `{task}` | {cell(row['with'])} | {cell(row['without'])} | {row['baseline']:.2f} | {row['random']:.2f} |")
-    print(f"(mean return per agent over {args.eval_worlds} episodes of {args.episode} steps, seed {args.eval_seed};"
-          f" ± the spread across training seeds {args.seeds}; {args.steps:,} agent-steps per run)")
-    with open(os.path.join(args.out, "result.json"), "w") as f:
-        json.dump(results, f, indent=1)
+def _dump(path: pathlib.Path, obj: dict) -> None:
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(obj, indent=1))
+    tmp.replace(path)
+
+
+def run(task: str, mode: str, seed: int, args: argparse.Namespace) -> dict:
+    """One training run and its evaluations, loaded from `OUT/<task>/<mode>_seed<seed>.json` if that
+    exists (made with the same budget), else trained and saved there."""
+    folder = pathlib.Path(args.out) / task
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{mode}_seed{seed}.json"
+    if path.exists():
+        saved = json.loads(path.read_text())
+        if saved["config"] == config(args):
+            return saved
+        print(f"{path}: made with another configuration, trained again", flush=True)
+    lay = mode == "with"
+    model, log = train(task, lay, seed, args)
+    torch.save(model.state_dict(), folder / f"{mode}_seed{seed}.pt")
+    t0 = time.time()
+    rec = {"task": task, "mode": mode, "seed": seed, "config": config(args), **log,
+           "eval": evaluate(task, lambda v: lambda o: to_env(model.act(o), lay), args)}
+    if lay:
+        rec["eval_rates_off"] = evaluate(task, lambda v: lambda o: to_env(model.act(o), False), args)
+    rec["eval_seconds"] = round(time.time() - t0, 1)
+    _dump(path, rec)
+    return rec
+
+
+def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
+    """The hand-written policy's or random actions' evaluation returns, cached in `OUT/<task>/`."""
+    folder = pathlib.Path(args.out) / task
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{name}.json"
+    cfg = {k: v for k, v in config(args).items() if k in ("episode", "eval_worlds", "eval_seed")}
+    if path.exists():
+        saved = json.loads(path.read_text())
+        if saved["config"] == cfg:
+            return saved["eval"]
+    if name == "baseline":
+        policy = {t: p for p, (t, _) in colcos.task_policies().items()}[task]
+        returns = evaluate(task, lambda v: Baseline(v, policy).act, args)
+    else:
+        returns = evaluate(task, lambda v: RandomPolicy(v, seed=1).act, args)
+    _dump(path, {"config": cfg, "eval": returns})
+    return returns
+
+
+def config(args: argparse.Namespace) -> dict:
+    """What a saved run must share with this call to be reused."""
+    keys = ("steps", "num_envs", "horizon", "episode", "lr", "eval_worlds", "eval_seed")
+    return {k: getattr(args, k) for k in keys}
+
+
+def twin(task: str, seed: int, args: argparse.Namespace) -> dict:
+    """The learned-with policy of `seed` on the digital twin and on the simulator's `parallel_env`, the
+    same episode seeds; mean return per agent of each episode."""
+    folder = pathlib.Path(args.out) / task
+    probe = VecEnv(task, num_envs=1, max_cycles=episode_steps(task, args), num_threads=args.threads)
+    d, w = probe.single_observation_space.shape[0], probe.single_action_space.shape[0]
+    n = probe.num_agents
+    model = PPO.ActorCritic(d, d + probe.state_space.shape[0] + n, act_dim=w)
+    model.load_state_dict(torch.load(folder / f"with_seed{seed}.pt"))
+    out: dict = {"seed": seed, "episodes": args.twin_episodes, "episode_steps": args.twin_steps or episode_steps(task, args)}
+    for plant in ("sim", "twin"):
+        returns, t0 = [], time.time()
+        with colcos.parallel_env(task=task, plant=plant, max_cycles=out["episode_steps"]) as env:
+            for k in range(args.twin_episodes):
+                obs, _ = env.reset(seed=args.eval_seed + k)
+                total = 0.0
+                while env.agents:
+                    acts = {a: to_env(model.act(obs[a]), True) for a in env.agents}
+                    obs, rew, _, _, _ = env.step(acts)
+                    total += sum(rew.values())
+                returns.append(total / n)
+                print(f"  {plant} episode {k}: {returns[-1]:.2f} ({time.time() - t0:.0f} s)", flush=True)
+            if plant == "twin":
+                out["plant_info"] = {k: v for k, v in env.plant_info().items() if isinstance(v, (int, float, str))}
+        out[plant] = returns
+        out[f"{plant}_seconds"] = round(time.time() - t0, 1)
+    _dump(folder / f"twin_seed{seed}.json", out)
+    return out
+
+
+def sd(xs) -> float:
+    """The sample standard deviation (ddof 1; 0 for a single value)."""
+    return float(np.std(xs, ddof=1)) if len(xs) > 1 else 0.0
+
+
+def spread(xs) -> str:
+    return f"{np.mean(xs):.2f} ± {sd(xs):.2f}"
+
+
+def plot(task: str, row: dict, args: argparse.Namespace) -> None:
     try:
         import matplotlib
 
@@ -199,21 +298,126 @@ def main() -> None:
     except ImportError:
         print("matplotlib not installed: no PNG")
         return
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), gridspec_kw={"width_ratios": [3, 2]})
+    ax = axes[0]
+    for mode, colour in (("with", "C0"), ("without", "C1")):
+        curves = [np.array(row["runs"][mode][s]["episode_curve"]) for s in sorted(row["runs"][mode])]
+        curves = [c for c in curves if len(c)]
+        if not curves:
+            continue
+        xs = curves[0][:, 0]
+        ys = np.stack([np.interp(xs, c[:, 0], c[:, 1]) for c in curves])
+        ax.plot(xs / 1e6, ys.mean(0), color=colour, lw=1.2, marker="o", ms=3,
+                label=f"learned, {mode} pheromone (mean of {len(curves)} seeds; band: min-max)")
+        ax.fill_between(xs / 1e6, ys.min(0), ys.max(0), color=colour, alpha=0.2, lw=0)
+    ax.axhline(np.mean(row["baseline"]), color="green", ls=":", label="hand-written (evaluation)")
+    ax.axhline(np.mean(row["random"]), color="grey", ls="--", label="random (evaluation)")
+    ax.set_xlabel("agent-steps (millions)")
+    ax.set_title("training: mean return of each batch of episodes (stochastic policy)", fontsize=9)
+    ax.legend(fontsize=7, loc="best")
+    # Evaluation: one dot per training seed (its mean over the evaluation episodes), the references'
+    # episodes as a mean and sd.
+    ax = axes[1]
+    cols = [("with", "learned\nwith", "C0"), ("without", "learned\nwithout", "C1"), ("with_rates_off", "with,\nrates 0", "C2")]
+    for i, (key, _, colour) in enumerate(cols):
+        ax.scatter(np.full(len(row[key]), i), row[key], color=colour, s=18, zorder=3)
+        ax.hlines(np.mean(row[key]), i - 0.25, i + 0.25, color=colour)
+    for i, key in ((3, "baseline_episodes"), (4, "random_episodes")):
+        ax.errorbar(i, np.mean(row[key]), yerr=np.std(row[key], ddof=1), fmt="s", color="k", ms=4, capsize=3)
+    ax.set_xticks(range(5), [c[1] for c in cols] + ["hand-\nwritten", "random"], fontsize=7)
+    ax.set_title(f"evaluation, {len(row['baseline_episodes'])} seeded episodes\ndots: training seeds (bar: mean);"
+                 " squares: mean ± sd over episodes", fontsize=8)
+    axes[0].set_ylabel("mean return per agent")
+    fig.suptitle(f"colcos {task}: PPO with and without pheromone actions, {episode_steps(task, args)}-step episodes", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(args.out, f"stigmergy_{task}.png"), dpi=110)
+    plt.close(fig)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--tasks", nargs="+", default=list(TASKS), choices=TASKS)
+    p.add_argument("--modes", nargs="+", default=list(MODES), choices=MODES, help="train only these (a share of the work)")
+    p.add_argument("--steps", type=int, default=2_000_000, help="training budget per run, agent-steps (rounded up to whole updates)")
+    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    p.add_argument("--num-envs", type=int, default=32)
+    p.add_argument("--horizon", type=int, default=64, help="steps per rollout")
+    p.add_argument("--episode", type=int, default=0, help="steps per episode, training and evaluation (0: the scenario's duration)")
+    p.add_argument("--threads", type=int, default=1, help="env worker threads (1: reproducible, and fair on a shared machine)")
+    p.add_argument("--lr", type=float, default=1e-3)
+    p.add_argument("--eval-worlds", type=int, default=32)
+    p.add_argument("--eval-seed", type=int, default=12345)
+    p.add_argument("--out", default="runs/stigmergy")
+    p.add_argument("--verbose", type=int, default=0, metavar="K", help="print progress every K updates")
+    p.add_argument("--twin-episodes", type=int, default=0, help="then run the first task's learned-with policy on the twin")
+    p.add_argument("--twin-steps", type=int, default=0, help="steps per twin episode (0: as --episode)")
+    args = p.parse_args()
+    torch.set_num_threads(1)
+    os.makedirs(args.out, exist_ok=True)
+    results: dict = {"args": vars(args), "tasks": {}}
+    start = time.time()
+    for task in args.tasks:
+        row: dict = {"runs": {m: {} for m in args.modes}}
+        for mode in args.modes:
+            for seed in args.seeds:
+                rec = run(task, mode, seed, args)
+                row["runs"][mode][seed] = rec
+                print(f"{task} {mode} seed {seed}: {np.mean(rec['eval']):.2f} (trained {rec['agent_steps']:,} agent-steps"
+                      f" in {rec['updates']} updates, {rec['train_seconds']:.0f} s; {time.time() - start:.0f} s so far)", flush=True)
+        for mode in args.modes:  # per training seed: the mean over the evaluation episodes
+            row[mode] = [float(np.mean(row["runs"][mode][s]["eval"])) for s in args.seeds]
+        if "with" in args.modes:
+            row["with_rates_off"] = [float(np.mean(row["runs"]["with"][s]["eval_rates_off"])) for s in args.seeds]
+        row["baseline_episodes"] = reference(task, "baseline", args)
+        row["random_episodes"] = reference(task, "random", args)
+        row["baseline"] = float(np.mean(row["baseline_episodes"]))
+        row["random"] = float(np.mean(row["random_episodes"]))
+        twin_file = pathlib.Path(args.out) / task / f"twin_seed{args.seeds[0]}.json"
+        if twin_file.exists():  # from an earlier call with --twin-episodes
+            row["twin"] = json.loads(twin_file.read_text())
+        row["train_seconds"] = sum(r["train_seconds"] + r.get("eval_seconds", 0) for m in row["runs"].values() for r in m.values())
+        results["tasks"][task] = row
+    if set(args.modes) == set(MODES):
+        print("\n| task | learned, with pheromone | learned, without | learned-with, rates forced to 0 | hand-written | random |")
+        print("| --- | --- | --- | --- | --- | --- |")
+        for task, row in results["tasks"].items():
+            print(f"| `{task}` | {spread(row['with'])} | {spread(row['without'])} | {spread(row['with_rates_off'])} "
+                  f"| {spread(row['baseline_episodes'])} | {spread(row['random_episodes'])} |")
+        print(f"(mean return per agent over {args.eval_worlds} episodes, seed {args.eval_seed}, of "
+              f"{', '.join(f'{episode_steps(t, args)} steps ({t})' for t in results['tasks'])};"
+              f" learned: ± the sample sd across training seeds {args.seeds} of each seed's mean; hand-written and random: ± the sd"
+              f" across the episodes; {args.steps:,} agent-steps per run)")
+        for task, row in results["tasks"].items():
+            gap, top = np.mean(row["with"]) - np.mean(row["without"]), max(sd(row["with"]), sd(row["without"]))
+            se = np.sqrt(sd(row["with"]) ** 2 / len(row["with"]) + sd(row["without"]) ** 2 / len(row["without"]))
+            row["with_minus_without"], row["largest_seed_sd"] = float(gap), top
+            row["welch_t"] = float(gap / se) if se > 0 else None
+            print(f"{task}: with - without = {gap:+.2f}; largest sd across seeds {top:.2f}; "
+                  f"{'beats it by more than the spread' if gap > top else 'not more than the spread'}"
+                  f"{f'; Welch t = {gap / se:.2f}' if se > 0 else ''}")
+            ep_sd = [float(np.std(row["runs"][m][s]["eval"])) for m in MODES for s in args.seeds]
+            print(f"  per seed with {np.round(row['with'], 2).tolist()}, without {np.round(row['without'], 2).tolist()};"
+                  f" sd across the episodes of one learned policy {min(ep_sd):.2f} to {max(ep_sd):.2f}")
+    results["wall_seconds"] = round(time.time() - start, 1)
+    if args.twin_episodes:
+        task, seed = args.tasks[0], args.seeds[0]
+        res = twin(task, seed, args)
+        results["twin"] = res
+        print(f"{task} learned-with seed {seed}, {args.twin_episodes} episodes of {res['episode_steps']} steps from seed "
+              f"{args.eval_seed}: simulator {spread(res['sim'])}, twin {spread(res['twin'])}")
     for task, row in results["tasks"].items():
-        fig, ax = plt.subplots(figsize=(6, 3.5))
-        for name, curve in row["curves"].items():
-            if curve:
-                xs, ys = zip(*curve)
-                ax.plot(np.array(xs) / 1e6, ys, lw=1, color="C0" if name.startswith("with/") else "C1", label=name)
-        ax.axhline(row["baseline"], color="green", ls=":", label="hand-written")
-        ax.axhline(row["random"], color="grey", ls="--", label="random")
-        ax.set_xlabel("agent-steps (millions)")
-        ax.set_ylabel("mean return per agent")
-        ax.set_title(f"colcos {task}: PPO with and without pheromone actions")
-        ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(os.path.join(args.out, f"{task}_curve.png"), dpi=120)
-    print(f"saved {args.out}/result.json and the learning curves")
+        for mode in args.modes:  # keep result.json small: curves stay in the per-run files
+            row["runs"][mode] = {s: {k: v for k, v in r.items() if k not in ("rate_curve", "episode_curve")}
+                                 | {"curves": f"{task}/{mode}_seed{s}.json"} for s, r in row["runs"][mode].items()}
+    with open(os.path.join(args.out, "result.json"), "w") as f:
+        json.dump(results, f, indent=1)
+    if set(args.modes) == set(MODES):
+        for task in args.tasks:
+            row = results["tasks"][task]
+            row_full = dict(row, runs={m: {s: json.loads((pathlib.Path(args.out) / task / f"{m}_seed{s}.json").read_text())
+                                           for s in args.seeds} for m in MODES})
+            plot(task, row_full, args)
+    print(f"saved {args.out}/result.json and the learning curves ({time.time() - start:.0f} s)")
 
 
 if __name__ == "__main__":
