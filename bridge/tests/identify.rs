@@ -141,8 +141,14 @@ fn check(truth: &Truth, seed: u64) {
                 "robot {i} wheel {w}: {scale:?} vs {s:?}"
             );
         }
-        assert!((got_lag - lag).abs() / lag < 0.2, "robot {i} lag {got_lag} vs {lag}");
-        assert!((got_lat - lat).abs() < 0.005, "robot {i} latency {got_lat} vs {lat}");
+        assert!(
+            (got_lag - lag).abs() / lag < 0.2,
+            "robot {i} lag {got_lag} vs {lag}"
+        );
+        assert!(
+            (got_lat - lat).abs() < 0.005,
+            "robot {i} latency {got_lat} vs {lat}"
+        );
     }
 }
 
@@ -186,7 +192,12 @@ fn identifies_the_third_truth() {
 fn too_little_data_names_what_cannot_be_identified() {
     let (sc, ticks) = record("", 0.6, 4);
     let series = robot_series(&ticks, &sc).unwrap();
-    let fit = fit_robot(0, &series[0].commands, &series[0].poses, &FitOptions::default());
+    let fit = fit_robot(
+        0,
+        &series[0].commands,
+        &series[0].poses,
+        &FitOptions::default(),
+    );
     for p in [
         fit.wheel_scale.clone().err(),
         fit.latency.clone().err(),
@@ -208,5 +219,10 @@ fn too_little_data_names_what_cannot_be_identified() {
     }
     let err = robot_series(&blind, &sc).unwrap_err().to_string();
     assert!(err.contains("no poses"), "{err}");
-    assert!(robot_series(&[], &sc).unwrap_err().to_string().contains("no ticks"));
+    assert!(
+        robot_series(&[], &sc)
+            .unwrap_err()
+            .to_string()
+            .contains("no ticks")
+    );
 }
