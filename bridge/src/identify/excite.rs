@@ -26,7 +26,8 @@ impl Excitation {
 
     /// Robot `robot`'s command at `t` s from the excitation's start.
     pub fn command(&self, robot: usize, t: f64) -> WheelCommand {
-        if !(t >= 0.0) {
+        // Before the start, and for a NaN time, nothing moves.
+        if t.is_nan() || t < 0.0 {
             return WheelCommand::STOP;
         }
         // Walk the segments from the start: each is its own hash, so no state is kept.
