@@ -150,8 +150,13 @@ impl LiveEnv {
         let local =
             plant.kind == PlantKind::Twin && plant.tracker.is_none() && plant.robots.is_none();
         if (plant.twin_scenario.is_some() || plant.twin_truth.is_some()) && !local {
+            let key = if plant.twin_scenario.is_some() {
+                "twin_scenario"
+            } else {
+                "truth"
+            };
             return Err(PlantError::option(
-                "twin_scenario",
+                key,
                 "only a twin started here (plant twin, no `tracker`/`robots` URLs) plays its own \
                  scenario; a twin elsewhere takes its scenario where it is started (`colcos twin`)",
             ));
