@@ -140,6 +140,14 @@ pub fn identify(args: IdentifyArgs, text: &mut String) -> Result<()> {
             .tracker_latency
             .map_or("unknown".into(), |t| format!("{:.1} ms", 1e3 * t))
     )?;
+    if let Some((p, h)) = found.tracker_noise() {
+        writeln!(
+            text,
+            "tracker noise at most {:.2} mm, {:.4} rad (the fit's residuals)",
+            1e3 * p,
+            h
+        )?;
+    }
     for f in &found.robots {
         writeln!(
             text,

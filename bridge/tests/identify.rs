@@ -135,6 +135,13 @@ fn check(truth: &Truth, seed: u64) {
              (truth {lag}), latency {got_lat:.4} +- {lat_sd:.4} (truth {lat}); {} windows, {} outliers",
             fit.windows, fit.outliers
         );
+        // The tracker's noise (1 mm, 0.02 rad) seen in the residuals, a little above it.
+        let (p, h) = (fit.rms[1] / 2f64.sqrt(), fit.rms[0] / 2f64.sqrt());
+        println!("  noise at most {:.2} mm, {h:.4} rad", 1e3 * p);
+        assert!(
+            (0.0008..0.002).contains(&p) && (0.015..0.03).contains(&h),
+            "{p} {h}"
+        );
         for w in 0..2 {
             assert!(
                 (scale[w] - s[w]).abs() / s[w] < 0.05,

@@ -58,5 +58,8 @@ fn a_twin_with_slow_wheels_is_seen_to_cover_less_ground() {
     let mut opts = PlantOptions::new(PlantKind::Twin);
     opts.twin_truth = Some(bad);
     let err = LiveEnv::new(&config(), &opts).err().unwrap().to_string();
-    assert!(err.contains("truth") && err.contains("wheel_scale"), "{err}");
+    assert!(
+        err.contains("truth") && err.contains("wheel_scale"),
+        "{err}"
+    );
 }

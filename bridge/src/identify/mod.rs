@@ -31,6 +31,27 @@ pub struct Identified {
     pub duration: f64,
 }
 
+impl Identified {
+    /// The tracker's noise as the fit's residuals show it, median over the robots: (position m,
+    /// heading rad). A window's residual is the difference of two poses' errors, hence the `sqrt 2`;
+    /// what the model misses adds to it, so these are upper bounds.
+    pub fn tracker_noise(&self) -> Option<(f64, f64)> {
+        let mut p: Vec<f64> = (self.robots.iter().map(|r| r.rms[1]))
+            .filter(|v| v.is_finite())
+            .collect();
+        let mut h: Vec<f64> = (self.robots.iter().map(|r| r.rms[0]))
+            .filter(|v| v.is_finite())
+            .collect();
+        if p.is_empty() || h.is_empty() {
+            return None;
+        }
+        p.sort_by(f64::total_cmp);
+        h.sort_by(f64::total_cmp);
+        let s = std::f64::consts::SQRT_2;
+        Some((p[p.len() / 2] / s, h[h.len() / 2] / s))
+    }
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum IdentifyError {
     #[error(transparent)]

@@ -17,6 +17,17 @@ pub fn overlay(found: &Identified, log: &str, scenario: &str) -> IndividualFile 
     if let Some(t) = found.tracker_latency {
         notes.insert("tracker_latency".into(), toml::Value::Float(round(t, 4)));
     }
+    if let Some((p, h)) = found.tracker_noise() {
+        // Upper bounds: what the drive model misses counts as noise too.
+        notes.insert(
+            "position_noise_at_most".into(),
+            toml::Value::Float(round(p, 5)),
+        );
+        notes.insert(
+            "heading_noise_at_most".into(),
+            toml::Value::Float(round(h, 4)),
+        );
+    }
     let mut unidentified = toml::Table::new();
     let robot = found
         .robots
