@@ -258,6 +258,16 @@ fn a_file_of_entries_is_read_and_checked() {
         err.contains("robots.toml") && err.contains("robot[0].motor_lag") && err.contains("-1"),
         "{err}"
     );
+    std::fs::write(
+        dir.path().join("robots.toml"),
+        "[[robot]]\nindex = 1\nwheel_scale = [1.0, 0.9, 0.8]\n",
+    )
+    .unwrap();
+    let err = World::new(&sc).err().unwrap().to_string();
+    assert!(
+        err.contains("robot[0].wheel_scale") && err.contains("got 3"),
+        "{err}"
+    );
     let missing = text.replace("robots.toml", "absent.toml");
     let sc = Scenario::from_toml_str(&missing, dir.path()).unwrap();
     let err = World::new(&sc).err().unwrap().to_string();

@@ -95,10 +95,27 @@ impl IndividualFile {
     /// Parses the file's text; the error names the key that is wrong.
     pub fn parse(text: &str) -> std::result::Result<IndividualFile, String> {
         let de = toml::de::Deserializer::parse(text).map_err(|e| e.to_string())?;
-        serde_path_to_error::deserialize(de).map_err(|e| {
+        let file: IndividualFile = serde_path_to_error::deserialize(de).map_err(|e| {
             let path = e.path().to_string();
             format!("at `{path}`: {}", e.into_inner())
-        })
+        })?;
+        // Serde fills `[left, right]` from the first two values of a longer array and drops the
+        // rest: a third wheel must be refused, not ignored.
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| e.to_string())?;
+        let entries = table.get("robot").and_then(|r| r.as_array());
+        for (n, entry) in entries.into_iter().flatten().enumerate() {
+            for key in ["wheel_scale", "wheel_scale_sd"] {
+                if let Some(a) = entry.get(key).and_then(|v| v.as_array())
+                    && a.len() != 2
+                {
+                    return Err(format!(
+                        "at `robot[{n}].{key}`: expected 2 values (left, right), got {}",
+                        a.len()
+                    ));
+                }
+            }
+        }
+        Ok(file)
     }
 
     pub fn to_toml(&self) -> String {
@@ -223,9 +240,8 @@ pub fn resolve(scenario: &super::Scenario, robots: usize) -> Result<Option<Vec<I
         let loaded = IndividualFile::load(&scenario.base_dir.join(file)).map_err(|e| {
             SimError::invalid("individual.file", format!("{file:?}"), e.to_string())
         })?;
-        validate_entries(&loaded.robot, &format!("{file}: robot"), robots).map_err(|e| {
-            SimError::invalid("individual.file", format!("{file:?}"), e.to_string())
-        })?;
+        validate_entries(&loaded.robot, "robot", robots)
+            .map_err(|e| SimError::invalid("individual.file", format!("{file:?}"), inner(e)))?;
         for e in &loaded.robot {
             out[e.index].overlay(e);
         }
@@ -251,7 +267,7 @@ pub fn with_truth(scenario: &super::Scenario, truth: &Path) -> Result<super::Sce
     let loaded = IndividualFile::load(truth)
         .map_err(|e| SimError::invalid("truth", format!("{shown:?}"), e.to_string()))?;
     validate_entries(&loaded.robot, "robot", scenario.robot_count())
-        .map_err(|e| SimError::invalid("truth", format!("{shown:?}"), e.to_string()))?;
+        .map_err(|e| SimError::invalid("truth", format!("{shown:?}"), inner(e)))?;
     let absolute = std::path::absolute(truth).unwrap_or_else(|_| truth.to_path_buf());
     let mut out = scenario.clone();
     out.spec.individual = IndividualSpec {
@@ -260,4 +276,12 @@ pub fn with_truth(scenario: &super::Scenario, truth: &Path) -> Result<super::Sce
     };
     super::validate::validate(&out)?;
     Ok(out)
+}
+
+/// An error about a key inside a file, without the scenario's prefix (the file's key names it).
+fn inner(e: SimError) -> String {
+    match e {
+        SimError::Invalid { key, value, reason } => format!("`{key}` = {value}: {reason}"),
+        other => other.to_string(),
+    }
 }
