@@ -8,6 +8,7 @@ pub mod backend;
 pub mod calibrate;
 pub mod display;
 pub mod experiment;
+pub mod identify;
 pub mod preflight;
 pub mod replay;
 pub mod report;

@@ -13,6 +13,12 @@ pub enum RigCommand {
     /// every limit broken named) when the shield stepped in too often, a robot reached the arena's
     /// edge, robots collided or the loop overran its ticks.
     Check(CheckArgs),
+    /// Drive a short, bounded excitation (held wheel commands of random length, inside the shield)
+    /// while the bridge records the rig log that `colcos rig identify` fits.
+    Excite(crate::identify::ExciteArgs),
+    /// Fit each robot's wheel scales, motor lag and command latency from a rig log, each with its
+    /// uncertainty, into a file of per-robot values for `[individual] file`.
+    Identify(crate::identify::IdentifyArgs),
 }
 
 #[derive(Args, Debug)]
@@ -48,7 +54,11 @@ pub struct CheckArgs {
 }
 
 pub fn run(command: RigCommand, text: &mut String) -> Result<()> {
-    let RigCommand::Check(args) = command;
+    let args = match command {
+        RigCommand::Check(args) => args,
+        RigCommand::Excite(args) => return crate::identify::excite(args, text),
+        RigCommand::Identify(args) => return crate::identify::identify(args, text),
+    };
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
         bail!("--seconds {}: must be in (0, 3600]", args.seconds);
     }

@@ -92,6 +92,11 @@ pub struct TwinArgs {
     /// Uniform jitter of the tracker delay, s.
     #[arg(long, default_value_t = 0.0)]
     pub tracker_jitter: f64,
+    /// The robots' hidden true values: a file of `[[robot]]` entries (wheel scales, motor lag,
+    /// command latency, sensor gain; as `[individual] file` takes) that the twin's robots drive and
+    /// sense with instead of the scenario's, while the bridge assumes the scenario's.
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
 }
 
 /// A flag that Ctrl-C and SIGTERM set.
@@ -197,7 +202,10 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
 }
 
 pub fn twin(args: TwinArgs, text: &mut String) -> Result<()> {
-    let sc = Scenario::from_file(&args.scenario)?;
+    let mut sc = Scenario::from_file(&args.scenario)?;
+    if let Some(truth) = &args.truth {
+        sc = colcos_sim::scenario::individual::with_truth(&sc, truth)?;
+    }
     if !args.public && !args.tracker.ip().is_loopback() {
         bail!(
             "--tracker {}: not a loopback address (add --public to serve beyond this machine)",

@@ -12,6 +12,7 @@ pub mod clock;
 pub mod colias;
 pub mod frames;
 pub mod host;
+pub mod identify;
 pub mod link;
 pub mod live;
 pub mod onboard;

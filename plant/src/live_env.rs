@@ -149,9 +149,14 @@ impl LiveEnv {
         }
         let local =
             plant.kind == PlantKind::Twin && plant.tracker.is_none() && plant.robots.is_none();
-        if plant.twin_scenario.is_some() && !local {
+        if (plant.twin_scenario.is_some() || plant.twin_truth.is_some()) && !local {
+            let key = if plant.twin_scenario.is_some() {
+                "twin_scenario"
+            } else {
+                "truth"
+            };
             return Err(PlantError::option(
-                "twin_scenario",
+                key,
                 "only a twin started here (plant twin, no `tracker`/`robots` URLs) plays its own \
                  scenario; a twin elsewhere takes its scenario where it is started (`colcos twin`)",
             ));
@@ -164,10 +169,13 @@ impl LiveEnv {
             .map_err(|e| PlantError::Io(format!("starting the frame stream for the twin: {e}")))?;
         let twin = match (plant.kind, &plant.tracker, &plant.robots) {
             (PlantKind::Twin, None, None) => {
-                let own = match &plant.twin_scenario {
+                let mut own = match &plant.twin_scenario {
                     Some(t) => t.resolve(scenario)?,
                     None => scenario.clone(),
                 };
+                if let Some(truth) = &plant.twin_truth {
+                    own = colcos_sim::scenario::individual::with_truth(&own, truth)?;
+                }
                 Some(TwinThread::start_seeing(
                     &own,
                     frames.as_ref().map(|f| f.local_addr()),

@@ -48,6 +48,9 @@ pub struct PlantOptions {
     /// `twin` started here: the scenario the twin plays (its true tracker latency, sensors, robot
     /// body) where it differs from the host's; None: the host's own.
     pub twin_scenario: Option<TwinScenario>,
+    /// `twin` started here: the twin's robots' hidden true values, a file of `[[robot]]` entries
+    /// (`colcos twin --truth`) over the twin's scenario; the host keeps its nominal ones.
+    pub twin_truth: Option<PathBuf>,
 }
 
 impl PlantOptions {
@@ -62,6 +65,7 @@ impl PlantOptions {
             calibration_max_age: 7.0 * 86400.0,
             calibration_max_error_mm: 3.0,
             twin_scenario: None,
+            twin_truth: None,
         }
     }
 }

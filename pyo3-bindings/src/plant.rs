@@ -78,10 +78,11 @@ impl PyPlant {
     /// in this process on loopback); `log`: the rig log to replay, or to write (twin, rig);
     /// `goto`: reset drives the robots to the episode's start poses, for at most `goto_timeout` s.
     /// `twin_scenario` (a file) / `twin_scenario_text` (TOML) / `twin_overrides_json` (a JSON object
-    /// of key paths and values over the host's scenario): what a twin started here plays instead.
+    /// of key paths and values over the host's scenario): what a twin started here plays instead;
+    /// `truth` (a file of `[[robot]]` entries, `colcos twin --truth`): its robots' hidden values.
     /// The other arguments are `VecEnv`'s (one world).
     #[new]
-    #[pyo3(signature = (plant, task, tracker=None, robots=None, log=None, goto=None, goto_timeout=None, twin_scenario=None, twin_scenario_text=None, twin_overrides_json=None, seed=None, scenario=None, scenario_text=None, max_cycles=None, action=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None, physics=None))]
+    #[pyo3(signature = (plant, task, tracker=None, robots=None, log=None, goto=None, goto_timeout=None, twin_scenario=None, twin_scenario_text=None, twin_overrides_json=None, seed=None, scenario=None, scenario_text=None, max_cycles=None, action=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None, physics=None, truth=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -106,6 +107,7 @@ impl PyPlant {
         params_json: Option<&Bound<'_, PyAny>>,
         backend: Option<&Bound<'_, PyAny>>,
         physics: Option<&Bound<'_, PyAny>>,
+        truth: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         guard(|| {
             let kind: PlantKind = args::text(plant, "plant")?.parse().map_err(plant_err)?;
@@ -139,6 +141,7 @@ impl PyPlant {
                 args::opt_text(twin_scenario_text, "twin_scenario_text")?,
                 args::opt_text(twin_overrides_json, "twin_overrides_json")?,
             )?;
+            opts.twin_truth = args::opt_text(truth, "truth")?.map(std::path::PathBuf::from);
             let one = Some(1u64.into_pyobject(py)?.into_any());
             let cfg = crate::vec_env::config(
                 task,

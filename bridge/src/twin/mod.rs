@@ -12,7 +12,7 @@ pub use camera::{CameraModel, Noise, detect_fiducials};
 pub use plant::{FIRMWARE_TIMEOUT, TwinPlant};
 pub use robot_end::{
     BUMPER_DARK, BUMPER_SPAN, ByteChannel, PtyChannel, Received, RobotEnd, RobotFaults, UdpChannel,
-    bumper_reading,
+    bumper_reading, motion as legacy_motion_wheels,
 };
 pub use tracker_server::{TrackerFaults, TrackerServer};
 

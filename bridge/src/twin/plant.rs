@@ -130,14 +130,20 @@ impl TwinPlant {
                 let size = Vec2::from(self.world.screen().size);
                 let points = sensor_positions(&pose, SENSOR_RADIUS);
                 let rng = &mut self.telemetry_rng[i];
-                match self.world.robot_sensors(i) {
+                let mut counts = match self.world.robot_sensors(i) {
                     // The scenario's per-robot sensors (`[sensor] per_robot`): each of the four
                     // its own model, read in order.
                     Some(own) => std::array::from_fn(|k| {
                         own.truth[k].read_frame(frame, size, &[points[k]], rng)[0]
                     }),
                     None => self.world.sensor().read_frame(frame, size, &points, rng),
+                };
+                // The robot's own gain and offset (`[individual]`, a twin's `--truth`), as the
+                // simulator applies them to what its sensors deliver.
+                if let Some((gain, offset)) = self.world.sensor_gain(i) {
+                    colcos_sim::scenario::individual::apply_sensor_gain(&mut counts, gain, offset);
                 }
+                counts
             }
             None => self.world.observations()[i].counts,
         }

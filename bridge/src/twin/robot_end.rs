@@ -288,7 +288,7 @@ pub fn bumper_reading(on: u16, off: u16) -> f32 {
 }
 
 /// Wheel speeds for an old firmware motion command, as that firmware drives.
-fn motion(kind: MotionKind, speed: f32) -> WheelCommand {
+pub fn motion(kind: MotionKind, speed: f32) -> WheelCommand {
     let s = if speed.is_finite() { speed } else { 0.0 };
     match kind {
         MotionKind::Forward | MotionKind::Start => WheelCommand { left: s, right: s },

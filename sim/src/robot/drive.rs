@@ -20,11 +20,26 @@ impl DriveState {
     /// `v += (cmd - v) * (1 - exp(-dt / tau))` with `tau = params.motor_lag`; `tau <= 0` follows the
     /// command at once. Commands are clamped to `+-max_wheel_speed`, NaN counts as 0.
     pub fn update(&mut self, cmd: WheelCommand, params: &ColiasParams, dt: f32) {
+        self.update_with(cmd, params, params.motor_lag, [1.0, 1.0], dt);
+    }
+
+    /// [`Self::update`] for a robot of its own (`[individual]`): time constant `tau` instead of
+    /// `params.motor_lag`, and each clamped command component times its wheel's `scale` (a wheel
+    /// that runs slow at the same command). With `tau = params.motor_lag` and scales of 1 the
+    /// results are bit for bit [`Self::update`]'s (`x * 1.0 == x`).
+    pub fn update_with(
+        &mut self,
+        cmd: WheelCommand,
+        params: &ColiasParams,
+        tau: f32,
+        scale: [f32; 2],
+        dt: f32,
+    ) {
         let max = params.max_wheel_speed.abs();
-        let l = clamp_command(cmd.left, max);
-        let r = clamp_command(cmd.right, max);
-        let alpha = if params.motor_lag > 0.0 {
-            -(-dt.max(0.0) / params.motor_lag).exp_m1()
+        let l = clamp_command(cmd.left, max) * scale[0];
+        let r = clamp_command(cmd.right, max) * scale[1];
+        let alpha = if tau > 0.0 {
+            -(-dt.max(0.0) / tau).exp_m1()
         } else {
             1.0
         };

@@ -1,10 +1,12 @@
 //! The Colias robot: body, differential drive with motor lag, and the rapier2d physics of a whole arena.
 
+mod actuation;
 mod colias;
 mod drive;
 mod obstacle_contacts;
 mod physics;
 
+pub use actuation::Actuation;
 pub use colias::ColiasParams;
 pub use drive::DriveState;
 pub use physics::{ArenaPhysics, MAX_HOSTED_ARENAS, PhysicsBackend, RapierHost};

@@ -2,6 +2,7 @@
 //! then validated before anything runs; or built in code with [`ScenarioBuilder`].
 
 mod builder;
+pub mod individual;
 mod limits;
 pub(crate) mod placement;
 mod randomize;
@@ -10,6 +11,7 @@ mod spec;
 mod validate;
 
 pub use builder::ScenarioBuilder;
+pub use individual::{Individual, IndividualFile, IndividualSpec, RobotIndividual};
 pub use limits::{
     MAX_CELLS, MAX_DEPOSIT_CELLS, MAX_GIF_SIDE, MAX_IMAGE_PIXELS, MAX_MAP_CELL_VISITS,
     MAX_POLYLINE_POINTS, MAX_POSES_IN_FLIGHT, MAX_ROBOTS, MAX_SOURCE_PAIRS, MAX_SUBSTEPS,
@@ -136,6 +138,7 @@ impl Scenario {
         spec.rig.screen_calibration.iter_mut().for_each(absolute);
         spec.rig.colour_calibration.iter_mut().for_each(absolute);
         spec.rig.onboard.iter_mut().for_each(absolute);
+        spec.individual.file.iter_mut().for_each(absolute);
         toml::to_string_pretty(&spec).unwrap_or_default()
     }
 }

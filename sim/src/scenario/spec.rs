@@ -58,6 +58,12 @@ pub struct ScenarioSpec {
         skip_serializing_if = "super::randomize::RandomizeSpec::is_default"
     )]
     pub randomize: super::randomize::RandomizeSpec,
+    /// Robots that differ: each robot's own wheels, motor lag, command latency and sensor gain.
+    #[serde(
+        default,
+        skip_serializing_if = "super::individual::IndividualSpec::is_default"
+    )]
+    pub individual: super::individual::IndividualSpec,
 }
 
 fn default_dt() -> f32 {

@@ -71,6 +71,7 @@ pub(super) fn validate(sc: &Scenario) -> Result<()> {
     validate_robots(sc)?;
     s.rig.validate(sc.robot_count())?;
     s.randomize.validate()?;
+    super::individual::validate_entries(&s.individual.robot, "individual.robot", sc.robot_count())?;
     Ok(())
 }
 

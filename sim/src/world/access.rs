@@ -95,6 +95,17 @@ impl World {
     pub fn robot_sensors(&self, i: usize) -> Option<&super::RobotSensors> {
         self.sensing.robot_sensors(i)
     }
+    /// Robot `i`'s own colour gain and offset on its counts (`[individual]`; `None`: nominal).
+    pub fn sensor_gain(&self, i: usize) -> Option<(f32, f32)> {
+        self.sensing.sensor_gain(i)
+    }
+    /// Robot `i`'s own actuation (`[individual]`; `None`: the nominal `[robot]` model).
+    pub fn actuation(&self, i: usize) -> Option<&crate::robot::Actuation> {
+        self.robots
+            .slots()
+            .get(i)
+            .and_then(|s| s.actuation.as_ref())
+    }
     /// The neighbour index of the current poses (tests probe bumpers through it).
     pub fn neighbour_index(&self) -> &NeighbourIndex {
         self.sensing.neighbours()

@@ -9,8 +9,10 @@ use crate::field::{
     image_map, polyline_map,
 };
 use crate::rng::{self, Stream};
-use crate::robot::{ArenaPhysics, DriveState, Pose};
-use crate::scenario::{EmitWhen, MapSpec, ModelKind, PheromoneSpec, Scenario, placement};
+use crate::robot::{Actuation, ArenaPhysics, DriveState, Pose};
+use crate::scenario::{
+    EmitWhen, MapSpec, ModelKind, PheromoneSpec, Scenario, ScenarioSpec, placement,
+};
 use crate::sensors::ColourSensor;
 use crate::tracker::Tracker;
 use glam::Vec2;
@@ -39,18 +41,19 @@ impl World {
         // Domain randomisation: this world's own draw of the `[randomize]` ranges.
         let base_sensor = scenario.spec.sensor;
         let drawn;
+        let mut rng = None;
         let scenario = if scenario.spec.randomize.is_default() {
             scenario
         } else {
             let mut sc = scenario.clone();
-            let mut rng = rng::stream_of(sc.spec.seed, world_index, Stream::Randomize);
+            let rng = rng.insert(rng::stream_of(sc.spec.seed, world_index, Stream::Randomize));
             let s = &mut sc.spec;
             let parts = crate::scenario::Randomized {
                 tracker: &mut s.tracker,
                 sensor: &mut s.sensor,
                 robot: &mut s.robot,
             };
-            scenario.spec.randomize.apply(parts, &mut rng);
+            scenario.spec.randomize.apply(parts, rng);
             drawn = sc;
             &drawn
         };
@@ -60,6 +63,18 @@ impl World {
         if spec.sensor.per_robot {
             let sensors = robot_sensors(scenario, &base_sensor, parts.poses.len())?;
             parts.sensing.set_robot_sensors(sensors);
+        }
+        // Robots that differ (`[individual]`), then `[randomize]`'s draws around each one's values.
+        let n = parts.poses.len();
+        let mut each = crate::scenario::individual::resolve(scenario, n)?;
+        if let Some(rng) = rng.as_mut()
+            && spec.randomize.draws_per_robot()
+        {
+            let each = each.get_or_insert_with(|| vec![Default::default(); n]);
+            spec.randomize.apply_each(each, spec.robot.motor_lag, rng);
+        }
+        if let Some(each) = &each {
+            individualise(&mut parts, each, spec);
         }
         let mut physics =
             ArenaPhysics::with_backend(arena, &spec.robot, &parts.poses, spec.physics);
@@ -124,6 +139,7 @@ impl WorldParts {
                     rng: rng::stream_of(spec.seed, world_index, Stream::Robot(index)),
                     drive: DriveState::default(),
                     command: WheelCommand::STOP,
+                    actuation: None,
                 });
                 for d in &group.deposits {
                     let pheromone = scenario.pheromone_index(&d.pheromone).expect("validated");
@@ -312,4 +328,29 @@ fn robot_sensors(
         })?;
     let radio = spec.rig.radio_addresses(robots)?;
     super::sensing::per_robot_sensors(&calibration, &radio, &spec.sensor, base, file)
+}
+
+/// Gives every robot that differs from the nominal model its own actuation and sensor gain.
+fn individualise(
+    parts: &mut WorldParts,
+    each: &[crate::scenario::Individual],
+    spec: &ScenarioSpec,
+) {
+    for (slot, own) in parts.slots.iter_mut().zip(each) {
+        if !own.drives_nominally() {
+            slot.actuation = Some(Actuation::new(
+                own.wheel_scale,
+                own.motor_lag.unwrap_or(spec.robot.motor_lag),
+                own.latency,
+                spec.dt,
+            ));
+        }
+    }
+    if each.iter().any(|e| !e.senses_nominally()) {
+        let gains = each
+            .iter()
+            .map(|e| (e.sensor_gain, e.sensor_offset))
+            .collect();
+        parts.sensing.set_sensor_gains(gains);
+    }
 }

@@ -16,6 +16,9 @@ pub struct RobotSlot {
     pub drive: DriveState,
     /// Command applied in the last step.
     pub command: WheelCommand,
+    /// The robot's own wheels, motor and command latency (`[individual]`); `None`: the nominal
+    /// `[robot]` model.
+    pub actuation: Option<crate::robot::Actuation>,
 }
 
 pub struct RobotSet {
@@ -70,7 +73,10 @@ fn drive_one(
         WheelCommand::STOP
     };
     slot.command = cmd;
-    slot.drive.update(cmd, params, dt);
+    match &mut slot.actuation {
+        Some(own) => own.drive(&mut slot.drive, cmd, params, dt),
+        None => slot.drive.update(cmd, params, dt),
+    }
     slot.drive.body_velocity(params)
 }
 

@@ -19,6 +19,9 @@ pub struct Sensing {
     /// Each robot's own four sensors (`[sensor] per_robot`), or none: every robot reads through
     /// `sensor`.
     robot_sensors: Vec<RobotSensors>,
+    /// Each robot's own colour gain and offset (`[individual]`), or none: every robot's counts as
+    /// its sensors read them.
+    sensor_gains: Vec<(f32, f32)>,
     bumper_params: BumperParams,
     bumper_rays: BumperRays,
     /// Robot radius, m (bumper rays start at the rim).
@@ -49,6 +52,7 @@ impl Sensing {
         Sensing {
             sensor,
             robot_sensors: Vec::new(),
+            sensor_gains: Vec::new(),
             bumper_rays: BumperRays::new(&bumper_params),
             bumper_params,
             radius,
@@ -72,6 +76,14 @@ impl Sensing {
     /// Gives each robot its own four sensors (one entry per robot, in order).
     pub fn set_robot_sensors(&mut self, sensors: Vec<RobotSensors>) {
         self.robot_sensors = sensors;
+    }
+    /// Robot `i`'s own colour gain and offset (`[individual]`), if the robots have their own.
+    pub fn sensor_gain(&self, i: usize) -> Option<(f32, f32)> {
+        self.sensor_gains.get(i).copied()
+    }
+    /// Gives each robot its own colour gain and offset on the counts (one entry per robot).
+    pub fn set_sensor_gains(&mut self, gains: Vec<(f32, f32)>) {
+        self.sensor_gains = gains;
     }
     /// The arena's static obstacles (what the bumpers see besides walls and robots).
     pub fn obstacles(&self) -> &Arc<Obstacles> {
@@ -134,6 +146,7 @@ pub fn sense(
     let (pheromones, frozen) = (fields.pheromones(), fields.frozen());
     let (sensor, neighbours, bumper) = (&sensing.sensor, &sensing.neighbours, &sensing.bumper_rays);
     let robot_sensors = &sensing.robot_sensors;
+    let sensor_gains = &sensing.sensor_gains;
     let (radius, arena) = (sensing.radius, sensing.arena);
     let obstacles = &*sensing.obstacles;
     let printed = obstacles.printed();
@@ -176,6 +189,15 @@ pub fn sense(
                     &mut slot.rng,
                 );
             }
+        }
+        // A robot's own gain and offset act on the counts its sensors deliver; its intensities
+        // then read them through the calibrated (nominal) inverse, as the rig's robot would.
+        if let Some(&(gain, offset)) = sensor_gains.get(i) {
+            crate::scenario::individual::apply_sensor_gain(&mut o.counts, gain, offset);
+            o.intensity = match robot_sensors.get(i) {
+                Some(own) => std::array::from_fn(|k| own.inverse[k].intensity(o.counts[k])),
+                None => sensor.intensities(&o.counts),
+            };
         }
         o.bumpers =
             neighbours.bumpers_facing(i, poses, forwards[i], radius, arena, bumper, obstacles);

@@ -1,0 +1,101 @@
+//! System identification from a rig log (`colcos rig identify`): each robot's wheel scales, motor
+//! lag and command-to-motion latency, fitted from the commands the bridge sent and the poses the
+//! tracker delivered, each with its uncertainty, written as a file of per-robot values that a
+//! scenario's `[individual] file` (and `colcos twin --truth`) reads.
+//!
+//! The files: [`series`] turns the log into each robot's commands and poses, [`windows`] the poses
+//! into what the robot did between captures, [`response`] the commands into what a model robot would
+//! have done, [`fit`] searches the parameters, [`overlay`] writes them.
+pub mod excite;
+pub mod fit;
+pub mod overlay;
+pub mod response;
+pub mod series;
+pub mod windows;
+
+pub use excite::Excitation;
+pub use fit::{FitOptions, Param, RobotFit, fit_robot};
+pub use series::{RobotSeries, SeriesError, robot_series};
+
+use crate::live::replay;
+use crate::recorder::{read_log, read_metadata};
+use colcos_sim::scenario::Scenario;
+
+/// What identification found in one log.
+#[derive(Clone, Debug)]
+pub struct Identified {
+    pub robots: Vec<RobotFit>,
+    /// The tracker's mean latency as the bridge measured it (the poses' age at arrival), s.
+    pub tracker_latency: Option<f64>,
+    /// Seconds of log.
+    pub duration: f64,
+}
+
+impl Identified {
+    /// The tracker's noise as the fit's residuals show it, median over the robots: (position m,
+    /// heading rad). A window's residual is the difference of two poses' errors, hence the `sqrt 2`;
+    /// what the model misses adds to it, so these are upper bounds.
+    pub fn tracker_noise(&self) -> Option<(f64, f64)> {
+        let mut p: Vec<f64> = (self.robots.iter().map(|r| r.rms[1]))
+            .filter(|v| v.is_finite())
+            .collect();
+        let mut h: Vec<f64> = (self.robots.iter().map(|r| r.rms[0]))
+            .filter(|v| v.is_finite())
+            .collect();
+        if p.is_empty() || h.is_empty() {
+            return None;
+        }
+        p.sort_by(f64::total_cmp);
+        h.sort_by(f64::total_cmp);
+        let s = std::f64::consts::SQRT_2;
+        Some((p[p.len() / 2] / s, h[h.len() / 2] / s))
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum IdentifyError {
+    #[error(transparent)]
+    Series(#[from] SeriesError),
+    #[error(transparent)]
+    Replay(#[from] replay::ReplayError),
+}
+
+/// Identifies every robot of `scenario` from the rig log `bytes`.
+pub fn identify(
+    bytes: &[u8],
+    scenario: &Scenario,
+    opts: &FitOptions,
+) -> Result<Identified, IdentifyError> {
+    series::check_scenario(&read_metadata(bytes), scenario)?;
+    let log = read_log(bytes);
+    let ticks = replay::ticks_of(&log, scenario.robot_count())?;
+    let robots = robot_series(&ticks, scenario)?;
+    let ages: Vec<f64> = ticks
+        .iter()
+        .flat_map(|t| t.poses.iter().filter(|p| p.fresh).map(|p| p.age))
+        .filter(|a| a.is_finite())
+        .collect();
+    let tracker_latency = (!ages.is_empty()).then(|| ages.iter().sum::<f64>() / ages.len() as f64);
+    let duration = ticks.last().map_or(0.0, |t| t.t) - ticks.first().map_or(0.0, |t| t.t);
+    let opts = FitOptions {
+        wheel_base: scenario.spec.robot.wheel_base as f64,
+        step: scenario.spec.dt as f64,
+        ..*opts
+    };
+    let fits = std::thread::scope(|s| {
+        let handles: Vec<_> = robots
+            .iter()
+            .enumerate()
+            .map(|(i, r)| s.spawn(move || fit_robot(i, &r.commands, &r.poses, &opts)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a fit panicked"))
+            .collect()
+    });
+    Ok(Identified {
+        robots: fits,
+        tracker_latency,
+        duration,
+    })
+}

@@ -1,0 +1,186 @@
+//! `colcos rig excite` and `colcos rig identify`: drive a short, bounded excitation through the
+//! bridge (inside the shield) while it records the rig log, then fit each robot's wheel scales,
+//! motor lag and command latency from that log into a file of per-robot values that a scenario's
+//! `[individual] file` (and `colcos twin --truth`) reads.
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use colcos_bridge::calibrate::RigCalibration;
+use colcos_bridge::identify::{self, Excitation, FitOptions, Param};
+use colcos_bridge::live::{LiveOptions, LiveSession};
+use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
+use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::scenario::Scenario;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Longest excitation, s: the robots drive unattended meanwhile.
+pub const MAX_EXCITE_SECONDS: f64 = 300.0;
+
+#[derive(Args, Debug)]
+pub struct ExciteArgs {
+    /// Scenario file (TOML) with its `[rig]` section: the robots, the arena and the shield.
+    pub scenario: PathBuf,
+    /// Where poses come from (as `colcos bridge --tracker`).
+    #[arg(long)]
+    pub tracker: String,
+    /// The robots' radio link (as `colcos bridge --robots`).
+    #[arg(long)]
+    pub robots: String,
+    /// Seconds of excitation (at most 300).
+    #[arg(long, default_value_t = 60.0)]
+    pub seconds: f64,
+    /// Largest wheel speed commanded, as a fraction of the shield's limit.
+    #[arg(long, default_value_t = 0.4)]
+    pub speed: f64,
+    /// Output directory: rig.mcap.
+    #[arg(long, default_value = "runs/excite")]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct IdentifyArgs {
+    /// The rig log (`rig.mcap` of `colcos rig excite` or `colcos bridge`).
+    pub log: PathBuf,
+    /// The scenario the log was recorded with (its robots' radio and tracker IDs, wheel base, step).
+    #[arg(long)]
+    pub scenario: PathBuf,
+    /// Where to write the robots' values (a file of `[[robot]]` entries for `[individual] file`).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `colcos rig excite`.
+pub fn excite(args: ExciteArgs, text: &mut String) -> Result<()> {
+    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= MAX_EXCITE_SECONDS) {
+        bail!(
+            "--seconds {}: must be in (0, {MAX_EXCITE_SECONDS}]",
+            args.seconds
+        );
+    }
+    if !(args.speed.is_finite() && args.speed > 0.0 && args.speed <= 1.0) {
+        bail!(
+            "--speed {}: must be a fraction in (0, 1] of the shield's wheel-speed limit",
+            args.speed
+        );
+    }
+    let sc = Scenario::from_file(&args.scenario)?;
+    let limit = sc
+        .spec
+        .rig
+        .shield
+        .max_wheel_speed
+        .min(sc.spec.robot.max_wheel_speed);
+    // The excitation turns and drives in small circles; its commands go through the shield, which
+    // keeps every robot inside the arena's virtual walls, and what the shield made of them is what
+    // the log records and identification fits.
+    if sc.spec.rig.shield.margin < sc.spec.robot.radius {
+        bail!(
+            "[rig] shield.margin = {} m is less than the robot's radius {} m: the excitation would \
+             drive bodies past the arena's edge; widen the margin",
+            sc.spec.rig.shield.margin,
+            sc.spec.robot.radius
+        );
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating output directory {}", args.out.display()))?;
+    let calibration = RigCalibration::load(&sc)?;
+    let opts = SourceOptions::new(calibration.frame_transform(&sc));
+    let source = open_pose_source(&args.tracker, &opts)
+        .with_context(|| format!("--tracker {}", args.tracker))?;
+    let link =
+        open_robot_link(&args.robots).with_context(|| format!("--robots {}", args.robots))?;
+    let log = args.out.join("rig.mcap");
+    let live_opts = LiveOptions {
+        duration: Some(args.seconds),
+        log: Some(log.clone()),
+        ..LiveOptions::default()
+    };
+    let excitation = Excitation::new(sc.spec.seed, (args.speed * limit as f64) as f32);
+    let n = sc.robot_count();
+    let mut session = LiveSession::new(&sc, source, link, None, live_opts)?;
+    let mut overrides: Vec<Option<WheelCommand>> = vec![None; n];
+    while !session.is_over() {
+        let t = session.elapsed();
+        for (i, o) in overrides.iter_mut().enumerate() {
+            *o = Some(excitation.command(i, t));
+        }
+        session.tick(&overrides)?;
+        session.wait_next();
+    }
+    let report = session.report();
+    writeln!(
+        text,
+        "excited {n} robots for {:.1} s: {} ticks, {} pose blocks, {} commands; shield capped {} and walled {}",
+        report.seconds,
+        report.ticks,
+        report.pose_blocks,
+        report.commands_sent,
+        report.shield.capped,
+        report.shield.walled
+    )?;
+    writeln!(text, "  wrote {}", log.display())?;
+    if report.pose_blocks == 0 {
+        bail!("no pose arrived from the tracker {}", args.tracker);
+    }
+    Ok(())
+}
+
+/// `colcos rig identify`.
+pub fn identify(args: IdentifyArgs, text: &mut String) -> Result<()> {
+    let sc = Scenario::from_file(&args.scenario)?;
+    let bytes =
+        std::fs::read(&args.log).with_context(|| format!("reading {}", args.log.display()))?;
+    let found = identify::identify(&bytes, &sc, &FitOptions::default())
+        .with_context(|| format!("identifying from {}", args.log.display()))?;
+    writeln!(
+        text,
+        "{:.1} s of log; tracker latency {}",
+        found.duration,
+        found
+            .tracker_latency
+            .map_or("unknown".into(), |t| format!("{:.1} ms", 1e3 * t))
+    )?;
+    if let Some((p, h)) = found.tracker_noise() {
+        writeln!(
+            text,
+            "tracker noise at most {:.2} mm, {:.4} rad (the fit's residuals)",
+            1e3 * p,
+            h
+        )?;
+    }
+    for f in &found.robots {
+        writeln!(
+            text,
+            "robot {}: wheel scales {}; motor lag {}; latency {} ({} windows, {} left out as collisions)",
+            f.index,
+            show2(&f.wheel_scale),
+            show_ms(&f.motor_lag),
+            show_ms(&f.latency),
+            f.windows,
+            f.outliers
+        )?;
+    }
+    let file = identify::overlay::overlay(&found, &args.log.display().to_string(), &sc.spec.name);
+    std::fs::write(&args.out, file.to_toml())
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    writeln!(
+        text,
+        "  wrote {} (name it in the scenario as [individual] file)",
+        args.out.display()
+    )?;
+    Ok(())
+}
+
+fn show2(p: &Param<[f64; 2]>) -> String {
+    match p {
+        Ok((v, sd)) => format!("{:.3} +- {:.3} / {:.3} +- {:.3}", v[0], sd[0], v[1], sd[1]),
+        Err(why) => why.clone(),
+    }
+}
+
+fn show_ms(p: &Param<f64>) -> String {
+    match p {
+        Ok((v, sd)) => format!("{:.1} +- {:.1} ms", 1e3 * v, 1e3 * sd),
+        Err(why) => why.clone(),
+    }
+}
