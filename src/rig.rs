@@ -204,7 +204,7 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
 pub fn twin(args: TwinArgs, text: &mut String) -> Result<()> {
     let mut sc = Scenario::from_file(&args.scenario)?;
     if let Some(truth) = &args.truth {
-        sc = colcos_sim::scenario::individual::with_truth(&sc, truth)?;
+        sc = sc.with_truth(truth)?;
     }
     if !args.public && !args.tracker.ip().is_loopback() {
         bail!(

@@ -14,7 +14,6 @@ use colcos_bridge::twin::{TrackerServer, Twin, UdpChannel};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;
-use colcos_sim::scenario::individual::with_truth;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
@@ -52,7 +51,7 @@ fn the_twin_drives_its_hidden_truth_and_identification_finds_it() {
     let truth_path = dir.path().join("truth.toml");
     std::fs::write(&truth_path, truth).unwrap();
     let host = Scenario::from_toml_str(SCENARIO, dir.path()).unwrap();
-    let twin_sc = with_truth(&host, &truth_path).unwrap();
+    let twin_sc = host.with_truth(&truth_path).unwrap();
     // The host never sees the truth.
     assert!(host.spec.individual.is_default());
 
@@ -115,11 +114,13 @@ fn the_twin_drives_its_hidden_truth_and_identification_finds_it() {
         );
         latencies.push(lat);
     }
-    // Robot 1's truth is no latency: what it shows is the pipeline's own, shared by all.
+    // Robot 1's truth is no latency: what it shows is the pipeline's own, shared by all. In real time
+    // on a loaded 2-core machine that shared delay jitters by about a tick between robots (11.5 ms
+    // seen at load 7), hence 20 ms here; the 5 ms bar holds in lockstep (`tests/identify.rs`).
     for (i, (_, _, lat)) in TRUTH.iter().enumerate() {
         let relative = latencies[i] - latencies[1];
         assert!(
-            (relative - lat).abs() < 0.010,
+            (relative - lat).abs() < 0.020,
             "robot {i}: {relative} s beyond robot 1, truth {lat} s (all: {latencies:?})"
         );
     }

@@ -174,7 +174,7 @@ impl LiveEnv {
                     None => scenario.clone(),
                 };
                 if let Some(truth) = &plant.twin_truth {
-                    own = colcos_sim::scenario::individual::with_truth(&own, truth)?;
+                    own = own.with_truth(truth)?;
                 }
                 Some(TwinThread::start_seeing(
                     &own,

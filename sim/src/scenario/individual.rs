@@ -259,27 +259,8 @@ pub fn apply_sensor_gain(counts: &mut [[u16; 3]; 4], gain: f32, offset: f32) {
     }
 }
 
-/// `scenario` with its robots' values taken from the file `truth` alone (`colcos twin --truth`): a
-/// twin's hidden per-robot truths, where the host drives with the scenario's nominal values. The
-/// file is read and checked here, so that a bad one is refused before anything starts.
-pub fn with_truth(scenario: &super::Scenario, truth: &Path) -> Result<super::Scenario> {
-    let shown = truth.display().to_string();
-    let loaded = IndividualFile::load(truth)
-        .map_err(|e| SimError::invalid("truth", format!("{shown:?}"), e.to_string()))?;
-    validate_entries(&loaded.robot, "robot", scenario.robot_count())
-        .map_err(|e| SimError::invalid("truth", format!("{shown:?}"), inner(e)))?;
-    let absolute = std::path::absolute(truth).unwrap_or_else(|_| truth.to_path_buf());
-    let mut out = scenario.clone();
-    out.spec.individual = IndividualSpec {
-        file: Some(absolute.to_string_lossy().into_owned()),
-        robot: Vec::new(),
-    };
-    super::validate::validate(&out)?;
-    Ok(out)
-}
-
 /// An error about a key inside a file, without the scenario's prefix (the file's key names it).
-fn inner(e: SimError) -> String {
+pub(super) fn inner(e: SimError) -> String {
     match e {
         SimError::Invalid { key, value, reason } => format!("`{key}` = {value}: {reason}"),
         other => other.to_string(),

@@ -33,6 +33,25 @@ pub struct Scenario {
 }
 
 impl Scenario {
+    /// This scenario with its robots' values taken from the file `truth` alone (`colcos twin
+    /// --truth`): a twin's hidden per-robot truths, where the host drives with the scenario's nominal
+    /// values. The file is read and checked here, so that a bad one is refused before anything starts.
+    pub fn with_truth(&self, truth: &Path) -> Result<Scenario> {
+        let shown = truth.display().to_string();
+        let loaded = individual::IndividualFile::load(truth)
+            .map_err(|e| SimError::invalid("truth", format!("{shown:?}"), e.to_string()))?;
+        individual::validate_entries(&loaded.robot, "robot", self.robot_count())
+            .map_err(|e| SimError::invalid("truth", format!("{shown:?}"), individual::inner(e)))?;
+        let absolute = std::path::absolute(truth).unwrap_or_else(|_| truth.to_path_buf());
+        let mut out = self.clone();
+        out.spec.individual = individual::IndividualSpec {
+            file: Some(absolute.to_string_lossy().into_owned()),
+            robot: Vec::new(),
+        };
+        validate::validate(&out)?;
+        Ok(out)
+    }
+
     /// Its obstacles (none when it lists none), built as the world builds them.
     pub fn obstacles(&self) -> Result<crate::arena::Obstacles> {
         crate::arena::Obstacles::build_in(
