@@ -412,6 +412,14 @@ fn a_lost_robot_alone_is_stopped_in_time() {
     );
 }
 
+/// The rig log's events, as text.
+fn events_of(log: &[colcos_bridge::recorder::Recorded]) -> Vec<String> {
+    log.iter()
+        .filter(|m| m.topic == Topic::Events)
+        .map(|m| String::from_utf8_lossy(&m.data).to_string())
+        .collect()
+}
+
 /// A robot whose radio goes quiet (it neither obeys nor answers): the bridge notices within about a
 /// second of unanswered data requests, says so, and sends it nothing but stops from then on.
 #[test]
@@ -424,12 +432,7 @@ fn a_robot_that_stops_answering_is_reported() {
     });
     let _twin = rig.twin.join().unwrap();
     assert_eq!(rig.report.silent_robots, vec![4], "{:?}", rig.report);
-    let events: Vec<String> = rig
-        .log
-        .iter()
-        .filter(|m| m.topic == Topic::Events)
-        .map(|m| String::from_utf8_lossy(&m.data).to_string())
-        .collect();
+    let events = events_of(&rig.log);
     assert!(
         events.iter().any(|e| e.contains("robot_silent")),
         "{events:?}"
@@ -448,12 +451,7 @@ fn a_robot_that_never_answers_is_reported() {
     });
     let _twin = rig.twin.join().unwrap();
     assert_eq!(rig.report.silent_robots, vec![5], "{:?}", rig.report);
-    let events: Vec<String> = rig
-        .log
-        .iter()
-        .filter(|m| m.topic == Topic::Events)
-        .map(|m| String::from_utf8_lossy(&m.data).to_string())
-        .collect();
+    let events = events_of(&rig.log);
     assert!(
         events.iter().any(|e| e.contains("never answered")),
         "{events:?}"
