@@ -36,16 +36,7 @@ impl<const G: usize> NearbyPoints<G> {
             sx.iter().sum::<f32>() * inv_n,
             sy.iter().sum::<f32>() * inv_n,
         );
-        let mut near = NearbyPoints {
-            len: n,
-            centroid: (cx, cy),
-            max_offset: (0.0, 0.0),
-            ex: [0.0; G],
-            ey: [0.0; G],
-            exx: [0.0; G],
-            eyy: [0.0; G],
-            exy: [0.0; G],
-        };
+        let mut near = Self::about(n, (cx, cy));
         // Largest magnitudes as integers: the bits of non-negative floats order as the floats (and a
         // NaN offset, above infinity, makes the bound NaN: the per-point path).
         let (mut mx, mut my) = (0u32, 0u32);
@@ -65,6 +56,21 @@ impl<const G: usize> NearbyPoints<G> {
 }
 
 impl<const G: usize> NearbyPoints<G> {
+    /// `n` points about `centroid`, their offsets still to be filled in.
+    #[inline]
+    fn about(n: usize, centroid: (f32, f32)) -> Self {
+        NearbyPoints {
+            len: n,
+            centroid,
+            max_offset: (0.0, 0.0),
+            ex: [0.0; G],
+            ey: [0.0; G],
+            exx: [0.0; G],
+            eyy: [0.0; G],
+            exy: [0.0; G],
+        }
+    }
+
     /// [`NearbyPoints::new`] of the first `n` points, bit for bit, for arrays whose lanes past `n`
     /// repeat lane 0 (a robot's 36 footprint samples padded to whole vectors) and `G` a multiple of
     /// eight: every lane's offsets are computed (no tail loop), and the padding leaves the largest
@@ -89,16 +95,7 @@ impl<const G: usize> NearbyPoints<G> {
             sx.iter().sum::<f32>() * inv_n,
             sy.iter().sum::<f32>() * inv_n,
         );
-        let mut near = NearbyPoints {
-            len: n,
-            centroid: (cx, cy),
-            max_offset: (0.0, 0.0),
-            ex: [0.0; G],
-            ey: [0.0; G],
-            exx: [0.0; G],
-            eyy: [0.0; G],
-            exy: [0.0; G],
-        };
+        let mut near = Self::about(n, (cx, cy));
         let (vcx, vcy) = (_mm256_set1_ps(cx), _mm256_set1_ps(cy));
         let sign = _mm256_set1_ps(-0.0);
         let (mut mx, mut my) = (_mm256_setzero_si256(), _mm256_setzero_si256());
