@@ -56,7 +56,10 @@ fn returns(task: &str, worlds: usize, seed: u64, who: Who) -> Vec<f64> {
         }
         env.step(Actions::Continuous(&a)).unwrap();
         for (w, t) in total.iter_mut().enumerate() {
-            *t += env.rewards()[w * n..(w + 1) * n].iter().sum::<f32>() as f64 / n as f64;
+            *t += env.outputs().rewards()[w * n..(w + 1) * n]
+                .iter()
+                .sum::<f32>() as f64
+                / n as f64;
         }
     }
     total

@@ -108,7 +108,7 @@ impl BaselinePolicy {
             )));
         }
         let d = env.obs_dim();
-        let obs = env.obs();
+        let obs = env.outputs().obs();
         for w in 0..e {
             let now = (env.episode(w), env.episode_steps(w));
             if now.0 != self.seen[w].0 || now.1 < self.seen[w].1 {

@@ -5,8 +5,9 @@
 //! `colcos_sim::robot::RapierHost`). Chunks are fixed by world index and count, so results do not
 //! depend on the number of threads.
 use crate::error::Result;
+use crate::outputs::OutSlices;
 use crate::world_slot::WorldSlot;
-use crate::world_step::{Begun, Ctx, Out, begin_world, conclude_world, finish_world};
+use crate::world_step::{Begun, Ctx, begin_world, conclude_world, finish_world};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::{MAX_HOSTED_ARENAS, PhysicsBackend, RapierHost};
 use colcos_sim::scenario::Scenario;
@@ -72,48 +73,6 @@ impl Chunks {
     }
 }
 
-/// The environment's output buffers, whole.
-pub(crate) struct Buffers<'a> {
-    pub(crate) obs: &'a mut [f32],
-    pub(crate) rewards: &'a mut [f32],
-    pub(crate) terminated: &'a mut [bool],
-    pub(crate) truncated: &'a mut [bool],
-    pub(crate) state: &'a mut [f32],
-    pub(crate) patch: &'a mut [u8],
-    pub(crate) final_obs: &'a mut [f32],
-    pub(crate) final_mask: &'a mut [bool],
-    pub(crate) shield: &'a mut [u8],
-}
-
-/// Per-world lengths of the buffers: agents, observation values, state values, patch bytes.
-#[derive(Clone, Copy)]
-pub(crate) struct Lengths {
-    pub(crate) agents: usize,
-    pub(crate) obs: usize,
-    pub(crate) state: usize,
-    pub(crate) patch: usize,
-    /// Deposit actions per agent.
-    pub(crate) deposits: usize,
-}
-
-impl Buffers<'_> {
-    /// World `i`'s slices.
-    pub(crate) fn world(&mut self, i: usize, len: Lengths) -> Out<'_> {
-        let part = |n: usize| i * n..(i + 1) * n;
-        Out {
-            obs: &mut self.obs[part(len.obs)],
-            rewards: &mut self.rewards[part(len.agents)],
-            terminated: &mut self.terminated[part(len.agents)],
-            truncated: &mut self.truncated[part(len.agents)],
-            state: &mut self.state[part(len.state)],
-            patch: &mut self.patch[part(len.patch)],
-            final_obs: &mut self.final_obs[part(len.obs)],
-            final_mask: &mut self.final_mask[i],
-            shield: &mut self.shield[part(len.agents)],
-        }
-    }
-}
-
 /// One step of every world, chunk by chunk on the current rayon pool.
 pub(crate) fn step_batch(
     ctx: &Ctx,
@@ -121,25 +80,23 @@ pub(crate) fn step_batch(
     chunks: &mut Chunks,
     commands: &[WheelCommand],
     rates: &[f32],
-    buffers: Buffers,
-    len: Lengths,
+    buffers: OutSlices,
 ) -> Result<()> {
     let c = chunks.size();
-    let outs = split(buffers, c, len);
+    let n = ctx.task.agents().len();
     chunks
         .par_iter_mut(slots)
-        .zip(commands.par_chunks(c * len.agents))
-        .zip(outs)
+        .zip(commands.par_chunks(c * n))
+        .zip(buffers.par_chunks(c))
         .enumerate()
         .try_for_each(|(k, (((slots, host), commands), mut buffers))| {
-            step_chunk(ctx, k * c, slots, host, commands, rates, &mut buffers, len)
+            step_chunk(ctx, k * c, slots, host, commands, rates, &mut buffers)
         })
 }
 
 /// One step of the worlds of a chunk (the first is world `first`; `commands` are the chunk's,
 /// `rates` the whole batch's): each begins its step, the host steps, each finishes. A world whose
 /// step fails leaves the others' steps whole; an error met is returned.
-#[allow(clippy::too_many_arguments)]
 fn step_chunk(
     ctx: &Ctx,
     first: usize,
@@ -147,17 +104,17 @@ fn step_chunk(
     mut host: Option<&mut RapierHost>,
     commands: &[WheelCommand],
     rates: &[f32],
-    buffers: &mut Buffers,
-    len: Lengths,
+    buffers: &mut OutSlices,
 ) -> Result<()> {
-    let per_world = len.agents * len.deposits;
+    let n = ctx.task.agents().len();
+    let per_world = n * ctx.deposits;
     let mut begun = [Begun::Reset; MAX_HOSTED_ARENAS];
     let mut result = Ok(());
     for (i, slot) in slots.iter_mut().enumerate() {
-        let cmds = &commands[i * len.agents..(i + 1) * len.agents];
+        let cmds = &commands[i * n..(i + 1) * n];
         let w = first + i;
         let lay = &rates[w * per_world..(w + 1) * per_world];
-        let mut out = buffers.world(i, len);
+        let mut out = buffers.world(i);
         let in_host = host.as_deref_mut().map(|h| (h, i));
         match begin_world(ctx, w, slot, (cmds, lay), &mut out, in_host) {
             Ok(b) => begun[i] = b,
@@ -171,7 +128,7 @@ fn step_chunk(
     // Last begun, first finished: those worlds' data is still in cache (worlds are independent, so
     // the order changes nothing else; 7-10 % more steps a second at 1,024 worlds).
     for (i, slot) in slots.iter_mut().enumerate().rev() {
-        let mut out = buffers.world(i, len);
+        let mut out = buffers.world(i);
         let in_host = host.as_deref_mut().map(|h| (h, i));
         let finished = finish_world(ctx, first + i, slot, &mut out, begun[i], in_host);
         if result.is_ok() {
@@ -181,68 +138,18 @@ fn step_chunk(
     result
 }
 
-/// The buffers cut into chunks of `c` worlds.
-fn split(
-    buffers: Buffers<'_>,
-    c: usize,
-    len: Lengths,
-) -> impl IndexedParallelIterator<Item = Buffers<'_>> {
-    let Buffers {
-        obs,
-        rewards,
-        terminated,
-        truncated,
-        state,
-        patch,
-        final_obs,
-        final_mask,
-        shield,
-    } = buffers;
-    obs.par_chunks_mut(c * len.obs)
-        .zip(rewards.par_chunks_mut(c * len.agents))
-        .zip(terminated.par_chunks_mut(c * len.agents))
-        .zip(truncated.par_chunks_mut(c * len.agents))
-        .zip(state.par_chunks_mut(c * len.state))
-        .zip(patch.par_chunks_mut(c * len.patch))
-        .zip(final_obs.par_chunks_mut(c * len.obs))
-        .zip(final_mask.par_chunks_mut(c))
-        .zip(shield.par_chunks_mut(c * len.agents))
-        .map(
-            |(
-                (
-                    ((((((obs, rewards), terminated), truncated), state), patch), final_obs),
-                    final_mask,
-                ),
-                shield,
-            )| {
-                Buffers {
-                    obs,
-                    rewards,
-                    terminated,
-                    truncated,
-                    state,
-                    patch,
-                    final_obs,
-                    final_mask,
-                    shield,
-                }
-            },
-        )
-}
-
 /// The end of every world's step that awaits it (a task written in Python: `ctx.evaluation` gives
 /// the rewards and terminations), chunk by chunk on the current rayon pool.
 pub(crate) fn conclude_batch(
     ctx: &Ctx,
     slots: &mut [WorldSlot],
     chunks: &mut Chunks,
-    buffers: Buffers,
-    len: Lengths,
+    buffers: OutSlices,
 ) -> Result<()> {
     let c = chunks.size();
     chunks
         .par_iter_mut(slots)
-        .zip(split(buffers, c, len))
+        .zip(buffers.par_chunks(c))
         .enumerate()
         .try_for_each(|(k, ((slots, mut host), mut buffers))| {
             let mut result = Ok(());
@@ -250,7 +157,7 @@ pub(crate) fn conclude_batch(
                 if !slot.awaiting {
                     continue;
                 }
-                let mut out = buffers.world(i, len);
+                let mut out = buffers.world(i);
                 let in_host = host.as_deref_mut().map(|h| (h, i));
                 let concluded = conclude_world(ctx, k * c + i, slot, &mut out, in_host);
                 if result.is_ok() {

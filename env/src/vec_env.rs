@@ -6,13 +6,14 @@
 //! `reset` overwrites them in place.
 use crate::actions::{ActionDecoder, Actions};
 use crate::backend::EnvBackend;
-use crate::batch_step::{Buffers, Chunks, Lengths, conclude_batch, step_batch};
-use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
+use crate::batch_step::{Chunks, conclude_batch, step_batch};
+use crate::config::{ActionKind, AutoresetMode, EnvConfig};
 use crate::error::{EnvError, Result};
+use crate::outputs::{Outputs, Writer};
 use crate::spaces::{EnvSpec, Space};
 use crate::task::{Task, registry};
+use crate::world_output::obs_dim;
 pub use crate::world_output::render_world;
-use crate::world_output::{obs_dim, write_patch, write_state, write_task_obs};
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
 use crate::world_step::{Ctx, Evaluation, step_world};
@@ -28,29 +29,18 @@ pub struct VecEnv {
     scenario: Scenario,
     backend: EnvBackend,
     mode: AutoresetMode,
-    patch_cfg: Option<PatchConfig>,
     pool: rayon::ThreadPool,
     slots: Vec<WorldSlot>,
     /// The chunks the worlds are stepped in, with their rapier hosts (see `batch_step`).
     chunks: Chunks,
-    obs: Vec<f32>,
-    rewards: Vec<f32>,
-    terminated: Vec<bool>,
-    truncated: Vec<bool>,
-    state: Vec<f32>,
-    patch: Vec<u8>,
-    final_obs: Vec<f32>,
-    final_mask: Vec<bool>,
-    /// What the shield did to each agent's last command `[E, N]`: bit 0 capped, bit 1 walled.
-    shield_flags: Vec<u8>,
+    out: Outputs,
+    writer: Writer,
     shield: Option<Shield>,
     /// Scratch: decoded wheel commands of the agents `[E, N]`.
     decoder: ActionDecoder,
     commands: Vec<colcos_sim::behaviour::WheelCommand>,
     /// Each agent's deposit rate fractions of this step, `[E, N, D]`.
     deposit_rates: Vec<f32>,
-    state_dim: usize,
-    patch_len: usize,
     needs_reset: bool,
     /// A deferred step waits for [`VecEnv::conclude`].
     awaiting: bool,
@@ -99,7 +89,6 @@ impl VecEnv {
             crate::actions::deposit_actions_per_agent(&scenario, task.agents())?,
             scenario.spec.robot.max_wheel_speed,
         );
-        let patch_len = cfg.patch.map_or(0, |p| p.pixels * p.pixels * 3);
         let threads = cfg.num_threads.unwrap_or(0);
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -165,32 +154,27 @@ impl VecEnv {
         let mut chunks = Chunks::new(&scenario, &slots);
         pool.install(|| chunks.attach_all(&mut slots));
         backend.settle(&slots[0].world);
+        let writer = Writer {
+            max_speed: scenario.spec.robot.max_wheel_speed,
+            max_cycles,
+            state: cfg.global_state,
+            patch: cfg.patch,
+        };
         let mut env = VecEnv {
+            out: Outputs::new(&spec),
+            writer,
             spec,
             task,
             scenario,
             backend,
             mode: cfg.autoreset,
-            patch_cfg: cfg.patch,
             pool,
             slots,
             chunks,
-            obs: vec![0.0; e * n * obs_dim],
-            rewards: vec![0.0; e * n],
-            terminated: vec![false; e * n],
-            truncated: vec![false; e * n],
-            // At least one element per world so that every buffer splits into E chunks.
-            state: vec![0.0; e * state_dim.max(1)],
-            patch: vec![0; e * n * patch_len.max(1)],
-            final_obs: vec![0.0; e * n * obs_dim],
-            final_mask: vec![false; e],
-            shield_flags: vec![0; e * n],
             shield,
             commands: vec![Default::default(); e * n],
             deposit_rates: vec![0.0; e * n * decoder.deposits()],
             decoder,
-            state_dim,
-            patch_len,
             needs_reset: true,
             awaiting: false,
         };
@@ -251,63 +235,14 @@ impl VecEnv {
         self.slots[e].episode.done
     }
 
-    /// Observations `[E, N, obs_dim]` (`OBS_DIM` sensor values, then the task's extras).
-    pub fn obs(&self) -> &[f32] {
-        &self.obs
+    /// The output buffers (observations, rewards, flags, state, patches, final observations, the
+    /// shield's flags), overwritten by every step and reset.
+    pub fn outputs(&self) -> &Outputs {
+        &self.out
     }
-    pub fn rewards(&self) -> &[f32] {
-        &self.rewards
-    }
-    pub fn terminated(&self) -> &[bool] {
-        &self.terminated
-    }
-    pub fn truncated(&self) -> &[bool] {
-        &self.truncated
-    }
-    /// Global state `[E, S]` (empty if disabled).
-    pub fn state(&self) -> &[f32] {
-        if self.state_dim == 0 {
-            &[]
-        } else {
-            &self.state
-        }
-    }
-    /// Screen patches `[E, N, P, P, 3]` (empty if disabled).
-    pub fn patch(&self) -> &[u8] {
-        if self.patch_len == 0 {
-            &[]
-        } else {
-            &self.patch
-        }
-    }
-    /// Final observations of worlds that ended in the last step (same-step autoreset) `[E, N, obs_dim]`.
-    pub fn final_obs(&self) -> &[f32] {
-        &self.final_obs
-    }
-    /// Which worlds ended (and were reset) in the last step, same-step autoreset.
-    pub fn final_mask(&self) -> &[bool] {
-        &self.final_mask
-    }
-    /// What the safety shield did to each agent's command in the last step `[E, N]`: bit 0 (1) the
-    /// speed was capped, bit 1 (2) it would have crossed a virtual wall. All zero without a shield.
-    pub fn shield_flags(&self) -> &[u8] {
-        &self.shield_flags
-    }
-
-    /// Raw pointers to the buffers, for bindings that hand out views. They stay valid and fixed for
-    /// the life of `self` (the buffers are never reallocated).
-    pub fn buffer_ptrs(&mut self) -> BufferPtrs {
-        BufferPtrs {
-            obs: self.obs.as_mut_ptr(),
-            rewards: self.rewards.as_mut_ptr(),
-            terminated: self.terminated.as_mut_ptr(),
-            truncated: self.truncated.as_mut_ptr(),
-            state: self.state.as_mut_ptr(),
-            patch: self.patch.as_mut_ptr(),
-            final_obs: self.final_obs.as_mut_ptr(),
-            final_mask: self.final_mask.as_mut_ptr(),
-            shield: self.shield_flags.as_mut_ptr(),
-        }
+    /// Raw pointers to the output buffers, for bindings that hand out views (see [`Outputs::ptrs`]).
+    pub fn buffer_ptrs(&mut self) -> crate::outputs::BufferPtrs {
+        self.out.ptrs()
     }
 
     /// Resets the worlds selected by `mask` (all if `None`). A `seed` becomes the new base seed and
@@ -432,53 +367,32 @@ impl VecEnv {
                 )));
             }
         }
-        let n = self.spec.num_agents;
         let ctx = Ctx {
             task: self.task.as_ref(),
             scenario: &self.scenario,
             backend: &self.backend,
             mode: self.mode,
-            max_cycles: self.spec.max_cycles,
-            max_speed: self.scenario.spec.robot.max_wheel_speed,
-            state_dim: self.state_dim,
-            patch: self.patch_cfg,
+            writer: self.writer,
             shield: self.shield,
             deposits: self.decoder.deposits(),
             evaluation,
         };
-        let len = Lengths {
-            agents: n,
-            obs: n * self.obs_dim(),
-            state: self.state_dim.max(1),
-            patch: n * self.patch_len.max(1),
-            deposits: self.decoder.deposits(),
-        };
-        let mut buffers = Buffers {
-            obs: &mut self.obs,
-            rewards: &mut self.rewards,
-            terminated: &mut self.terminated,
-            truncated: &mut self.truncated,
-            state: &mut self.state,
-            patch: &mut self.patch,
-            final_obs: &mut self.final_obs,
-            final_mask: &mut self.final_mask,
-            shield: &mut self.shield_flags,
-        };
+        let buffers = self.out.all();
         let (slots, chunks) = (&mut self.slots, &mut self.chunks);
         if actions.is_none() {
             return self
                 .pool
-                .install(|| conclude_batch(&ctx, slots, chunks, buffers, len));
+                .install(|| conclude_batch(&ctx, slots, chunks, buffers));
         }
         if let [slot] = slots.as_mut_slice() {
             // One world (a PettingZoo `parallel_env`): step it on the calling thread. Handing a single
             // world to the pool costs two thread wake-ups per step, a third of the step at this size.
             let actions = (&self.commands[..], &self.deposit_rates[..]);
-            return step_world(&ctx, 0, slot, actions, &mut buffers.world(0, len));
+            return step_world(&ctx, 0, slot, actions, &mut buffers.into_world(0));
         }
         let (commands, rates) = (&self.commands, &self.deposit_rates);
         self.pool
-            .install(|| step_batch(&ctx, slots, chunks, commands, rates, buffers, len))
+            .install(|| step_batch(&ctx, slots, chunks, commands, rates, buffers))
     }
 
     /// Checks and decodes the actions into wheel commands.
@@ -493,41 +407,11 @@ impl VecEnv {
 
     /// Rewrites observations, state and patches of every world and clears rewards and flags.
     fn write_all_outputs(&mut self) {
-        let n = self.spec.num_agents;
-        let ctx_max = self.scenario.spec.robot.max_wheel_speed;
-        let (sd, pl) = (self.state_dim, self.patch_len);
-        let agents = self.task.agents();
-        let d = self.obs_dim();
         for (w, slot) in self.slots.iter().enumerate() {
-            write_task_obs(
-                &slot.world,
-                self.task.as_ref(),
-                slot.episode.task_state(),
-                ctx_max,
-                &mut self.obs[w * n * d..(w + 1) * n * d],
-            );
-            if sd > 0 {
-                write_state(
-                    &slot.world,
-                    slot.episode.steps,
-                    self.spec.max_cycles,
-                    &mut self.state[w * sd..(w + 1) * sd],
-                );
-            }
-            if let Some(p) = &self.patch_cfg {
-                write_patch(
-                    &slot.world,
-                    agents,
-                    p,
-                    &mut self.patch[w * n * pl..(w + 1) * n * pl],
-                );
-            }
+            let out = &mut self.out.world(w);
+            (self.writer).write(self.task.as_ref(), &slot.world, &slot.episode, out);
         }
-        self.rewards.fill(0.0);
-        self.terminated.fill(false);
-        self.truncated.fill(false);
-        self.final_mask.fill(false);
-        self.shield_flags.fill(0);
+        self.out.clear();
     }
 
     /// The screen with the robots drawn on it, `width` pixels wide, of world `e`.
@@ -540,17 +424,4 @@ impl VecEnv {
         })?;
         Ok(render_world(&slot.world, self.task.agents(), width))
     }
-}
-
-/// Raw pointers to a [`VecEnv`]'s buffers (see [`VecEnv::buffer_ptrs`]).
-pub struct BufferPtrs {
-    pub obs: *mut f32,
-    pub rewards: *mut f32,
-    pub terminated: *mut bool,
-    pub truncated: *mut bool,
-    pub state: *mut f32,
-    pub patch: *mut u8,
-    pub final_obs: *mut f32,
-    pub final_mask: *mut bool,
-    pub shield: *mut u8,
 }

@@ -2,28 +2,15 @@
 //! other robots deciding with their own behaviours), the task hands out rewards and ends episodes,
 //! and the outputs are written.
 use crate::backend::EnvBackend;
-use crate::config::{AutoresetMode, PatchConfig};
-use crate::episode::{AgentOut, StepEnd};
+use crate::config::AutoresetMode;
+use crate::episode::StepEnd;
 use crate::error::Result;
+use crate::outputs::{OutSlices, Writer};
 use crate::task::Task;
-use crate::world_output::{write_patch, write_state, write_task_obs};
 use crate::world_slot::WorldSlot;
 use colcos_sim::robot::RapierHost;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::shield::{Intervention, Shield};
-
-/// Per-world output slices.
-pub(crate) struct Out<'a> {
-    pub(crate) obs: &'a mut [f32],
-    pub(crate) rewards: &'a mut [f32],
-    pub(crate) terminated: &'a mut [bool],
-    pub(crate) truncated: &'a mut [bool],
-    pub(crate) state: &'a mut [f32],
-    pub(crate) patch: &'a mut [u8],
-    pub(crate) final_obs: &'a mut [f32],
-    pub(crate) final_mask: &'a mut bool,
-    pub(crate) shield: &'a mut [u8],
-}
 
 /// One world's agents' commands `[N]` and deposit rate fractions `[N, D]`.
 pub(crate) type AgentActions<'a> = (&'a [colcos_sim::behaviour::WheelCommand], &'a [f32]);
@@ -34,10 +21,8 @@ pub(crate) struct Ctx<'a> {
     pub(crate) scenario: &'a Scenario,
     pub(crate) backend: &'a EnvBackend,
     pub(crate) mode: AutoresetMode,
-    pub(crate) max_cycles: u64,
-    pub(crate) max_speed: f32,
-    pub(crate) state_dim: usize,
-    pub(crate) patch: Option<PatchConfig>,
+    /// How the outputs are written; its `max_cycles` is the episode length.
+    pub(crate) writer: Writer,
     pub(crate) shield: Option<Shield>,
     /// Deposit actions per agent.
     pub(crate) deposits: usize,
@@ -76,7 +61,7 @@ pub(crate) fn step_world(
     w: usize,
     slot: &mut WorldSlot,
     actions: AgentActions,
-    out: &mut Out,
+    out: &mut OutSlices,
 ) -> Result<()> {
     let begun = begin_world(ctx, w, slot, actions, out, None)?;
     finish_world(ctx, w, slot, out, begun, None)
@@ -90,11 +75,11 @@ pub(crate) fn begin_world(
     w: usize,
     slot: &mut WorldSlot,
     (cmds, rates): AgentActions,
-    out: &mut Out,
+    out: &mut OutSlices,
     host: Option<(&mut RapierHost, usize)>,
 ) -> Result<Begun> {
     let agents = ctx.task.agents();
-    *out.final_mask = false;
+    out.final_mask[0] = false;
     out.shield.fill(0);
     if slot.episode.done {
         // Next-step autoreset: this step only resets the world.
@@ -147,7 +132,7 @@ pub(crate) fn finish_world(
     ctx: &Ctx,
     w: usize,
     slot: &mut WorldSlot,
-    out: &mut Out,
+    out: &mut OutSlices,
     begun: Begun,
     mut host: Option<(&mut RapierHost, usize)>,
 ) -> Result<()> {
@@ -169,15 +154,12 @@ pub(crate) fn conclude_world(
     ctx: &Ctx,
     w: usize,
     slot: &mut WorldSlot,
-    out: &mut Out,
+    out: &mut OutSlices,
     host: Option<(&mut RapierHost, usize)>,
 ) -> Result<()> {
     slot.awaiting = false;
-    let agent_out = AgentOut {
-        rewards: out.rewards,
-        terminated: out.terminated,
-        truncated: out.truncated,
-    };
+    let max_cycles = ctx.writer.max_cycles;
+    let agent_out = out.agent_out();
     let done = match ctx.evaluation {
         Evaluation::Given {
             rewards,
@@ -188,7 +170,7 @@ pub(crate) fn conclude_world(
             (slot.episode).finish_given(
                 &rewards[part.clone()],
                 &terminated[part],
-                ctx.max_cycles,
+                max_cycles,
                 StepEnd::Stepped,
                 agent_out,
             )
@@ -196,7 +178,7 @@ pub(crate) fn conclude_world(
         _ => slot.episode.finish_step(
             ctx.task,
             &slot.world,
-            ctx.max_cycles,
+            max_cycles,
             StepEnd::Stepped,
             agent_out,
         ),
@@ -204,7 +186,7 @@ pub(crate) fn conclude_world(
     write_world(ctx, slot, out);
     if done && ctx.mode == AutoresetMode::SameStep {
         out.final_obs.copy_from_slice(out.obs);
-        *out.final_mask = true;
+        out.final_mask[0] = true;
         next_episode(ctx, w, slot, out, host)?;
     }
     Ok(())
@@ -215,7 +197,7 @@ fn next_episode(
     ctx: &Ctx,
     w: usize,
     slot: &mut WorldSlot,
-    out: &mut Out,
+    out: &mut OutSlices,
     host: Option<(&mut RapierHost, usize)>,
 ) -> Result<()> {
     *slot = WorldSlot::build(
@@ -230,16 +212,8 @@ fn next_episode(
     Ok(())
 }
 
-pub(crate) fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut Out) {
-    let agents = ctx.task.agents();
-    let state = slot.episode.task_state();
-    write_task_obs(&slot.world, ctx.task, state, ctx.max_speed, out.obs);
-    if ctx.state_dim > 0 {
-        write_state(&slot.world, slot.episode.steps, ctx.max_cycles, out.state);
-    }
-    if let Some(p) = &ctx.patch {
-        write_patch(&slot.world, agents, p, out.patch);
-    }
+fn write_world(ctx: &Ctx, slot: &WorldSlot, out: &mut OutSlices) {
+    (ctx.writer).write(ctx.task, &slot.world, &slot.episode, out);
 }
 
 /// A shield intervention as the bits of [`VecEnv::shield_flags`].

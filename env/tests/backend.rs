@@ -78,9 +78,10 @@ fn scenario_key_and_gpu_observations() {
         gpu.step(Actions::Continuous(&a)).unwrap();
         cpu.step(Actions::Continuous(&a)).unwrap();
         let worst = gpu
+            .outputs()
             .obs()
             .iter()
-            .zip(cpu.obs())
+            .zip(cpu.outputs().obs())
             .map(|(g, c)| (g - c).abs())
             .fold(0f32, f32::max);
         assert!(worst <= 1e-5, "step {step}: observations differ by {worst}");

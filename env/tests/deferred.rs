@@ -30,22 +30,31 @@ fn given_the_tasks_own_rewards_a_deferred_step_is_a_plain_step() {
             deferred.step_deferred(Actions::Continuous(&a)).unwrap();
             // What a Python task would have said: here, the Rust task's verdict, and every agent of
             // world 1 terminated at step 10.
-            let mut terminated = plain.terminated().to_vec();
+            let mut terminated = plain.outputs().terminated().to_vec();
             if t == 10 {
                 let n = plain.spec().num_agents;
                 terminated[n..2 * n].fill(true);
             }
-            deferred.conclude(plain.rewards(), &terminated).unwrap();
+            deferred
+                .conclude(plain.outputs().rewards(), &terminated)
+                .unwrap();
             if t == 10 {
-                assert!(deferred.terminated()[plain.spec().num_agents]);
+                assert!(deferred.outputs().terminated()[plain.spec().num_agents]);
                 terminations += 1;
                 continue;
             }
             if t < 10 {
-                assert_eq!(deferred.obs(), plain.obs(), "{mode:?} step {t}");
-                assert_eq!(deferred.rewards(), plain.rewards());
-                assert_eq!(deferred.truncated(), plain.truncated());
-                assert_eq!(deferred.final_mask(), plain.final_mask());
+                assert_eq!(
+                    deferred.outputs().obs(),
+                    plain.outputs().obs(),
+                    "{mode:?} step {t}"
+                );
+                assert_eq!(deferred.outputs().rewards(), plain.outputs().rewards());
+                assert_eq!(deferred.outputs().truncated(), plain.outputs().truncated());
+                assert_eq!(
+                    deferred.outputs().final_mask(),
+                    plain.outputs().final_mask()
+                );
             }
         }
         assert_eq!(terminations, 1);
@@ -77,5 +86,5 @@ fn a_deferred_step_must_be_concluded_with_one_value_per_agent() {
     assert!(nan.contains("world 1, agent robot_1"), "{nan}");
     env.conclude(&vec![1.5; e * n], &vec![false; e * n])
         .unwrap();
-    assert!(env.rewards().iter().all(|&r| r == 1.5));
+    assert!(env.outputs().rewards().iter().all(|&r| r == 1.5));
 }

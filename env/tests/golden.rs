@@ -25,13 +25,13 @@ impl Fnv {
 }
 
 fn record(env: &VecEnv, h: &mut Fnv) {
-    h.floats(env.obs());
-    h.floats(env.rewards());
-    h.flags(env.terminated());
-    h.flags(env.truncated());
-    h.floats(env.state());
-    h.floats(env.final_obs());
-    h.flags(env.final_mask());
+    h.floats(env.outputs().obs());
+    h.floats(env.outputs().rewards());
+    h.flags(env.outputs().terminated());
+    h.flags(env.outputs().truncated());
+    h.floats(env.outputs().state());
+    h.floats(env.outputs().final_obs());
+    h.flags(env.outputs().final_mask());
     // The task's per-episode memory (none for the first three tasks: nothing hashed).
     for w in 0..env.spec().num_envs {
         env.task_state(w)

@@ -52,7 +52,7 @@ fn drive(env: &mut VecEnv, rows: &[&[f32]], steps: usize) -> Vec<Vec<f32>> {
     (0..steps)
         .map(|_| {
             env.step(Actions::Continuous(&a)).unwrap();
-            env.rewards().to_vec()
+            env.outputs().rewards().to_vec()
         })
         .collect()
 }
@@ -74,10 +74,10 @@ fn a_delivery_pays_the_whole_team_exactly_and_the_food_runs_out() {
     for trip in 0..3 {
         // To the nest, then back onto the patch.
         let mut there = drive(&mut env, &[&ahead, &still], 1);
-        let picked = env.obs()[17];
+        let picked = env.outputs().obs()[17];
         assert_eq!(picked, if trip < 2 { 1.0 } else { 0.0 }, "trip {trip}");
         there.extend(drive(&mut env, &[&ahead, &still], 39));
-        let carry_seen = env.obs()[17];
+        let carry_seen = env.outputs().obs()[17];
         assert_eq!(carry_seen, 0.0, "trip {trip}: dropped at the nest");
         for (t, r) in there.iter().enumerate() {
             assert_eq!(r[0], r[1], "a team reward: step {t}");
@@ -138,7 +138,10 @@ fn alarm_pays_the_safe_fraction_and_flags_the_predator() {
     assert_eq!(env.obs_dim(), 18);
     let r = &drive(&mut env, &[&[0.0, 0.0, 1.0], &[0.0, 0.0, 0.0]], 1)[0];
     assert_eq!(r, &[0.5 - 2.0, 0.5]);
-    assert_eq!((env.obs()[17], env.obs()[18 + 17]), (1.0, 0.0));
+    assert_eq!(
+        (env.outputs().obs()[17], env.outputs().obs()[18 + 17]),
+        (1.0, 0.0)
+    );
 }
 
 #[test]
@@ -197,7 +200,13 @@ fn run(task: &str, threads: usize, steps: usize) -> Vec<u32> {
     for _ in 0..steps {
         b.act(&env, &mut a).unwrap();
         env.step(Actions::Continuous(&a)).unwrap();
-        out.extend(env.obs().iter().chain(env.rewards()).map(|v| v.to_bits()));
+        out.extend(
+            env.outputs()
+                .obs()
+                .iter()
+                .chain(env.outputs().rewards())
+                .map(|v| v.to_bits()),
+        );
         out.extend((0..4).flat_map(|w| env.task_state(w).to_vec()));
     }
     out
@@ -233,7 +242,12 @@ fn mean_return(task: &str, seed: u64, hand: bool) -> f64 {
             }
         }
         env.step(Actions::Continuous(&a)).unwrap();
-        total += env.rewards().iter().map(|&r| r as f64).sum::<f64>();
+        total += env
+            .outputs()
+            .rewards()
+            .iter()
+            .map(|&r| r as f64)
+            .sum::<f64>();
     }
     total / (4 * n) as f64
 }

@@ -25,10 +25,10 @@ fn run(task: &str, maze: bool, physics: PhysicsBackend, threads: usize) -> Vec<u
             .map(|k| ((k * 13 + (t / 7) * 5) as f32 * 0.61).sin().signum())
             .collect();
         env.step(Actions::Continuous(&a)).unwrap();
-        out.extend(env.obs().iter().map(|x| x.to_bits()));
-        out.extend(env.rewards().iter().map(|x| x.to_bits()));
-        out.extend(env.state().iter().map(|x| x.to_bits()));
-        out.extend(env.terminated().iter().map(|&x| x as u32));
+        out.extend(env.outputs().obs().iter().map(|x| x.to_bits()));
+        out.extend(env.outputs().rewards().iter().map(|x| x.to_bits()));
+        out.extend(env.outputs().state().iter().map(|x| x.to_bits()));
+        out.extend(env.outputs().terminated().iter().map(|&x| x as u32));
     }
     out
 }

@@ -23,6 +23,6 @@ pub mod preflight;
 mod twin_scenario;
 
 pub use goto::GoTo;
-pub use live_env::{GoToReport, LiveEnv, PlantBuffers};
+pub use live_env::{GoToReport, LiveEnv};
 pub use options::{PlantError, PlantKind, PlantOptions};
 pub use twin_scenario::TwinScenario;

@@ -9,9 +9,9 @@ use colcos_bridge::host::Host;
 use colcos_bridge::live::{LiveOptions, LiveSession, LoopCore, replay};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_env::task::registry;
-use colcos_env::world_output::{render_world, write_patch, write_state, write_task_obs};
+use colcos_env::world_output::render_world;
 use colcos_env::{
-    ActionDecoder, Actions, AgentOut, EnvConfig, EnvSpec, Episode, StepEnd, Task, VecEnv,
+    ActionDecoder, Actions, EnvConfig, EnvSpec, Episode, Outputs, StepEnd, Task, VecEnv, Writer,
     shield_bits,
 };
 use colcos_sim::behaviour::WheelCommand;
@@ -44,8 +44,7 @@ pub struct LiveEnv {
     driver: Driver,
     goto: Option<(GoTo, f64)>,
     goto_report: GoToReport,
-    patch: Option<colcos_env::PatchConfig>,
-    max_speed: f32,
+    writer: Writer,
     overrides: Vec<Option<WheelCommand>>,
     pub(crate) decoder: ActionDecoder,
     /// Scratch: the agents' decoded commands and deposit rates.
@@ -55,13 +54,8 @@ pub struct LiveEnv {
     needs_reset: bool,
     /// A deferred step (a task written in Python) waits for `conclude` with how it ended.
     pub(crate) awaiting: Option<StepEnd>,
-    obs: Vec<f32>,
-    rewards: Vec<f32>,
-    terminated: Vec<bool>,
-    truncated: Vec<bool>,
-    state: Vec<f32>,
-    patch_buf: Vec<u8>,
-    shield: Vec<u8>,
+    /// The outputs of one world (`[1, N, ...]`), as the batch's.
+    out: Outputs,
     /// The live loop's report as it was when the plant was closed.
     closed: Option<Option<colcos_bridge::live::LiveReport>>,
 }
@@ -97,11 +91,14 @@ impl LiveEnv {
             )
         });
         let (n, robots) = (spec.num_agents, spec.num_robots);
-        let state_dim = spec.state.as_ref().map_or(0, |s| s.flat_len());
-        let patch_len = spec.patch.as_ref().map_or(0, |s| s.flat_len());
-        Ok(LiveEnv {
+        let writer = Writer {
             max_speed: p.max_wheel_speed,
+            max_cycles: spec.max_cycles,
+            state: spec.state.is_some(),
             patch: cfg.patch,
+        };
+        Ok(LiveEnv {
+            writer,
             task,
             kind: plant.kind,
             driver,
@@ -115,13 +112,7 @@ impl LiveEnv {
             needs_reset: true,
             awaiting: None,
             // The task's extra entries (a carrying flag) included, as the spec says.
-            obs: vec![0.0; n * spec.observation.flat_len()],
-            rewards: vec![0.0; n],
-            terminated: vec![false; n],
-            truncated: vec![false; n],
-            state: vec![0.0; state_dim.max(1)],
-            patch_buf: vec![0; (n * patch_len).max(1)],
-            shield: vec![0; n],
+            out: Outputs::new(&spec),
             closed: None,
             spec,
             scenario,
@@ -253,49 +244,13 @@ impl LiveEnv {
     pub fn goto_report(&self) -> GoToReport {
         self.goto_report
     }
-    pub fn obs(&self) -> &[f32] {
-        &self.obs
+    /// The output buffers (`[1, N, ...]`), overwritten by every reset and step.
+    pub fn outputs(&self) -> &Outputs {
+        &self.out
     }
-    pub fn rewards(&self) -> &[f32] {
-        &self.rewards
-    }
-    pub fn terminated(&self) -> &[bool] {
-        &self.terminated
-    }
-    pub fn truncated(&self) -> &[bool] {
-        &self.truncated
-    }
-    /// Global state `[S]` (empty if disabled).
-    pub fn state(&self) -> &[f32] {
-        if self.spec.state.is_some() {
-            &self.state
-        } else {
-            &[]
-        }
-    }
-    /// Screen patches `[N, P, P, 3]` (empty if disabled).
-    pub fn patch(&self) -> &[u8] {
-        if self.spec.patch.is_some() {
-            &self.patch_buf
-        } else {
-            &[]
-        }
-    }
-    /// What the shield did to each agent's last command: bit 0 capped, bit 1 walled.
-    pub fn shield_flags(&self) -> &[u8] {
-        &self.shield
-    }
-    /// Mutable pointers to the buffers, for bindings that hand out views; fixed for the life of self.
-    pub fn buffer_ptrs(&mut self) -> PlantBuffers {
-        PlantBuffers {
-            obs: self.obs.as_mut_ptr(),
-            rewards: self.rewards.as_mut_ptr(),
-            terminated: self.terminated.as_mut_ptr(),
-            truncated: self.truncated.as_mut_ptr(),
-            state: self.state.as_mut_ptr(),
-            patch: self.patch_buf.as_mut_ptr(),
-            shield: self.shield.as_mut_ptr(),
-        }
+    /// Raw pointers to the output buffers, for bindings that hand out views (see [`Outputs::ptrs`]).
+    pub fn buffer_ptrs(&mut self) -> colcos_env::BufferPtrs {
+        self.out.ptrs()
     }
 
     /// The screen with the robots on it (agents white), `width` px wide.
@@ -337,10 +292,7 @@ impl LiveEnv {
         self.driver.tick(&self.overrides)?;
         self.episode.restart(episode);
         self.needs_reset = false;
-        self.rewards.fill(0.0);
-        self.terminated.fill(false);
-        self.truncated.fill(false);
-        self.shield.fill(0);
+        self.out.clear();
         self.write_outputs();
         Ok(())
     }
@@ -433,11 +385,8 @@ impl LiveEnv {
     /// The end of a step: the task's (or the `given`) rewards and terminations, the shield's
     /// flags, the outputs.
     pub(crate) fn finish(&mut self, end: StepEnd, given: Option<(&[f32], &[bool])>) {
-        let out = AgentOut {
-            rewards: &mut self.rewards,
-            terminated: &mut self.terminated,
-            truncated: &mut self.truncated,
-        };
+        let mut world = self.out.world(0);
+        let out = world.agent_out();
         let max = self.spec.max_cycles;
         let done = match given {
             Some((r, t)) => self.episode.finish_given(r, t, max, end, out),
@@ -448,7 +397,7 @@ impl LiveEnv {
         let interventions = self.driver.interventions();
         for ((&i, &was), flags) in (self.task.agents().iter())
             .zip(&self.episode.was_terminated)
-            .zip(self.shield.iter_mut())
+            .zip(world.shield.iter_mut())
         {
             *flags = if was {
                 0
@@ -461,27 +410,8 @@ impl LiveEnv {
     }
 
     fn write_outputs(&mut self) {
-        let host = self.driver.host();
-        let agents = self.task.agents();
-        let state = self.episode.task_state();
-        write_task_obs(
-            host,
-            self.task.as_ref(),
-            state,
-            self.max_speed,
-            &mut self.obs,
-        );
-        if self.spec.state.is_some() {
-            write_state(
-                host,
-                self.episode.steps,
-                self.spec.max_cycles,
-                &mut self.state,
-            );
-        }
-        if let Some(p) = &self.patch {
-            write_patch(host, agents, p, &mut self.patch_buf);
-        }
+        let out = &mut self.out.world(0);
+        (self.writer).write(self.task.as_ref(), self.driver.host(), &self.episode, out);
     }
 
     /// Stops every robot now (twin, rig).
@@ -533,17 +463,6 @@ impl LiveEnv {
     pub fn time(&self) -> f64 {
         self.driver.time()
     }
-}
-
-/// Raw pointers to a [`LiveEnv`]'s buffers (see [`LiveEnv::buffer_ptrs`]).
-pub struct PlantBuffers {
-    pub obs: *mut f32,
-    pub rewards: *mut f32,
-    pub terminated: *mut bool,
-    pub truncated: *mut bool,
-    pub state: *mut f32,
-    pub patch: *mut u8,
-    pub shield: *mut u8,
 }
 
 /// A rig log recorded with another scenario (its `rig` metadata names it and its robot count) is

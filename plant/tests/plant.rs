@@ -59,12 +59,18 @@ fn the_twin_plant_keeps_a_wall_seeking_policy_inside_and_replays_its_log() {
     let arena = env.scenario().arena_size();
     let r = env.scenario().spec.robot.radius;
     let (mut walled, mut steps) = (0, 0);
-    while !env.truncated().iter().any(|t| *t) {
+    while !env.outputs().truncated().iter().any(|t| *t) {
         env.step(Actions::Continuous(&full_ahead(n))).unwrap();
         steps += 1;
-        walled += env.shield_flags().iter().filter(|f| **f & 2 != 0).count();
+        walled += env
+            .outputs()
+            .shield_flags()
+            .iter()
+            .filter(|f| **f & 2 != 0)
+            .count();
         assert!(
-            env.obs()
+            env.outputs()
+                .obs()
                 .iter()
                 .all(|v| v.is_finite() && (-1.0..=1.0).contains(v))
         );
@@ -90,7 +96,7 @@ fn the_twin_plant_keeps_a_wall_seeking_policy_inside_and_replays_its_log() {
     let mut replay = LiveEnv::new(&cfg, &opts).unwrap();
     replay.reset(None).unwrap();
     let mut steps = 0;
-    while !replay.truncated().iter().any(|t| *t) {
+    while !replay.outputs().truncated().iter().any(|t| *t) {
         replay.step(Actions::Continuous(&full_ahead(n))).unwrap();
         steps += 1;
     }

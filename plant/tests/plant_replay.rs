@@ -34,7 +34,7 @@ fn a_replay_plays_the_recorded_episodes_not_the_whole_log() {
         env.reset(if episode == 0 { Some(4) } else { None })
             .unwrap();
         let mut steps = 0;
-        while !env.truncated()[0] && !env.terminated()[0] {
+        while !env.outputs().truncated()[0] && !env.outputs().terminated()[0] {
             env.step(Actions::Continuous(&ahead)).unwrap();
             steps += 1;
         }
@@ -46,7 +46,7 @@ fn a_replay_plays_the_recorded_episodes_not_the_whole_log() {
     let first_again = (0..20)
         .take_while(|_| {
             env.step(Actions::Continuous(&ahead)).unwrap();
-            !env.truncated()[0]
+            !env.outputs().truncated()[0]
         })
         .count();
     assert_eq!(first_again + 1, 10);

@@ -3,7 +3,7 @@
 //! unchanged. The GIL is released around every call that waits on the arena (reset, step).
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
-use crate::vec_env::{AgentBuffers, Owned, Ptrs, action_width, agent_views, owned_actions};
+use crate::vec_env::{Owned, Ptrs, action_width, output_views, owned_actions};
 use colcos_env::Actions;
 use colcos_plant::{LiveEnv, PlantError, PlantKind, PlantOptions, TwinScenario};
 use colcos_sim::scenario::Scenario;
@@ -181,6 +181,7 @@ impl PyPlant {
 
     /// Numpy views of the output buffers, overwritten by every reset and step: `obs [1,N,D]`,
     /// `rewards [1,N]`, `terminated`/`truncated [1,N]`, `shield [1,N]` (bit 0 capped, bit 1 walled),
+    /// `final_obs [1,N,D]` and `final_mask [1]` (never set: a plant does not reset itself),
     /// `state [1,S]` and `patch [1,N,P,P,3]` if enabled.
     fn views<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
         guard(|| {
@@ -191,20 +192,10 @@ impl PyPlant {
                 let mut g = me.lock();
                 (Ptrs(g.buffer_ptrs()), g.spec().clone())
             });
-            let p = ptrs.0;
             let d = PyDict::new(py);
-            let bufs = AgentBuffers {
-                obs: p.obs,
-                rewards: p.rewards,
-                terminated: p.terminated,
-                truncated: p.truncated,
-                shield: p.shield,
-                state: p.state,
-                patch: p.patch,
-            };
             // SAFETY: the buffers are allocated once in LiveEnv::new and never reallocated; each view
             // keeps `owner` (and so the plant) alive.
-            unsafe { agent_views(&d, &owner, &bufs, &spec, 1)? };
+            unsafe { output_views(&d, &owner, &ptrs.0, &spec)? };
             Ok(d)
         })
     }

@@ -250,29 +250,10 @@ impl PyVecEnv {
                 let mut g = me.lock();
                 (Ptrs(g.env.buffer_ptrs()), g.env.spec().clone())
             });
-            let ptrs = ptrs.0;
-            let (e, n) = (spec.num_envs, spec.num_agents);
-            let d_obs = spec.observation.flat_len();
             let d = PyDict::new(py);
             // SAFETY: the buffers are allocated once in VecEnv::new and never reallocated; each view
             // keeps `owner` (and so the VecEnv) alive.
-            unsafe {
-                let agents = AgentBuffers {
-                    obs: ptrs.obs,
-                    rewards: ptrs.rewards,
-                    terminated: ptrs.terminated,
-                    truncated: ptrs.truncated,
-                    shield: ptrs.shield,
-                    state: ptrs.state,
-                    patch: ptrs.patch,
-                };
-                agent_views(&d, &owner, &agents, &spec, e)?;
-                d.set_item(
-                    "final_obs",
-                    view(&owner, ptrs.final_obs, vec![e, n, d_obs])?,
-                )?;
-                d.set_item("final_mask", view(&owner, ptrs.final_mask, vec![e])?)?;
-            }
+            unsafe { output_views(&d, &owner, &ptrs.0, &spec)? };
             Ok(d)
         })
     }
@@ -438,38 +419,29 @@ impl PyVecEnv {
     }
 }
 
-/// Actions copied out of Python's array, so that the env's lock is taken without the GIL.
-/// The per-agent output buffers of `E` worlds, as raw pointers (see [`agent_views`]).
-pub(crate) struct AgentBuffers {
-    pub obs: *mut f32,
-    pub rewards: *mut f32,
-    pub terminated: *mut bool,
-    pub truncated: *mut bool,
-    pub shield: *mut u8,
-    pub state: *mut f32,
-    pub patch: *mut u8,
-}
-
-/// Puts numpy views of `bufs` for `e` worlds into `d`: `obs [E,N,D]`, `rewards`, `terminated`,
-/// `truncated`, `shield [E,N]`, and `state [E,S]` and `patch [E,N,P,P,3]` where `spec` has them.
+/// Puts numpy views of the output buffers at `bufs` into `d`: `obs [E,N,D]`, `rewards`,
+/// `terminated`, `truncated`, `shield [E,N]`, `final_obs [E,N,D]`, `final_mask [E]`, and `state [E,S]`
+/// and `patch [E,N,P,P,3]` where `spec` has them.
 ///
 /// # Safety
-/// Every buffer must hold `e` worlds' worth of elements and stay valid for as long as `owner` lives.
-pub(crate) unsafe fn agent_views<'py>(
+/// The buffers must be those of an `Outputs` made for `spec` and stay valid for as long as `owner`
+/// lives.
+pub(crate) unsafe fn output_views<'py>(
     d: &Bound<'py, PyDict>,
     owner: &Bound<'py, PyAny>,
-    bufs: &AgentBuffers,
+    bufs: &colcos_env::BufferPtrs,
     spec: &colcos_env::EnvSpec,
-    e: usize,
 ) -> PyResult<()> {
-    let n = spec.num_agents;
+    let (e, n) = (spec.num_envs, spec.num_agents);
+    let obs = vec![e, n, spec.observation.flat_len()];
     unsafe {
-        let obs = vec![e, n, spec.observation.flat_len()];
-        d.set_item("obs", view(owner, bufs.obs, obs)?)?;
+        d.set_item("obs", view(owner, bufs.obs, obs.clone())?)?;
         d.set_item("rewards", view(owner, bufs.rewards, vec![e, n])?)?;
         d.set_item("terminated", view(owner, bufs.terminated, vec![e, n])?)?;
         d.set_item("truncated", view(owner, bufs.truncated, vec![e, n])?)?;
         d.set_item("shield", view(owner, bufs.shield, vec![e, n])?)?;
+        d.set_item("final_obs", view(owner, bufs.final_obs, obs)?)?;
+        d.set_item("final_mask", view(owner, bufs.final_mask, vec![e])?)?;
         if let Some(s) = &spec.state {
             d.set_item("state", view(owner, bufs.state, vec![e, s.flat_len()])?)?;
         }
