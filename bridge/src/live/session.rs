@@ -87,7 +87,7 @@ impl LiveSession {
             None => None,
         };
         let trajectory = match &opts.trajectory {
-            Some(path) => Some(TrajectoryLog::create(path)?),
+            Some(path) => Some(TrajectoryLog::create(path, &scenario.spec.robots)?),
             None => None,
         };
         let out = &scenario.spec.output;
@@ -448,6 +448,12 @@ impl LiveSession {
     fn write_trajectory(&mut self) -> Result<()> {
         if let Some(traj) = self.trajectory.as_mut() {
             let host = self.core.host();
+            let lay: Vec<&[f32]> = match traj.has_lay_columns() {
+                true => (0..host.poses().len())
+                    .map(|i| host.deposit_actions(i))
+                    .collect(),
+                false => Vec::new(),
+            };
             traj.record_rows(&TickRows {
                 // Counted from 0 at the first tick with poses, as `colcos run` counts its steps.
                 tick: self.report.logged_ticks,
@@ -458,6 +464,7 @@ impl LiveSession {
                 commands: self.core.sent(),
                 groups: &self.groups,
                 group_specs: &self.scenario.spec.robots,
+                lay: &lay,
             })?;
             self.report.logged_ticks += 1;
         }

@@ -1,14 +1,61 @@
 //! The trajectory log: one CSV row per robot and logged tick, appended and flushed as the run goes,
-//! so a killed run keeps every complete row.
+//! so a killed run keeps every complete row. Where robots may lay pheromone by action
+//! (`[[robots]] deposit_actions`), each such pheromone gets a `lay_<name>` column: the fraction of its
+//! `max_rate` the robot laid at that tick (0 for robots whose group cannot lay it).
 use super::fixed::{push_digits, push_fixed};
 use crate::error::{Result, SimError};
+use crate::scenario::RobotGroupSpec;
 use crate::world::World;
 use rayon::prelude::*;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Column names of the trajectory CSV, in order.
+/// The pheromones robots may lay by action, one log column each, and where each group's robots keep
+/// that pheromone's fraction among their own deposit actions.
+#[derive(Clone, Debug, Default)]
+pub struct LayColumns {
+    names: Vec<String>,
+    /// Per group, per column: the index into the robot's deposit actions, if its group lays it.
+    slots: Vec<Vec<Option<usize>>>,
+}
+
+impl LayColumns {
+    /// The columns of the robot groups `groups` (none where no group has deposit actions).
+    pub fn of(groups: &[RobotGroupSpec]) -> Self {
+        let mut names: Vec<String> = Vec::new();
+        for d in groups.iter().flat_map(|g| &g.deposit_actions) {
+            if !names.contains(&d.pheromone) {
+                names.push(d.pheromone.clone());
+            }
+        }
+        let slots = groups
+            .iter()
+            .map(|g| {
+                let find =
+                    |name: &String| (g.deposit_actions.iter()).position(|d| &d.pheromone == name);
+                names.iter().map(find).collect()
+            })
+            .collect();
+        LayColumns { names, slots }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.names.is_empty()
+    }
+}
+
+/// Column names of the trajectory CSV of a scenario whose robots lay by action as `lay` says.
+pub fn header_with(lay: &LayColumns) -> String {
+    let mut h = header();
+    for name in &lay.names {
+        h.push_str(",lay_");
+        h.push_str(name);
+    }
+    h
+}
+
+/// Column names of the trajectory CSV, in order (without `lay_` columns).
 pub fn header() -> String {
     let mut cols: Vec<String> = [
         "tick",
@@ -45,11 +92,12 @@ pub struct TrajectoryLog {
     /// robots themselves cannot be shared across the formatting threads).
     commands: Vec<crate::behaviour::WheelCommand>,
     groups: Vec<usize>,
+    lay: LayColumns,
 }
 
 impl TrajectoryLog {
-    /// Creates (truncates) the log and writes the header.
-    pub fn create(path: &Path) -> Result<Self> {
+    /// Creates (truncates) the log of a scenario with robot groups `groups` and writes the header.
+    pub fn create(path: &Path, groups: &[RobotGroupSpec]) -> Result<Self> {
         let file = File::create(path)
             .map_err(|e| SimError::io(format!("creating {}", path.display()), e))?;
         let mut log = TrajectoryLog {
@@ -58,12 +106,19 @@ impl TrajectoryLog {
             line: String::new(),
             commands: Vec::new(),
             groups: Vec::new(),
+            lay: LayColumns::of(groups),
         };
-        let h = header();
+        let h = header_with(&log.lay);
         log.write_str(&h)?;
         log.write_str("\n")?;
         log.flush()?;
         Ok(log)
+    }
+
+    /// Whether the log has `lay_` columns (then [`TickRows::lay`] must hold every robot's deposit
+    /// actions).
+    pub fn has_lay_columns(&self) -> bool {
+        !self.lay.is_empty()
     }
 
     fn write_str(&mut self, s: &str) -> Result<()> {
@@ -89,6 +144,13 @@ impl TrajectoryLog {
         commands.extend(world.robots().iter().map(|r| r.command));
         groups.clear();
         groups.extend(world.robots().iter().map(|r| r.group));
+        let lay: Vec<&[f32]> = if self.lay.is_empty() {
+            Vec::new()
+        } else {
+            (0..groups.len())
+                .map(|i| world.deposit_actions(i))
+                .collect()
+        };
         let rows = TickRows {
             tick: world.tick(),
             time: world.time(),
@@ -98,6 +160,7 @@ impl TrajectoryLog {
             commands: &commands,
             groups: &groups,
             group_specs: &world.scenario().spec.robots,
+            lay: &lay,
         };
         let latest = world.tracked_frame_stamp();
         let written = self
@@ -122,7 +185,7 @@ impl TrajectoryLog {
         if n < 2 * ROWS_PER_CHUNK {
             let mut text = std::mem::take(&mut self.line);
             text.clear();
-            (0..n).for_each(|i| rows.push_row(&mut text, i, latest));
+            (0..n).for_each(|i| rows.push_row(&mut text, i, latest, &self.lay));
             let res = self.write_str(&text);
             self.line = text;
             res?;
@@ -131,9 +194,10 @@ impl TrajectoryLog {
             let chunks: Vec<String> = (0..n.div_ceil(ROWS_PER_CHUNK))
                 .into_par_iter()
                 .map(|c| {
+                    let lay = &self.lay;
                     let mut text = String::with_capacity(ROWS_PER_CHUNK * 160);
                     (c * ROWS_PER_CHUNK..((c + 1) * ROWS_PER_CHUNK).min(n))
-                        .for_each(|i| rows.push_row(&mut text, i, latest));
+                        .for_each(|i| rows.push_row(&mut text, i, latest, lay));
                     text
                 })
                 .collect();
@@ -161,13 +225,16 @@ pub struct TickRows<'a> {
     /// Each robot's group, an index into `group_specs` (its role is written).
     pub groups: &'a [usize],
     pub group_specs: &'a [crate::scenario::RobotGroupSpec],
+    /// Each robot's deposit actions (fractions of their `max_rate`); empty where no robot lays by
+    /// action.
+    pub lay: &'a [&'a [f32]],
 }
 
 impl TickRows<'_> {
     /// Appends robot `i`'s row, newline included. `tracked_seen` is 1 when the tracked pose comes from
     /// the tracker's newest frame (stamped `latest`), 0 when the robot dropped out of it and keeps an
     /// older pose; without `latest`, the pose's own `seen`.
-    fn push_row(&self, l: &mut String, i: usize, latest: Option<f32>) {
+    fn push_row(&self, l: &mut String, i: usize, latest: Option<f32>, lay: &LayColumns) {
         let (p, t, o, cmd) = (
             &self.poses[i],
             &self.tracked[i],
@@ -213,6 +280,13 @@ impl TickRows<'_> {
             l.push(',');
             push_fixed(l, b, 3);
         }
+        if let Some(slots) = lay.slots.get(self.groups[i]).filter(|_| !lay.is_empty()) {
+            let mine = self.lay.get(i).copied().unwrap_or(&[]);
+            for slot in slots {
+                l.push(',');
+                push_fixed(l, slot.and_then(|k| mine.get(k)).copied().unwrap_or(0.0), 3);
+            }
+        }
         l.push('\n');
     }
 }
@@ -232,7 +306,7 @@ mod tests {
         let mut world = World::new(&sc).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("trajectory.csv");
-        let mut log = TrajectoryLog::create(&path).unwrap();
+        let mut log = TrajectoryLog::create(&path, &sc.spec.robots).unwrap();
         let mut expected = Vec::new();
         for _ in 0..50 {
             world.step();

@@ -118,7 +118,7 @@ pub fn run(
     };
     log::debug!("field backend: {backend}");
     let log_path = out_dir.join("trajectory.csv");
-    let mut log = TrajectoryLog::create(&log_path)?;
+    let mut log = TrajectoryLog::create(&log_path, &scenario.spec.robots)?;
     files.push(log_path);
     log.record(&world)?;
 

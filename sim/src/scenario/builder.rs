@@ -21,8 +21,8 @@
 //! assert_eq!(scenario.robot_count(), 10);
 //! ```
 use super::{
-    DepositSpec, EmitSpec, EmitWhen, MapSpec, ModelKind, PheromoneSpec, Placement, RobotGroupSpec,
-    Scenario, ScenarioSpec, SourceSpec, parse_spec,
+    DepositActionSpec, DepositSpec, EmitSpec, EmitWhen, MapSpec, ModelKind, PheromoneSpec,
+    Placement, RobotGroupSpec, Scenario, ScenarioSpec, SourceSpec, parse_spec,
 };
 use crate::error::Result;
 use crate::field::{BackendChoice, Kernel};
@@ -288,6 +288,22 @@ impl RobotGroupSpec {
             pheromone: pheromone.into(),
             kernel,
             rate,
+        });
+        self
+    }
+
+    /// Lets the group's agents lay grid pheromone `pheromone` by action, up to `max_rate` units per
+    /// second at the kernel's peak (`[[robots]] deposit_actions`).
+    pub fn with_deposit_action(
+        mut self,
+        pheromone: impl Into<String>,
+        kernel: Kernel,
+        max_rate: f32,
+    ) -> Self {
+        self.deposit_actions.push(DepositActionSpec {
+            pheromone: pheromone.into(),
+            kernel,
+            max_rate,
         });
         self
     }
