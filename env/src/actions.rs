@@ -150,23 +150,34 @@ impl ActionDecoder {
     }
 }
 
-/// Deposit actions per agent: every agent's group declares the same number, and only agents'
-/// groups declare any (a scripted robot could not choose its rates).
+/// Deposit actions per agent (trails, then emitters switched by action: see
+/// `RobotGroupSpec::action_pheromones`): every agent's group declares the same number, and only
+/// agents' groups declare any (a scripted robot could not choose its rates).
 pub(crate) fn deposit_actions_per_agent(scenario: &Scenario, agents: &[usize]) -> Result<usize> {
     let mut first = 0;
     let mut per_agent: Option<(usize, usize)> = None;
     for (g, group) in scenario.spec.robots.iter().enumerate() {
-        let d = group.deposit_actions.len();
+        let d = group.action_count();
         let range = first..first + group.count;
         first += group.count;
         let is_agent = agents.iter().any(|i| range.contains(i));
         let key = format!("robots[{g}].deposit_actions");
         if !is_agent {
             if d > 0 {
+                let emits = d > group.deposit_actions.len();
                 return Err(EnvError::param(
-                    key,
-                    "this group's robots are not agents of the task, so nothing would choose \
-                     their rates (give them `deposits` instead)",
+                    if emits {
+                        format!("robots[{g}].emits")
+                    } else {
+                        key
+                    },
+                    if emits {
+                        "an emitter with `when = \"action\"` on robots that are not agents of the \
+                         task: nothing would switch it (use `follow` or `near`)"
+                    } else {
+                        "this group's robots are not agents of the task, so nothing would choose \
+                         their rates (give them `deposits` instead)"
+                    },
                 ));
             }
             continue;
@@ -177,8 +188,9 @@ pub(crate) fn deposit_actions_per_agent(scenario: &Scenario, agents: &[usize]) -
                 return Err(EnvError::param(
                     key,
                     format!(
-                        "{d} deposit actions, but the agents of robots[{h}] have {e}: every agent \
-                         of a task takes actions of one width"
+                        "{d} deposit actions (trails and emitters switched by action), but the \
+                         agents of robots[{h}] have {e}: every agent of a task takes actions of \
+                         one width"
                     ),
                 ));
             }

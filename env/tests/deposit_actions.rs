@@ -190,3 +190,60 @@ fn bad_deposit_actions_are_refused_by_name() {
         "{err}"
     );
 }
+
+/// A gaussian `alarm` pheromone each agent switches on and off (`when = "action"`), after its red
+/// trail: actions `[left, right, red rate, alarm switch]`.
+fn with_alarm_switch() -> String {
+    let alarm = "[[pheromones]]\nname = \"alarm\"\nmodel = \"gaussian\"\ncolour = [0, 255, 0]\n\
+                 evaporation = 1.0\n\n[[robots]]";
+    let emits = r#"emits = [{ pheromone = "alarm", k = 0.01, sigma = [0.03, 0.03], evaporation = 1.0, when = "action" }]"#;
+    trail_with(&format!("{}\n{emits}", action_line(3.0))).replacen("[[robots]]", alarm, 1)
+}
+
+/// Worlds whose agents' alarm sources have been switched on.
+fn alarms_on(env: &VecEnv) -> Vec<usize> {
+    (0..env.spec().num_envs)
+        .map(|e| {
+            let world = env.world(e).unwrap();
+            let FieldModel::Gaussian(g) = &world.pheromones()[2].model else {
+                panic!("alarm is gaussian")
+            };
+            g.sources.iter().filter(|s| s.start.is_finite()).count()
+        })
+        .collect()
+}
+
+#[test]
+fn an_agent_switches_a_gaussian_emitter_with_its_last_action_entry() {
+    let mut env = env(with_alarm_switch(), ActionKind::Continuous);
+    assert_eq!(env.spec().action.flat_len(), 4);
+    red_after(&mut env, &[0.0, 0.3], 5);
+    assert_eq!(alarms_on(&env), [0, 0, 0], "below 0.5 is off");
+    red_after(&mut env, &[0.0, 1.0], 1);
+    assert_eq!(alarms_on(&env), [4, 4, 4], "every agent's source is on");
+    // Discrete: 6 motions x 2 bits; bit 1 (the alarm) is on from action 6 * 2.
+    let mut discrete = self::env(with_alarm_switch(), ActionKind::Discrete);
+    let n = discrete.spec().num_envs * discrete.spec().num_agents;
+    discrete
+        .step(Actions::Discrete(&vec![1 + 6 * 2; n]))
+        .unwrap();
+    assert_eq!(alarms_on(&discrete), [4, 4, 4]);
+}
+
+#[test]
+fn an_action_switched_emitter_on_robots_that_are_not_agents_is_refused() {
+    let walker = r#"
+[[robots]]
+count = 1
+role = "walker"
+behaviour = "wander"
+emits = [{ pheromone = "alarm", k = 0.01, sigma = [0.03, 0.03], evaporation = 1.0, when = "action" }]
+"#;
+    let mut cfg = EnvConfig::new("trail");
+    cfg.scenario = ScenarioSource::Text(with_alarm_switch() + walker);
+    let err = VecEnv::new(&cfg).err().expect("refused").to_string();
+    assert!(
+        err.contains("robots[1].emits") && err.contains("nothing would switch it"),
+        "{err}"
+    );
+}

@@ -1,7 +1,8 @@
 //! The trajectory log: one CSV row per robot and logged tick, appended and flushed as the run goes,
 //! so a killed run keeps every complete row. Where robots may lay pheromone by action
-//! (`[[robots]] deposit_actions`), each such pheromone gets a `lay_<name>` column: the fraction of its
-//! `max_rate` the robot laid at that tick (0 for robots whose group cannot lay it).
+//! (`[[robots]] deposit_actions`, emitters with `when = "action"`), each such pheromone gets a
+//! `lay_<name>` column: the robot's action for it at that tick (a fraction of a trail's `max_rate`; an
+//! emitter's switch), 0 for robots whose group cannot lay it.
 use super::fixed::{push_digits, push_fixed};
 use crate::error::{Result, SimError};
 use crate::scenario::RobotGroupSpec;
@@ -24,16 +25,15 @@ impl LayColumns {
     /// The columns of the robot groups `groups` (none where no group has deposit actions).
     pub fn of(groups: &[RobotGroupSpec]) -> Self {
         let mut names: Vec<String> = Vec::new();
-        for d in groups.iter().flat_map(|g| &g.deposit_actions) {
-            if !names.contains(&d.pheromone) {
-                names.push(d.pheromone.clone());
+        for name in groups.iter().flat_map(|g| g.action_pheromones()) {
+            if !names.iter().any(|n| n == name) {
+                names.push(name.to_string());
             }
         }
         let slots = groups
             .iter()
             .map(|g| {
-                let find =
-                    |name: &String| (g.deposit_actions.iter()).position(|d| &d.pheromone == name);
+                let find = |name: &String| g.action_pheromones().position(|p| p == name);
                 names.iter().map(find).collect()
             })
             .collect();

@@ -224,6 +224,12 @@ impl EmitSpec {
         }
     }
 
+    /// Switched on and off by the robot's agent (one action entry; see [`EmitWhen::Action`]).
+    pub fn when_action(mut self) -> Self {
+        self.when = EmitWhen::Action;
+        self
+    }
+
     /// Refreshed at the robot only while it is within `distance` (m) of a robot of role `role`.
     pub fn when_near(mut self, role: impl Into<String>, distance: f32) -> Self {
         self.when = EmitWhen::Near {

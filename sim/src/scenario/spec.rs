@@ -254,6 +254,22 @@ pub struct RobotGroupSpec {
 }
 
 impl RobotGroupSpec {
+    /// The pheromones this group's agents lay by action, in the order of their action entries:
+    /// `deposit_actions` (grid trails, a rate fraction each), then the `emits` switched by action
+    /// (`when = "action"`, on from 0.5).
+    pub fn action_pheromones(&self) -> impl Iterator<Item = &str> {
+        let trails = self.deposit_actions.iter().map(|d| d.pheromone.as_str());
+        let switched = (self.emits.iter())
+            .filter(|e| e.when == EmitWhen::Action)
+            .map(|e| e.pheromone.as_str());
+        trails.chain(switched)
+    }
+
+    /// Action entries per robot of this group for laying pheromone (see [`Self::action_pheromones`]).
+    pub fn action_count(&self) -> usize {
+        self.action_pheromones().count()
+    }
+
     /// A robot's behaviour as this group names it (`key`: the group's key, for errors).
     pub fn build_behaviour(
         &self,
@@ -303,6 +319,8 @@ pub struct EmitSpec {
 /// `follow`: the source sits at the robot and is refreshed every step (AGP follows the leader).
 /// `near`: while the robot is within `distance` of a robot of role `role`, the source is moved to it and
 /// its clock restarts (refreshed); away from it, the source stays and evaporates (ALP).
+/// `action`: the robot's agent switches it: while its action entry is at least 0.5 the source is
+/// refreshed at the robot; below, it stays and evaporates (nothing is emitted before the first "on").
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum EmitWhen {
@@ -312,4 +330,5 @@ pub enum EmitWhen {
         role: String,
         distance: f32,
     },
+    Action,
 }

@@ -518,8 +518,8 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
                 return Err(SimError::invalid(
                     format!("{key}.pheromone"),
                     format!("{pheromone:?}"),
-                    "trail deposits need a grid pheromone (an agent cannot switch a Gaussian \
-                     source on and off yet)",
+                    "trail deposits need a grid pheromone (an agent lays a gaussian one with \
+                     `emits = [{ ..., when = \"action\" }]`)",
                 ));
             }
             non_negative(&format!("{key}.{rate_key}"), rate)?;

@@ -1,6 +1,6 @@
 //! Building a world from a scenario: fields with their static maps, robots, emitters; and the same
 //! parts without bodies or a tracker model, for a host whose robots and tracker are real.
-use super::inject::{Deposit, Emitter};
+use super::inject::{Deposit, EmitRule, Emitter};
 use super::{FieldSet, Injection, RobotSet, RobotSlot, Sensing, Tracking, World};
 use crate::behaviour::WheelCommand;
 use crate::error::Result;
@@ -163,17 +163,22 @@ impl WorldParts {
                         action: Some(k),
                     });
                 }
+                let mut switch = group.deposit_actions.len();
                 for e in &group.emits {
                     let pheromone = scenario.pheromone_index(&e.pheromone).expect("validated");
                     let FieldModel::Gaussian(field) = &mut pheromones[pheromone].model else {
                         unreachable!("validated")
                     };
-                    let (start, near) = match &e.when {
-                        EmitWhen::Follow => (0.0, None),
+                    let (start, rule) = match &e.when {
+                        EmitWhen::Follow => (0.0, EmitRule::Follow),
                         EmitWhen::Near { role, distance } => (
                             f32::INFINITY,
-                            Some((robots_with_role(scenario, role, index), *distance)),
+                            EmitRule::Near(robots_with_role(scenario, role, index), *distance),
                         ),
+                        EmitWhen::Action => {
+                            switch += 1;
+                            (f32::INFINITY, EmitRule::Action(switch - 1))
+                        }
                     };
                     field.sources.push(GaussianSource {
                         k: e.k,
@@ -188,7 +193,7 @@ impl WorldParts {
                         robot: index,
                         pheromone,
                         source: field.sources.len() - 1,
-                        near,
+                        rule,
                     });
                 }
             }

@@ -15,6 +15,9 @@ const BANDED_DEPOSITS: usize = 256;
 /// Bands of rows each grid field is cut into then.
 const BANDS: usize = 4;
 
+/// An emitter switched by action is on from this fraction.
+pub const EMIT_ON: f32 = 0.5;
+
 /// One robot's trail deposit of this step: the segment from where it injected last to where it is.
 struct Segment {
     pheromone: usize,
@@ -74,8 +77,17 @@ pub(super) struct Emitter {
     pub pheromone: usize,
     /// Index of the source in the pheromone's [`crate::field::GaussianField`].
     pub source: usize,
-    /// `None`: follow always; `Some((targets, distance))`: refresh when near one of `targets`.
-    pub near: Option<(Vec<usize>, f32)>,
+    pub rule: EmitRule,
+}
+
+/// When an emitter's source is refreshed at its robot.
+pub(super) enum EmitRule {
+    /// Every step.
+    Follow,
+    /// While the robot is within the distance of one of the target robots.
+    Near(Vec<usize>, f32),
+    /// While the robot's action `k` (among its deposit actions) is at least 0.5.
+    Action(usize),
 }
 
 pub struct Injection {
@@ -107,6 +119,11 @@ impl Injection {
         let mut action_first = vec![0; robots + 1];
         for d in deposits.iter().filter(|d| d.action.is_some()) {
             action_first[d.robot + 1] += 1;
+        }
+        for e in &emitters {
+            if let EmitRule::Action(_) = e.rule {
+                action_first[e.robot + 1] += 1;
+            }
         }
         for i in 0..robots {
             action_first[i + 1] += action_first[i];
@@ -194,11 +211,14 @@ pub fn inject(
         let Some(pos) = point(e.robot) else {
             continue;
         };
-        let refresh = match &e.near {
-            None => true,
-            Some((targets, distance)) => targets
+        let refresh = match &e.rule {
+            EmitRule::Follow => true,
+            EmitRule::Near(targets, distance) => targets
                 .iter()
                 .any(|&t| point(t).is_some_and(|q| q.distance(pos) <= *distance)),
+            EmitRule::Action(k) => {
+                injection.action_rates[injection.action_first[e.robot] + k] >= EMIT_ON
+            }
         };
         if refresh && let FieldModel::Gaussian(g) = &mut fields.pheromones_mut()[e.pheromone].model
         {
