@@ -191,3 +191,51 @@ fn missing_image_is_a_clear_error_at_validation() {
     assert!(e.contains("pheromones[0].maps[0].image"), "{e}");
     assert!(e.contains("no_such_file.png"), "{e}");
 }
+
+/// A map is a polyline (with a width) or an image (with a channel): keys of the other kind, both
+/// kinds or neither are refused as the file is read, naming the key.
+#[test]
+fn a_map_has_the_keys_of_one_kind() {
+    let with = |m: &str| {
+        GOOD.replace(
+            "evaporation = 10.0",
+            &format!("evaporation = 10.0\nmaps = [{m}]"),
+        )
+    };
+    let line = "polyline = [[0.1, 0.1], [0.2, 0.2]]";
+    let cases = [
+        (
+            format!("{{ {line}, width = 0.01, channel = \"r\", rate = 1 }}"),
+            "pheromones[0].maps[0].channel",
+            "only image maps",
+        ),
+        (
+            "{ image = \"m.png\", width = 0.01, rate = 1 }".to_string(),
+            "pheromones[0].maps[0].width",
+            "only polyline maps",
+        ),
+        (
+            "{ image = \"m.png\", channel = \"a\", rate = 1 }".to_string(),
+            "pheromones[0].maps[0].channel",
+            "\"luma\"",
+        ),
+        (
+            format!("{{ {line}, image = \"m.png\", width = 0.01, rate = 1 }}"),
+            "pheromones[0].maps[0]",
+            "exactly one of",
+        ),
+        (
+            "{ rate = 1 }".to_string(),
+            "pheromones[0].maps[0]",
+            "exactly one of",
+        ),
+        (
+            format!("{{ {line}, width = 0.01, rate = 1, colour = 3 }}"),
+            "pheromones[0].maps[0]",
+            "colour",
+        ),
+    ];
+    for (map, key, why) in cases {
+        assert_err(&with(&map), &[key, why]);
+    }
+}

@@ -355,7 +355,10 @@ mod tests {
         let out = tempfile::tempdir().unwrap();
         run(&sc, out.path(), RunOptions::default()).unwrap();
         let saved = Scenario::from_file(out.path().join("scenario.toml")).expect("the saved copy");
-        let image = saved.spec.pheromones[0].maps[0].image.clone().unwrap();
+        let crate::scenario::MapSpec::Image { image, .. } = &saved.spec.pheromones[0].maps[0]
+        else {
+            panic!("an image map")
+        };
         assert!(Path::new(&image).is_absolute(), "{image}");
         let again = tempfile::tempdir().unwrap();
         let report = run(&saved, again.path(), RunOptions::default()).expect("runs again");

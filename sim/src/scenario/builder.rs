@@ -200,11 +200,9 @@ impl PheromoneSpec {
 impl MapSpec {
     /// A trail along `points` (m), `width` m wide, injecting `rate` units per second.
     pub fn polyline(points: Vec<[f32; 2]>, width: f32, rate: f32) -> Self {
-        MapSpec {
-            polyline: Some(points),
-            width: Some(width),
-            image: None,
-            channel: None,
+        MapSpec::Polyline {
+            polyline: points,
+            width,
             rate,
         }
     }

@@ -111,7 +111,12 @@ pub(super) fn check_substeps(sc: &Scenario, i: usize, grid: &GridSpec) -> Result
 
 /// A polyline map's point count and drawing work (as `polyline_map` visits cells).
 pub(super) fn check_polyline(key: &str, map: &MapSpec, grid: &GridSpec) -> Result<()> {
-    let Some(points) = &map.polyline else {
+    let MapSpec::Polyline {
+        polyline: points,
+        width,
+        ..
+    } = map
+    else {
         return Ok(());
     };
     if points.len() > MAX_POLYLINE_POINTS {
@@ -121,7 +126,7 @@ pub(super) fn check_polyline(key: &str, map: &MapSpec, grid: &GridSpec) -> Resul
             format!("more than {MAX_POLYLINE_POINTS} points"),
         ));
     }
-    let half = 0.5 * map.width.unwrap_or(0.0).max(0.0);
+    let half = 0.5 * width.max(0.0);
     let visits: f64 = points
         .windows(2)
         .map(|w| {

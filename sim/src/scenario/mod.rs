@@ -148,7 +148,10 @@ impl Scenario {
         spec.pheromones
             .iter_mut()
             .flat_map(|ph| ph.maps.iter_mut())
-            .filter_map(|m| m.image.as_mut())
+            .filter_map(|m| match m {
+                MapSpec::Image { image, .. } => Some(image),
+                MapSpec::Polyline { .. } => None,
+            })
             .for_each(absolute);
         spec.obstacles
             .iter_mut()
@@ -170,11 +173,13 @@ pub fn parse_spec(text: &str) -> Result<ScenarioSpec> {
     })?;
     let spec: ScenarioSpec = serde_path_to_error::deserialize(de).map_err(|e| {
         let path = e.path().to_string();
-        let inner = e.into_inner().to_string();
-        let message = if path == "." || path.is_empty() {
-            inner
-        } else {
-            format!("at `{path}`: {inner}")
+        let error = e.into_inner();
+        // A table checked as a whole (a map) names its key at fault as `.key: ...`.
+        let sub = (error.message().strip_prefix('.')).and_then(|r| r.split_once(": "));
+        let message = match sub {
+            Some((key, reason)) => format!("at `{path}.{key}`: {reason}"),
+            None if path == "." || path.is_empty() => error.to_string(),
+            None => format!("at `{path}`: {error}"),
         };
         SimError::Parse {
             path: "<text>".into(),

@@ -174,20 +174,88 @@ pub struct PheromoneSpec {
     pub preload: bool,
 }
 
-/// A static injection map: a polyline with a width, or an image.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MapSpec {
-    /// Points of a polyline, m.
-    pub polyline: Option<Vec<[f32; 2]>>,
-    /// Trail width, m.
-    pub width: Option<f32>,
-    /// PNG path, relative to the scenario file.
-    pub image: Option<String>,
-    /// Image channel to read: "r", "g", "b" or "luma" (default).
-    pub channel: Option<crate::channel::ImageChannel>,
+/// A static injection map: a polyline with a width, or an image. Written in TOML as a table with
+/// either `polyline` and `width` or `image` (and `channel`), and `rate`; which keys belong to which
+/// kind is checked as the file is read (see `MapFields`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged, try_from = "MapFields")]
+pub enum MapSpec {
+    Polyline {
+        /// Points of the polyline, m.
+        polyline: Vec<[f32; 2]>,
+        /// Trail width, m.
+        width: f32,
+        /// Injection rate J, units per second.
+        rate: f32,
+    },
+    Image {
+        /// PNG path, relative to the scenario file.
+        image: String,
+        /// Image channel to read: "r", "g", "b" or "luma" (default).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        channel: Option<crate::channel::ImageChannel>,
+        /// Injection rate J, units per second at full image level.
+        rate: f32,
+    },
+}
+
+impl MapSpec {
     /// Injection rate J, units per second (at full image level).
-    pub rate: f32,
+    pub fn rate(&self) -> f32 {
+        match self {
+            MapSpec::Polyline { rate, .. } | MapSpec::Image { rate, .. } => *rate,
+        }
+    }
+}
+
+/// A map's keys as written; [`MapSpec`] is made from them. An error names the key at fault as
+/// `.key: ...`, which the parser appends to the map's own path.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MapFields {
+    polyline: Option<Vec<[f32; 2]>>,
+    width: Option<f32>,
+    image: Option<String>,
+    channel: Option<crate::channel::ImageChannel>,
+    rate: f32,
+}
+
+impl TryFrom<MapFields> for MapSpec {
+    type Error = String;
+
+    fn try_from(f: MapFields) -> Result<Self, String> {
+        use crate::channel::ImageChannel;
+        match (f.polyline, f.image) {
+            (Some(polyline), None) => {
+                if f.channel.is_some() {
+                    return Err(".channel: only image maps have a channel".into());
+                }
+                let width = f
+                    .width
+                    .ok_or(".width: missing (a polyline map needs a width)")?;
+                Ok(MapSpec::Polyline {
+                    polyline,
+                    width,
+                    rate: f.rate,
+                })
+            }
+            (None, Some(image)) => {
+                if let Some(w) = f.width {
+                    return Err(format!(".width: {w}: only polyline maps have a width"));
+                }
+                // Maps are read as RGB: their alpha is not a level.
+                if f.channel == Some(ImageChannel::A) {
+                    return Err(".channel: \"a\": must be \"r\", \"g\", \"b\" or \"luma\"".into());
+                }
+                Ok(MapSpec::Image {
+                    image,
+                    channel: f.channel,
+                    rate: f.rate,
+                })
+            }
+            _ => Err("give exactly one of `polyline` or `image`".into()),
+        }
+    }
 }
 
 /// A Gaussian source of eq. (5).

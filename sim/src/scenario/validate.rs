@@ -272,7 +272,7 @@ fn validate_pheromones(sc: &Scenario, grid: &crate::field::GridSpec) -> Result<(
                     let key = format!("pheromones[{i}].maps[{m}]");
                     validate_map(&key, map)?;
                     limits::check_polyline(&key, map, grid)?;
-                    if let Some(image) = &map.image {
+                    if let MapSpec::Image { image, .. } = map {
                         limits::check_image(&key, image, &sc.base_dir)?;
                     }
                 }
@@ -313,62 +313,24 @@ fn validate_pheromones(sc: &Scenario, grid: &crate::field::GridSpec) -> Result<(
 }
 
 fn validate_map(key: &str, map: &MapSpec) -> Result<()> {
-    non_negative(&format!("{key}.rate"), map.rate)?;
-    match (&map.polyline, &map.image) {
-        (Some(points), None) => {
-            if points.len() < 2 {
-                return Err(SimError::invalid(
-                    format!("{key}.polyline"),
-                    points.len(),
-                    "needs at least 2 points",
-                ));
-            }
-            for (n, pt) in points.iter().enumerate() {
-                finite(&format!("{key}.polyline[{n}][0]"), pt[0])?;
-                finite(&format!("{key}.polyline[{n}][1]"), pt[1])?;
-            }
-            match map.width {
-                Some(w) => positive(&format!("{key}.width"), w)?,
-                None => {
-                    return Err(SimError::invalid(
-                        format!("{key}.width"),
-                        "missing",
-                        "a polyline map needs a width",
-                    ));
-                }
-            }
-            if map.channel.is_some() {
-                return Err(SimError::invalid(
-                    format!("{key}.channel"),
-                    format!("{:?}", map.channel),
-                    "only image maps have a channel",
-                ));
-            }
-        }
-        (None, Some(_)) => {
-            // Maps are read as RGB: their alpha is not a level.
-            if let Some(c @ crate::channel::ImageChannel::A) = map.channel {
-                return Err(SimError::invalid(
-                    format!("{key}.channel"),
-                    format!("{:?}", c.name()),
-                    "must be \"r\", \"g\", \"b\" or \"luma\"",
-                ));
-            }
-            if map.width.is_some() {
-                return Err(SimError::invalid(
-                    format!("{key}.width"),
-                    format!("{:?}", map.width),
-                    "only polyline maps have a width",
-                ));
-            }
-        }
-        _ => {
+    non_negative(&format!("{key}.rate"), map.rate())?;
+    // Which keys a map has was checked as the file was read (`MapSpec`'s `MapFields`).
+    if let MapSpec::Polyline {
+        polyline, width, ..
+    } = map
+    {
+        if polyline.len() < 2 {
             return Err(SimError::invalid(
-                key,
-                "map",
-                "give exactly one of `polyline` or `image`",
+                format!("{key}.polyline"),
+                polyline.len(),
+                "needs at least 2 points",
             ));
         }
+        for (n, pt) in polyline.iter().enumerate() {
+            finite(&format!("{key}.polyline[{n}][0]"), pt[0])?;
+            finite(&format!("{key}.polyline[{n}][1]"), pt[1])?;
+        }
+        positive(&format!("{key}.width"), *width)?;
     }
     Ok(())
 }

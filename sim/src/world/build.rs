@@ -289,22 +289,31 @@ fn build_pheromone(
 }
 
 fn build_map(scenario: &Scenario, _key: &str, map: &MapSpec, grid: &GridSpec) -> Result<Vec<f32>> {
-    if let Some(points) = &map.polyline {
-        let pts: Vec<Vec2> = points.iter().map(|p| Vec2::from(*p)).collect();
-        return Ok(polyline_map(grid, &pts, map.width.unwrap_or(0.0), map.rate));
-    }
-    let path = scenario
-        .base_dir
-        .join(map.image.as_deref().unwrap_or_default());
+    let (image, channel, rate) = match map {
+        MapSpec::Polyline {
+            polyline,
+            width,
+            rate,
+        } => {
+            let pts: Vec<Vec2> = polyline.iter().map(|p| Vec2::from(*p)).collect();
+            return Ok(polyline_map(grid, &pts, *width, *rate));
+        }
+        MapSpec::Image {
+            image,
+            channel,
+            rate,
+        } => (image, channel, *rate),
+    };
+    let path = scenario.base_dir.join(image);
     use crate::channel::{Channel, ImageChannel};
-    // Validation refused alpha for maps; luma is the default.
-    let channel = match map.channel {
+    // Reading the file refused alpha for maps; luma is the default.
+    let channel = match channel {
         Some(ImageChannel::R) => Some(Channel::R),
         Some(ImageChannel::G) => Some(Channel::G),
         Some(ImageChannel::B) => Some(Channel::B),
         Some(ImageChannel::A | ImageChannel::Luma) | None => None,
     };
-    image_map(grid, &path, channel, map.rate)
+    image_map(grid, &path, channel, rate)
 }
 
 /// `[sensor] per_robot`: every robot's own sensors from the file `[rig] colour_calibration` names
