@@ -13,8 +13,9 @@
 //!
 //! A live run opens a tracker with [`open_pose_source`] and the robots with [`open_robot_link`],
 //! and hands both to a [`LiveSession`].
-// What no other crate uses stays inside: a `pub` item must be reachable from the crate root.
-#![warn(unreachable_pub)]
+// What no other crate uses stays inside: a `pub` item must be reachable from the crate root, and a
+// type in a public signature must be nameable there.
+#![warn(unreachable_pub, unnameable_types)]
 
 pub mod calibrate;
 pub mod geometry;

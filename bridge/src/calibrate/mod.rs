@@ -17,7 +17,7 @@ pub use latency::{LatencyReport, StageDelays};
 pub use run_colour::{ColourRunOptions, calibrate_colour};
 pub use run_latency::{LatencyRunOptions, calibrate_latency};
 pub use run_screen::{ScreenRunOptions, calibrate_screen};
-pub use screen::ScreenCalibration;
+pub use screen::{FiducialSighting, ScreenCalibration};
 // The twin's camera tests show the same fiducials the screen calibration does.
 #[cfg(test)]
 pub(crate) use screen::render_fiducials;
@@ -133,7 +133,7 @@ impl RigCalibration {
 }
 
 /// Now, UTC, as `YYYY-MM-DDTHH:MM:SSZ`.
-pub fn utc_now() -> String {
+pub(crate) fn utc_now() -> String {
     let secs = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_secs() as i64)

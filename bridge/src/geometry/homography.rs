@@ -95,7 +95,7 @@ fn transform(t: &Matrix3<f64>, p: [f64; 2]) -> [f64; 2] {
 
 /// The least-squares (algebraic) homography taking each `from[i]` to `to[i]`: at least four pairs,
 /// no three of the first four on a line. `None` when the points do not determine one.
-pub fn fit_dlt(from: &[[f64; 2]], to: &[[f64; 2]]) -> Option<Homography> {
+pub(crate) fn fit_dlt(from: &[[f64; 2]], to: &[[f64; 2]]) -> Option<Homography> {
     if from.len() != to.len() || from.len() < 4 {
         return None;
     }
@@ -139,7 +139,7 @@ pub fn fit_dlt(from: &[[f64; 2]], to: &[[f64; 2]]) -> Option<Homography> {
 }
 
 /// Distance from `h(from)` to `to`, in `to`'s units (infinite where the map is undefined).
-pub fn residual(h: &Homography, from: [f64; 2], to: [f64; 2]) -> f64 {
+pub(crate) fn residual(h: &Homography, from: [f64; 2], to: [f64; 2]) -> f64 {
     h.apply(from)
         .map(|p| ((p[0] - to[0]).powi(2) + (p[1] - to[1]).powi(2)).sqrt())
         .unwrap_or(f64::INFINITY)
@@ -147,7 +147,7 @@ pub fn residual(h: &Homography, from: [f64; 2], to: [f64; 2]) -> f64 {
 
 /// A robust fit and which pairs it kept.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RobustFit {
+pub(crate) struct RobustFit {
     pub homography: Homography,
     /// Per pair: kept (an inlier) or rejected.
     pub inliers: Vec<bool>,
@@ -158,7 +158,7 @@ pub struct RobustFit {
 /// RANSAC: homographies through random four-pair samples, the one that explains the most pairs
 /// within `threshold` (in `to`'s units) wins and is refitted on them (twice, as the inlier set
 /// settles). Deterministic for a given `seed`.
-pub fn fit_ransac(
+pub(crate) fn fit_ransac(
     from: &[[f64; 2]],
     to: &[[f64; 2]],
     threshold: f64,

@@ -5,5 +5,7 @@
 mod homography;
 mod screen_map;
 
-pub use homography::{Homography, RobustFit, fit_dlt, fit_ransac, residual};
-pub use screen_map::{ScreenMap, wrap_pi};
+pub use homography::Homography;
+pub(crate) use homography::{fit_dlt, fit_ransac, residual};
+pub use screen_map::ScreenMap;
+pub(crate) use screen_map::wrap_pi;

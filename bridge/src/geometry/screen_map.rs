@@ -6,7 +6,7 @@ use super::Homography;
 use std::f64::consts::PI;
 
 /// Wraps an angle to (-pi, pi].
-pub fn wrap_pi(a: f64) -> f64 {
+pub(crate) fn wrap_pi(a: f64) -> f64 {
     let w = a.rem_euclid(2.0 * PI);
     if w > PI { w - 2.0 * PI } else { w }
 }

@@ -43,7 +43,7 @@ pub fn robot_params(
 }
 
 /// `params` as `PWP` frames of five values each, for robot `radio`.
-pub fn upload_packets(radio: u8, t_ms: u32, params: &[f32]) -> Vec<CommandPacket> {
+pub(crate) fn upload_packets(radio: u8, t_ms: u32, params: &[f32]) -> Vec<CommandPacket> {
     params
         .chunks(5)
         .enumerate()

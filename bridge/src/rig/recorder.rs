@@ -62,7 +62,7 @@ impl Topic {
 }
 
 #[derive(Debug, thiserror::Error)]
-pub enum RecorderError {
+pub(crate) enum RecorderError {
     #[error("rig log {path}: {source}")]
     Io {
         path: String,
@@ -72,7 +72,7 @@ pub enum RecorderError {
     Mcap(#[from] mcap::McapError),
 }
 
-pub struct Recorder {
+pub(crate) struct Recorder {
     writer: mcap::Writer<BufWriter<File>>,
     channels: [u16; 7],
     sequence: u32,
@@ -80,7 +80,7 @@ pub struct Recorder {
 
 impl Recorder {
     /// A new log at `path` (replacing any file there).
-    pub fn create(path: &Path) -> Result<Recorder, RecorderError> {
+    pub(crate) fn create(path: &Path) -> Result<Recorder, RecorderError> {
         let file = File::create(path).map_err(|source| RecorderError::Io {
             path: path.display().to_string(),
             source,
@@ -102,7 +102,12 @@ impl Recorder {
     }
 
     /// Records `data` on `topic` at `t_ns` ns since the Unix epoch.
-    pub fn record(&mut self, topic: Topic, t_ns: u64, data: &[u8]) -> Result<(), RecorderError> {
+    pub(crate) fn record(
+        &mut self,
+        topic: Topic,
+        t_ns: u64,
+        data: &[u8],
+    ) -> Result<(), RecorderError> {
         let channel_id = self.channels[Topic::ALL.iter().position(|t| *t == topic).unwrap_or(0)];
         self.sequence = self.sequence.wrapping_add(1);
         let header = mcap::records::MessageHeader {
@@ -116,7 +121,7 @@ impl Recorder {
     }
 
     /// Writes a metadata record `name` of key-value strings (what the run ran with).
-    pub fn write_metadata(
+    pub(crate) fn write_metadata(
         &mut self,
         name: &str,
         values: BTreeMap<String, String>,
@@ -129,13 +134,13 @@ impl Recorder {
     }
 
     /// Pushes everything recorded so far to the file.
-    pub fn flush(&mut self) -> Result<(), RecorderError> {
+    pub(crate) fn flush(&mut self) -> Result<(), RecorderError> {
         self.writer.flush()?;
         Ok(())
     }
 
     /// Writes the summary and closes the log.
-    pub fn finish(mut self) -> Result<(), RecorderError> {
+    pub(crate) fn finish(mut self) -> Result<(), RecorderError> {
         self.writer.finish()?;
         Ok(())
     }
@@ -187,7 +192,7 @@ pub fn read_metadata(bytes: &[u8]) -> Vec<(String, BTreeMap<String, String>)> {
 }
 
 /// FNV-1a (64-bit) of a frame's bytes, for the log.
-pub fn fnv1a(bytes: &[u8]) -> u64 {
+pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
         (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
     })

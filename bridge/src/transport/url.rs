@@ -49,7 +49,7 @@ pub enum PoseUrl {
 
 /// Where robot commands go and telemetry comes from.
 #[derive(Clone, Debug, PartialEq)]
-pub enum LinkUrl {
+pub(crate) enum LinkUrl {
     Serial {
         device: String,
         baud: u32,

@@ -3,7 +3,7 @@
 use super::{HEADER, TRAILER};
 
 /// Wraps a payload in the header and trailer.
-pub fn encode_frame<const N: usize>(payload: &[u8; N]) -> Vec<u8> {
+pub(crate) fn encode_frame<const N: usize>(payload: &[u8; N]) -> Vec<u8> {
     let mut v = Vec::with_capacity(N + 4);
     v.extend_from_slice(&HEADER);
     v.extend_from_slice(payload);

@@ -6,7 +6,7 @@ use colcos_sim::behaviour::WheelCommand;
 
 /// For each telemetry colour sensor (front, back, left, right), its simulator index
 /// (n = 0 right / Y-, 1 front / X+, 2 left / Y+, 3 back / X-).
-pub const TELEMETRY_TO_SIM: [usize; 4] = [1, 3, 2, 0];
+pub(crate) const TELEMETRY_TO_SIM: [usize; 4] = [1, 3, 2, 0];
 
 /// Telemetry colour counts (front, back, left, right) in the simulator's sensor order.
 pub fn colour_to_sim(wire: [[u16; 3]; 4]) -> [[u16; 3]; 4] {

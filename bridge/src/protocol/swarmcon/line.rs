@@ -4,7 +4,7 @@ use super::MAX_LINE;
 
 /// A line or a dropped over-long line, as produced by [`LineBuffer::push`].
 #[derive(Debug, PartialEq, Eq)]
-pub enum LineChunk<'a> {
+pub(crate) enum LineChunk<'a> {
     /// One line without its `\n` (a trailing `\r` is kept; the parser ignores it).
     Line(&'a [u8]),
     /// A line exceeded the limit and was discarded up to its `\n`.
@@ -13,7 +13,7 @@ pub enum LineChunk<'a> {
 
 /// Accumulates partial lines across reads; never holds more than `max_line` bytes.
 #[derive(Debug)]
-pub struct LineBuffer {
+pub(crate) struct LineBuffer {
     partial: Vec<u8>,
     max_line: usize,
     /// Dropping bytes until the next `\n` because the current line is too long.
@@ -27,7 +27,7 @@ impl Default for LineBuffer {
 }
 
 impl LineBuffer {
-    pub fn new(max_line: usize) -> Self {
+    pub(crate) fn new(max_line: usize) -> Self {
         LineBuffer {
             partial: Vec::new(),
             max_line: max_line.max(1),
@@ -35,18 +35,13 @@ impl LineBuffer {
         }
     }
 
-    pub fn max_line(&self) -> usize {
+    pub(crate) fn max_line(&self) -> usize {
         self.max_line
-    }
-
-    /// Bytes of an unfinished line currently held.
-    pub fn pending(&self) -> usize {
-        self.partial.len()
     }
 
     /// Feeds bytes and calls `f` for every complete line, in order. Lines wholly inside `bytes` are
     /// passed without copying.
-    pub fn push(&mut self, mut bytes: &[u8], mut f: impl FnMut(LineChunk<'_>)) {
+    pub(crate) fn push(&mut self, mut bytes: &[u8], mut f: impl FnMut(LineChunk<'_>)) {
         while !bytes.is_empty() {
             let Some(nl) = bytes.iter().position(|&b| b == b'\n') else {
                 self.keep_partial(bytes);

@@ -10,18 +10,18 @@ mod transform;
 mod write;
 
 pub use calibrate::{Calibrate, CalibrateError};
-pub use line::{LineBuffer, LineChunk};
 pub use parse::{TrackerError, TrackerLine, parse_line};
 pub use stream::{ParserCounters, StreamParser, TrackerMessage};
 pub use transform::FrameTransform;
-pub use write::{HeaderForm, format_c_f3, push_c_f3, write_block, write_event, write_frame};
+pub(crate) use write::write_event;
+pub use write::{HeaderForm, write_block};
 
 /// The TCP port the position server listens on.
-pub const DEFAULT_PORT: u16 = 6666;
+pub(crate) const DEFAULT_PORT: u16 = 6666;
 /// Lines longer than this are dropped (a real line is under 60 bytes).
-pub const MAX_LINE: usize = 4096;
+pub(crate) const MAX_LINE: usize = 4096;
 /// Most slots one block may announce; the server itself caps it at 100.
-pub const MAX_SLOTS: usize = 1024;
+pub(crate) const MAX_SLOTS: usize = 1024;
 
 /// Whether a slot's pose comes from this camera frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -17,7 +17,7 @@ pub enum HeaderForm {
 }
 
 /// Appends `v` as C's `%.3f` prints it (glibc spellings for non-finite values).
-pub fn push_c_f3(out: &mut String, v: f64) {
+pub(crate) fn push_c_f3(out: &mut String, v: f64) {
     if v.is_nan() {
         out.push_str(if v.is_sign_negative() { "-nan" } else { "nan" });
     } else if v.is_infinite() {
@@ -30,14 +30,14 @@ pub fn push_c_f3(out: &mut String, v: f64) {
 }
 
 /// `v` as C's `%.3f` prints it.
-pub fn format_c_f3(v: f64) -> String {
+pub(crate) fn format_c_f3(v: f64) -> String {
     let mut s = String::new();
     push_c_f3(&mut s, v);
     s
 }
 
 /// Appends one frame (header and `Robot` lines). `HeaderForm::Updated` writes `frame.updated`, or 0.
-pub fn write_frame(out: &mut String, frame: &TrackerFrame, form: HeaderForm) {
+pub(crate) fn write_frame(out: &mut String, frame: &TrackerFrame, form: HeaderForm) {
     let _ = write!(
         out,
         "Detected {} of {} at {}",
@@ -63,7 +63,7 @@ pub fn write_frame(out: &mut String, frame: &TrackerFrame, form: HeaderForm) {
 }
 
 /// Appends an event line.
-pub fn write_event(out: &mut String, event: TrackerEvent) {
+pub(crate) fn write_event(out: &mut String, event: TrackerEvent) {
     out.push_str(match event {
         TrackerEvent::Calibrated => "Calibrated\n",
         TrackerEvent::Closed => "Closed\n",

@@ -7,10 +7,10 @@ mod udp;
 
 pub use scheduler::{AirtimeScheduler, SchedulerCounters};
 pub use serial::SerialWire;
-pub use udp::UdpWire;
+use udp::UdpWire;
 
+use super::url::{LinkUrl, UrlError};
 use crate::protocol::colias::{CommandPacket, Telemetry, TelemetryDecoder};
-use crate::transport::{LinkUrl, UrlError};
 use std::time::Instant;
 use thiserror::Error;
 

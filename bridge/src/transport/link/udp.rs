@@ -7,13 +7,13 @@ use std::net::{SocketAddr, ToSocketAddrs, UdpSocket};
 /// Datagrams read per pump at most, so a flood cannot stall the live loop.
 const MAX_DATAGRAMS: usize = 256;
 
-pub struct UdpWire {
+pub(crate) struct UdpWire {
     sock: UdpSocket,
 }
 
 impl UdpWire {
     /// Binds an ephemeral local port and sends to `remote`.
-    pub fn connect(remote: &str) -> std::io::Result<Self> {
+    pub(crate) fn connect(remote: &str) -> std::io::Result<Self> {
         let addr: SocketAddr = remote.to_socket_addrs()?.next().ok_or_else(|| {
             std::io::Error::new(
                 ErrorKind::NotFound,
@@ -31,10 +31,6 @@ impl UdpWire {
         sock.connect(addr)?;
         sock.set_nonblocking(true)?;
         Ok(UdpWire { sock })
-    }
-
-    pub fn local_addr(&self) -> std::io::Result<SocketAddr> {
-        self.sock.local_addr()
     }
 }
 
