@@ -8,8 +8,8 @@
 //! real time: a run on the twin takes as long as it simulates) writes `s_t.csv`, `summary.txt` and
 //! the figure `s_t.png`; `-- --plot OUT_DIR` draws the figure again from `s_t.csv`.
 use colcos::bridge::calibrate::RigCalibration;
-use colcos::bridge::live::{LiveOptions, LiveSession};
-use colcos::bridge::swarmcon::HeaderForm;
+use colcos::bridge::protocol::swarmcon::HeaderForm;
+use colcos::bridge::rig::{LiveOptions, LiveSession};
 use colcos::bridge::twin::{TrackerServer, Twin, UdpChannel};
 use colcos::bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos::experiment::case2::SCENARIO_TOML;
@@ -141,7 +141,7 @@ fn on_twin(label: &str, host: &Scenario, twin: &Scenario) -> Curve {
         let truth: Vec<Vec2> = twin
             .lock()
             .unwrap()
-            .plant()
+            .arena()
             .world()
             .poses()
             .iter()

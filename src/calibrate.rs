@@ -4,13 +4,13 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use colcos_bridge::calibrate::RigCalibration;
-use colcos_bridge::calibrate::run_colour::{ColourRunOptions, calibrate_colour};
-use colcos_bridge::calibrate::run_latency::{LatencyRunOptions, calibrate_latency};
-use colcos_bridge::calibrate::run_screen::{ScreenRunOptions, calibrate_screen};
-use colcos_bridge::calibrate::session::{RawTracker, Rig};
-use colcos_bridge::frames::FrameServer;
+use colcos_bridge::calibrate::{
+    CalibrationRig, ColourRunOptions, LatencyRunOptions, RawTracker, ScreenRunOptions,
+    calibrate_colour, calibrate_latency, calibrate_screen,
+};
 use colcos_bridge::open_robot_link;
-use colcos_bridge::url::PoseUrl;
+use colcos_bridge::transport::FrameServer;
+use colcos_bridge::transport::PoseUrl;
 use colcos_sim::scenario::Scenario;
 use std::fmt::Write as _;
 use std::net::SocketAddr;
@@ -126,7 +126,7 @@ fn parse_grid(s: &str) -> Result<[usize; 2], String> {
 }
 
 /// Opens the tracker, the frame stream and (if given) the link.
-fn open_rig(common: &Common) -> Result<(Scenario, Rig)> {
+fn open_rig(common: &Common) -> Result<(Scenario, CalibrationRig)> {
     let sc = Scenario::from_file(&common.scenario)?;
     // The output's folder exists (or is made) before anything is measured: a measurement is not
     // thrown away for a missing `calib/`.
@@ -157,7 +157,7 @@ fn open_rig(common: &Common) -> Result<(Scenario, Rig)> {
         Some(url) => Some(open_robot_link(url).with_context(|| format!("--robots {url}"))?),
         None => None,
     };
-    Ok((sc, Rig::new(tracker, frames, link)))
+    Ok((sc, CalibrationRig::new(tracker, frames, link)))
 }
 
 fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
@@ -235,7 +235,7 @@ pub fn main(args: CalibrateArgs, text: &mut String) -> Result<()> {
             };
             let report = calibrate_latency(&mut rig, &sc, &transform, &opts)?;
             write_json(&common.out, &report)?;
-            let ms = |s: Option<colcos_bridge::calibrate::latency::Stage>| {
+            let ms = |s: Option<colcos_bridge::calibrate::StageDelays>| {
                 s.map_or("not measured".to_string(), |s| {
                     format!(
                         "{:.1} ms (p5 {:.1}, p95 {:.1})",

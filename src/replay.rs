@@ -3,8 +3,8 @@
 //! bytes; this checks that a recorded run is reproducible (and what changed when it is not).
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use colcos_bridge::colias::LegacyDrive;
-use colcos_bridge::live::{LoopCore, replay};
+use colcos_bridge::protocol::colias::LegacyDrive;
+use colcos_bridge::rig::{LoopCore, replay};
 use colcos_sim::scenario::Scenario;
 use std::fmt::Write as _;
 use std::path::PathBuf;

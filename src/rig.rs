@@ -3,9 +3,9 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use colcos_bridge::calibrate::RigCalibration;
-use colcos_bridge::frames::FrameServer;
-use colcos_bridge::live::{self, LiveOptions};
-use colcos_bridge::swarmcon::HeaderForm;
+use colcos_bridge::protocol::swarmcon::HeaderForm;
+use colcos_bridge::rig::{self, LiveOptions};
+use colcos_bridge::transport::FrameServer;
 use colcos_bridge::twin::{ByteChannel, CameraModel, PtyChannel, TrackerServer, Twin, UdpChannel};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::scenario::Scenario;
@@ -149,7 +149,7 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
         ..LiveOptions::default()
     };
     let stop = stop_on_signal()?;
-    let report = live::run(&sc, source, link, frames, live_opts, stop)?;
+    let report = rig::run(&sc, source, link, frames, live_opts, stop)?;
     let summary = args.out.join("summary.json");
     std::fs::write(&summary, serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("writing {}", summary.display()))?;
@@ -265,7 +265,7 @@ pub fn twin(args: TwinArgs, text: &mut String) -> Result<()> {
     writeln!(
         text,
         "twin ran {:.1} s of {}: {} commands received",
-        twin.plant().time(),
+        twin.arena().time(),
         args.scenario.display(),
         twin.received().len()
     )?;
@@ -278,9 +278,9 @@ fn open_display(
     sc: &Scenario,
     monitor: usize,
     args: &BridgeArgs,
-) -> Result<Box<dyn colcos_bridge::live::FrameSink>> {
+) -> Result<Box<dyn colcos_bridge::rig::FrameSink>> {
     struct Window(colcos_display::Viewer);
-    impl colcos_bridge::live::FrameSink for Window {
+    impl colcos_bridge::rig::FrameSink for Window {
         fn show(&mut self, frame: &image::RgbImage) -> bool {
             let size = (frame.width(), frame.height());
             let rgba = image::DynamicImage::ImageRgb8(frame.clone())
@@ -310,6 +310,6 @@ fn open_display(
     _: &Scenario,
     monitor: usize,
     _: &BridgeArgs,
-) -> Result<Box<dyn colcos_bridge::live::FrameSink>> {
+) -> Result<Box<dyn colcos_bridge::rig::FrameSink>> {
     bail!("--display {monitor}: this build has no display window (the `display` feature)")
 }

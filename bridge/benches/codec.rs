@@ -2,10 +2,12 @@
 //! frame), and the tracker parser on blocks of 100 robots (target at least 10,000 blocks/s). Prints
 //! each figure and its ratio to the target, then runs the criterion groups.
 
-use colcos_bridge::colias::{
+use colcos_bridge::protocol::colias::{
     CommandDecoder, CommandPacket, HostCommand, Telemetry, TelemetryDecoder,
 };
-use colcos_bridge::swarmcon::{HeaderForm, SlotPose, StreamParser, TrackerFrame, write_block};
+use colcos_bridge::protocol::swarmcon::{
+    HeaderForm, SlotPose, StreamParser, TrackerFrame, write_block,
+};
 use criterion::{Criterion, Throughput};
 use std::hint::black_box;
 use std::time::{Duration, Instant};

@@ -3,18 +3,18 @@
 //! rendered at the panel's 4K on the CPU, for 100 robots on the 65-inch panel with three grid
 //! pheromones (5 mm cells). Target: at most 5 ms, a quarter of the 20 ms tick. Prints medians of each
 //! part and of the whole against the 5 ms bar and the 20 ms tick, for the screen drawn three ways in
-//! the same run: into a kept image (`ScreenRenderer::render_into`), as a new image (`Host::render`,
+//! the same run: into a kept image (`ScreenRenderer::render_into`), as a new image (`HostWorld::render`,
 //! `screen::render`), and by the per-pixel renderer the simulator had before (kept below as the
 //! reference; every frame is checked to be byte-identical to it).
 //!
 //! ```text
 //! cargo bench -p colcos-bridge --bench live_tick
 //! ```
-use colcos_bridge::host::Host;
-use colcos_bridge::source::frame_to_poses;
-use colcos_bridge::swarmcon::{
+use colcos_bridge::protocol::swarmcon::{
     FrameTransform, HeaderForm, SlotPose, SlotState, StreamParser, TrackerFrame, write_block,
 };
+use colcos_bridge::rig::HostWorld;
+use colcos_bridge::transport::frame_to_poses;
 use colcos_sim::Vec2;
 use colcos_sim::field::{FieldModel, Pheromone};
 use colcos_sim::scenario::{Scenario, SensorSource};
@@ -128,7 +128,7 @@ fn threads() -> usize {
 
 fn main() {
     let sc = Scenario::from_toml_str(SCENARIO, ".").expect("scenario");
-    let mut host = Host::new(&sc, SensorSource::Virtual).expect("host");
+    let mut host = HostWorld::new(&sc, SensorSource::Virtual).expect("host");
     let transform = FrameTransform::new(sc.arena_size().y as f64);
     let start = colcos_sim::world::World::new(&sc)
         .expect("world")
@@ -174,7 +174,7 @@ fn main() {
         let messages = parser.feed(block.as_bytes());
         let mut poses = Vec::new();
         for m in &messages {
-            if let colcos_bridge::swarmcon::TrackerMessage::Frame(f) = m {
+            if let colcos_bridge::protocol::swarmcon::TrackerMessage::Frame(f) = m {
                 poses = frame_to_poses(f, &transform);
             }
         }

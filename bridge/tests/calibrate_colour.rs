@@ -7,8 +7,8 @@ mod calibrate_common;
 
 use calibrate_common::{TwinRun, scenario};
 use colcos_bridge::calibrate::RigCalibration;
-use colcos_bridge::calibrate::run_colour::{ColourRunOptions, calibrate_colour};
-use colcos_bridge::twin::TwinPlant;
+use colcos_bridge::calibrate::{ColourRunOptions, calibrate_colour};
+use colcos_bridge::twin::TwinArena;
 use colcos_sim::rng::{Stream, stream_of};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::sensors::{ColourCalibration, ColourSensor, RobotColour, SensorFit};
@@ -74,13 +74,13 @@ fn twin_scenario(file: &ColourCalibration, dir: &std::path::Path) -> Scenario {
 fn the_twins_robots_read_through_their_own_sensors() {
     let file = file_models();
     let dir = tempfile::tempdir().unwrap();
-    let mut plant = TwinPlant::new(&twin_scenario(&file, dir.path())).unwrap();
+    let mut arena = TwinArena::new(&twin_scenario(&file, dir.path())).unwrap();
     let levels = [180.0, 90.0, 40.0];
     let frame = RgbImage::from_pixel(384, 216, image::Rgb(levels.map(|v| v as u8)));
     for (r, robot) in file.robots.iter().enumerate() {
         let mut mean = [[0.0f64; 3]; 4];
         for _ in 0..16 {
-            let counts = plant.colour_counts(r, Some(&frame));
+            let counts = arena.colour_counts(r, Some(&frame));
             for k in 0..4 {
                 for c in 0..3 {
                     mean[k][c] += counts[k][c] as f64 / 16.0;
@@ -209,7 +209,7 @@ fn the_live_loop_refuses_a_missing_calibration_file() {
         &[(0.3, 0.3, 0.0)],
         "colour_calibration = \"/nonexistent/colour.json\"",
     );
-    let err = colcos_bridge::live::LoopCore::new(&sc, Default::default())
+    let err = colcos_bridge::rig::LoopCore::new(&sc, Default::default())
         .err()
         .expect("refused")
         .to_string();

@@ -4,11 +4,11 @@
 mod calibrate_common;
 
 use calibrate_common::{TwinRun, scenario, wanderers};
-use colcos_bridge::calibrate::run_latency::{LatencyRunOptions, calibrate_latency};
-use colcos_bridge::clock::ClockOffset;
-use colcos_bridge::host::Host;
-use colcos_bridge::swarmcon::FrameTransform;
-use colcos_bridge::twin::{Noise, TwinPlant};
+use colcos_bridge::calibrate::{LatencyRunOptions, calibrate_latency};
+use colcos_bridge::protocol::swarmcon::FrameTransform;
+use colcos_bridge::rig::HostWorld;
+use colcos_bridge::transport::ClockOffset;
+use colcos_bridge::twin::{Noise, TwinArena};
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::{Scenario, SensorSource};
 use std::collections::VecDeque;
@@ -75,23 +75,23 @@ fn a_40_ms_tracker_is_measured_within_5_ms_and_compensating_it_brings_the_inject
 }
 
 /// Mean distance, m, between where the host injects and where each robot truly is, over 15 s of
-/// `sc` run in process: the twin's plant as the arena, its poses reaching the host 40 +- 10 ms
+/// `sc` run in process: the twin's arena, its poses reaching the host 40 +- 10 ms
 /// late (1 mm noise), aged by the clock-offset estimate as the live loop does (on the clock of the
 /// tick they are used in), compensated by `latency`.
 fn injection_error(sc: &Scenario, latency: f32) -> f64 {
-    let mut plant = TwinPlant::new(sc).unwrap();
-    let mut host = Host::new(sc, SensorSource::Virtual).unwrap();
+    let mut twin = TwinArena::new(sc).unwrap();
+    let mut host = HostWorld::new(sc, SensorSource::Virtual).unwrap();
     host.set_latency(latency);
-    let n = plant.robot_count();
+    let n = twin.robot_count();
     let dt = sc.spec.dt as f64;
     let mut noise = Noise::new(9);
     let mut clock = ClockOffset::default();
     let mut pipe: VecDeque<(f64, f64, Vec<Pose>)> = VecDeque::new();
     let (mut sum, mut count) = (0.0, 0usize);
     for k in 0..(16.0 / dt) as usize {
-        plant.step();
-        let t = plant.time();
-        let seen: Vec<Pose> = plant
+        twin.step();
+        let t = twin.time();
+        let seen: Vec<Pose> = twin
             .poses()
             .iter()
             .map(|p| {
@@ -116,7 +116,7 @@ fn injection_error(sc: &Scenario, latency: f32) -> f64 {
         let commands = host.tick(dt as f32).to_vec();
         if k as f64 * dt >= 1.0 {
             let arena = sc.arena_size();
-            for (p, q) in host.poses().iter().zip(plant.poses()) {
+            for (p, q) in host.poses().iter().zip(twin.poses()) {
                 // Robots pressed against a wall do not go where their commands say.
                 let inside = q.pos.x > 0.08
                     && q.pos.y > 0.08
@@ -129,7 +129,7 @@ fn injection_error(sc: &Scenario, latency: f32) -> f64 {
             }
         }
         for (i, c) in commands.into_iter().enumerate().take(n) {
-            plant.hear(Some(i), c);
+            twin.hear(Some(i), c);
         }
     }
     sum / count.max(1) as f64

@@ -4,8 +4,8 @@
 mod calibrate_common;
 
 use calibrate_common::{TwinRun, scenario};
-use colcos_bridge::calibrate::run_screen::{ScreenRunOptions, calibrate_screen};
 use colcos_bridge::calibrate::{RigCalibration, ScreenCalibration};
+use colcos_bridge::calibrate::{ScreenRunOptions, calibrate_screen};
 use colcos_bridge::twin::{CameraModel, Noise};
 use colcos_bridge::{SourceOptions, open_pose_source};
 
@@ -71,7 +71,7 @@ fn the_screen_calibration_recovers_the_camera_within_a_millimetre() {
     );
 
     // Without the parallax correction the same markers would be off by up to ~2 cm.
-    let flat = colcos_bridge::calibrate::ScreenMap {
+    let flat = colcos_bridge::geometry::ScreenMap {
         marker_height: 0.0,
         ..map
     };
@@ -102,7 +102,7 @@ fn the_screen_calibration_recovers_the_camera_within_a_millimetre() {
     std::thread::sleep(std::time::Duration::from_millis(400));
     let snapshot = source.poll().expect("poses through the calibration");
     let twin = run.stop();
-    let truth = twin.plant().poses();
+    let truth = twin.arena().poses();
     for p in snapshot.poses.iter().filter(|p| p.fresh) {
         let t = truth[p.id as usize];
         let d = (p.pose.pos - t.pos).length();

@@ -1,7 +1,7 @@
 //! The Colias serial protocol: every telemetry field at its documented offset, command frames byte
 //! for byte, and frame decoding under garbage and arbitrary splits.
 
-use colcos_bridge::colias::{
+use colcos_bridge::protocol::colias::{
     CommandDecoder, CommandPacket, HostCommand, MotionKind, TELEMETRY_LEN, Telemetry,
     TelemetryDecoder, colour_to_sim,
 };

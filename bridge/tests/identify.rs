@@ -4,10 +4,10 @@
 //! ticks; the fit must find every wheel scale within 5 %, every latency within 5 ms and every motor
 //! lag within 20 %. The arena is large (4 m) so that the robots, which no shield guards here, rarely
 //! touch a wall: on the rig the shield keeps them off. Bad input is refused with the reason.
-use colcos_bridge::colias::{CommandPacket, HostCommand};
 use colcos_bridge::identify::{Excitation, FitOptions, fit_robot, robot_series};
-use colcos_bridge::live::PoseIn;
-use colcos_bridge::live::replay::RecordedTick;
+use colcos_bridge::protocol::colias::{CommandPacket, HostCommand};
+use colcos_bridge::rig::PoseIn;
+use colcos_bridge::rig::replay::RecordedTick;
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::Scenario;

@@ -1,11 +1,11 @@
 //! The bridge's live loop driving the digital twin end to end over loopback: SwarmCon over TCP, the
 //! robots' serial protocol over UDP and over a pseudo-terminal, the displayed frames over the frame
 //! stream; and the safety stops, measured from the twin's own record of what it received.
-use colcos_bridge::colias::{BROADCAST_ID, HostCommand};
-use colcos_bridge::frames::FrameServer;
-use colcos_bridge::live::{self, LiveOptions, LiveReport, LoopCore, replay};
-use colcos_bridge::recorder::{Topic, read_log};
-use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::protocol::colias::{BROADCAST_ID, HostCommand};
+use colcos_bridge::protocol::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::rig::recorder::{Topic, read_log};
+use colcos_bridge::rig::{self, LiveOptions, LiveReport, LoopCore, replay};
+use colcos_bridge::transport::FrameServer;
 use colcos_bridge::twin::{
     ByteChannel, PtyChannel, RobotFaults, TrackerFaults, TrackerServer, Twin, UdpChannel,
 };
@@ -24,7 +24,7 @@ struct Rig {
     twin: std::thread::JoinHandle<Twin>,
     faults: Arc<Mutex<TrackerFaults>>,
     report: LiveReport,
-    log: Vec<colcos_bridge::recorder::Recorded>,
+    log: Vec<colcos_bridge::rig::recorder::Recorded>,
     bridge_stopped_at: Instant,
 }
 
@@ -72,7 +72,7 @@ fn run_rig(
         let sc = sc.clone();
         let stop = stop.clone();
         std::thread::spawn(move || {
-            live::run(&sc, source, link, Some(frames), live_opts, stop).unwrap()
+            rig::run(&sc, source, link, Some(frames), live_opts, stop).unwrap()
         })
     };
     during(&faults, &robot_faults);
@@ -80,7 +80,7 @@ fn run_rig(
     let bridge_stopped_at = Instant::now();
     let log = read_log(&std::fs::read(&log_path).unwrap());
     // The log and the report record the latencies the run ran with.
-    let meta = colcos_bridge::recorder::read_metadata(&std::fs::read(&log_path).unwrap());
+    let meta = colcos_bridge::rig::recorder::read_metadata(&std::fs::read(&log_path).unwrap());
     let rig_meta = &meta
         .iter()
         .find(|(name, _)| name == "rig")
@@ -166,7 +166,7 @@ fn case_two_drives_the_twin_over_udp() {
             .filter_map(|c| wheel_speeds(&c.packet.command))
             .any(|(l, r)| l != 0.0 || r != 0.0);
         assert!(moving, "robot {id} never got a motion command");
-        let moved = twin.plant().poses()[i].pos.distance(start_poses[i].pos);
+        let moved = twin.arena().poses()[i].pos.distance(start_poses[i].pos);
         assert!(moved > 0.02, "robot {id} moved only {moved} m");
     }
     // S(t) of eq. (9), the followers' summed distance to the leader: the robots on the twin aggregate
@@ -186,7 +186,7 @@ fn case_two_drives_the_twin_over_udp() {
     let (s0, s_sim, s_twin) = (
         s_of(&start_poses),
         s_of(sim.poses()),
-        s_of(twin.plant().poses()),
+        s_of(twin.arena().poses()),
     );
     let (r_sim, r_twin) = (s_sim / s0, s_twin / s0);
     eprintln!(
@@ -204,7 +204,7 @@ fn case_two_drives_the_twin_over_udp() {
     assert_eq!(wheel_speeds(&last.command), Some((0.0, 0.0)));
     for i in 0..5 {
         assert_eq!(
-            twin.plant().command(i),
+            twin.arena().command(i),
             colcos_sim::behaviour::WheelCommand::STOP
         );
     }
@@ -413,7 +413,7 @@ fn a_lost_robot_alone_is_stopped_in_time() {
 }
 
 /// The rig log's events, as text.
-fn events_of(log: &[colcos_bridge::recorder::Recorded]) -> Vec<String> {
+fn events_of(log: &[colcos_bridge::rig::recorder::Recorded]) -> Vec<String> {
     log.iter()
         .filter(|m| m.topic == Topic::Events)
         .map(|m| String::from_utf8_lossy(&m.data).to_string())

@@ -2,15 +2,15 @@
 //! written by scripts/onboard_fixture.py: both wheels at half the largest wheel speed, the left one
 //! slowed by the front-left bumper) and runs it on each robot's own readings; the bridge uploads the
 //! parameters, starts the policy and sends no wheel commands.
-use colcos_bridge::colias::colour_from_sim;
-use colcos_bridge::colias::{
+use colcos_bridge::onboard::{OnboardFirmware, OnboardManifest, RUNTIME_LEN, robot_params};
+use colcos_bridge::protocol::colias::colour_from_sim;
+use colcos_bridge::protocol::colias::{
     CommandPacket, FrameDecoder, HostCommand, PolicyMode, TELEMETRY_LEN, Telemetry,
 };
-use colcos_bridge::frames::FrameServer;
-use colcos_bridge::live::{self, LiveOptions, LoopCore, replay};
-use colcos_bridge::onboard::{OnboardFirmware, OnboardManifest, RUNTIME_LEN, robot_params};
-use colcos_bridge::recorder::read_log;
-use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::protocol::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::rig::recorder::read_log;
+use colcos_bridge::rig::{self, LiveOptions, LoopCore, replay};
+use colcos_bridge::transport::FrameServer;
 use colcos_bridge::twin::{FIRMWARE_TIMEOUT, TrackerServer, Twin, UdpChannel};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::behaviour::WheelCommand;
@@ -72,8 +72,8 @@ fn run(
     seconds: f64,
 ) -> (
     Twin,
-    live::LiveReport,
-    Vec<colcos_bridge::recorder::Recorded>,
+    rig::LiveReport,
+    Vec<colcos_bridge::rig::recorder::Recorded>,
 ) {
     let _turn = one_at_a_time();
     let twin_sc = scenario(&fixture());
@@ -110,7 +110,7 @@ fn run(
         log: Some(log.clone()),
         ..LiveOptions::default()
     };
-    let report = live::run(
+    let report = rig::run(
         host,
         source,
         open_robot_link(&url).unwrap(),
@@ -169,7 +169,7 @@ fn the_twins_robots_run_the_exported_policy_on_board() {
         });
         assert!(!driven, "robot {radio} got a wheel command from the host");
         // Straight along x at 0.1 m/s while the policy ran (~2.5 s less the start).
-        let moved = twin.plant().poses()[i].pos - start[i].pos;
+        let moved = twin.arena().poses()[i].pos - start[i].pos;
         assert!(
             (0.12..0.26).contains(&moved.x) && moved.y.abs() < 0.01,
             "robot {radio} moved {moved:?}"
@@ -180,7 +180,7 @@ fn the_twins_robots_run_the_exported_policy_on_board() {
     let mut payloads = Vec::new();
     for m in log
         .iter()
-        .filter(|m| m.topic == colcos_bridge::recorder::Topic::Telemetry)
+        .filter(|m| m.topic == colcos_bridge::rig::recorder::Topic::Telemetry)
     {
         decoder.feed_into(&m.data, &mut payloads);
     }
@@ -202,7 +202,7 @@ fn the_twins_robots_run_the_exported_policy_on_board() {
     // The exit stop took every robot back from its policy.
     for i in 0..3 {
         assert!(!fleet.running(i));
-        assert_eq!(twin.plant().command(i), WheelCommand::STOP);
+        assert_eq!(twin.arena().command(i), WheelCommand::STOP);
     }
     // The same poses and telemetry through a fresh loop give the same frames.
     let ticks = replay::ticks_of(&log, 3).unwrap();
@@ -234,7 +234,7 @@ fn robots_flashed_with_another_policy_are_held() {
     let (twin, _report, log) = run(&host, 1.5);
     let events: Vec<String> = log
         .iter()
-        .filter(|m| m.topic == colcos_bridge::recorder::Topic::Events)
+        .filter(|m| m.topic == colcos_bridge::rig::recorder::Topic::Events)
         .map(|m| String::from_utf8_lossy(&m.data).into_owned())
         .filter(|e| e.contains("onboard_policy_refused"))
         .collect();
@@ -244,7 +244,7 @@ fn robots_flashed_with_another_policy_are_held() {
         "{events:?}"
     );
     for (i, s) in start.iter().enumerate() {
-        let moved = twin.plant().poses()[i].pos.distance(s.pos);
+        let moved = twin.arena().poses()[i].pos.distance(s.pos);
         assert!(moved < 1e-4, "robot {i} moved {moved} m");
     }
 }
@@ -292,7 +292,7 @@ impl Bench {
             self.twin.tick();
         }
     }
-    fn status(&mut self, radio: u8) -> colcos_bridge::colias::OnboardStatus {
+    fn status(&mut self, radio: u8) -> colcos_bridge::protocol::colias::OnboardStatus {
         self.send(radio, HostCommand::RequestTelemetry(1));
         let mut buf = [0u8; 256];
         let mut out = Vec::new();
@@ -337,7 +337,7 @@ fn the_robots_firmware_obeys_stops_and_silence() {
     b.send(1, HostCommand::RunPolicy { hash: m.hash ^ 4 });
     b.steps(10);
     assert_eq!(b.status(1).mode, PolicyMode::Refused);
-    assert_eq!(b.twin.plant().command(0), WheelCommand::STOP);
+    assert_eq!(b.twin.arena().command(0), WheelCommand::STOP);
     // The right one: half the export's 0.35 m/s.
     b.send(1, HostCommand::RunPolicy { hash: m.hash });
     b.steps(5);
@@ -354,18 +354,18 @@ fn the_robots_firmware_obeys_stops_and_silence() {
     );
     b.steps(5);
     assert_eq!(b.status(1).mode, PolicyMode::Host);
-    assert_eq!(b.twin.plant().command(0), WheelCommand::STOP);
+    assert_eq!(b.twin.arena().command(0), WheelCommand::STOP);
     // Started again, then silence: stopped by the firmware within its timeout (+ a tick).
     b.send(1, HostCommand::RunPolicy { hash: m.hash });
     b.steps(3);
-    assert_ne!(b.twin.plant().command(0), WheelCommand::STOP);
-    let dt = b.twin.plant().world().dt() as f64;
+    assert_ne!(b.twin.arena().command(0), WheelCommand::STOP);
+    let dt = b.twin.arena().world().dt() as f64;
     let silent_steps = (FIRMWARE_TIMEOUT / dt).ceil() as usize + 2;
     b.steps(silent_steps);
-    assert_eq!(b.twin.plant().command(0), WheelCommand::STOP);
+    assert_eq!(b.twin.arena().command(0), WheelCommand::STOP);
     assert_eq!(b.status(1).mode, PolicyMode::Host);
     // The other robots never heard a thing.
-    assert_eq!(b.twin.plant().command(1), WheelCommand::STOP);
+    assert_eq!(b.twin.arena().command(1), WheelCommand::STOP);
 }
 
 /// A manifest that does not fit is refused naming `rig.onboard` and the field.

@@ -1,6 +1,6 @@
 //! Byte-for-byte fixtures of the position server's stream, written from the documented C formats.
 
-use colcos_bridge::swarmcon::{
+use colcos_bridge::protocol::swarmcon::{
     Calibrate, HeaderForm, SlotState, StreamParser, TrackerEvent, TrackerFrame, TrackerMessage,
     write_block,
 };

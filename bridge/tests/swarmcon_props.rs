@@ -1,7 +1,7 @@
 //! Property tests of the tracker stream parser: any byte stream, cut anywhere, never panics and gives
 //! the same result as one read; what the writer writes, the parser reads back.
 
-use colcos_bridge::swarmcon::{
+use colcos_bridge::protocol::swarmcon::{
     HeaderForm, SlotPose, StreamParser, TrackerFrame, TrackerMessage, write_block,
 };
 use proptest::prelude::*;

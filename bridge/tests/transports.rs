@@ -2,10 +2,13 @@
 //! comes back; JSON poses over UDP; replay files; the serial link over a real pseudo-terminal; the
 //! UDP robot link.
 
-use colcos_bridge::colias::{CommandDecoder, CommandPacket, HostCommand, MotionKind, Telemetry};
-use colcos_bridge::link::{AirtimeScheduler, Link, RobotLink, SerialWire, open_robot_link};
-use colcos_bridge::swarmcon::{Calibrate, FrameTransform, TrackerEvent};
-use colcos_bridge::{ConnectionState, SourceOptions, open_pose_source};
+use colcos_bridge::protocol::colias::{
+    CommandDecoder, CommandPacket, HostCommand, MotionKind, Telemetry,
+};
+use colcos_bridge::protocol::swarmcon::{Calibrate, FrameTransform, TrackerEvent};
+use colcos_bridge::transport::ConnectionState;
+use colcos_bridge::transport::{AirtimeScheduler, Link, RobotLink, SerialWire, open_robot_link};
+use colcos_bridge::{SourceOptions, open_pose_source};
 use std::io::{Read, Write};
 use std::net::{TcpListener, UdpSocket};
 use std::time::{Duration, Instant};

@@ -8,8 +8,8 @@
 //! lockstep) because both programs run in real time on whatever cores the test machine spares: the
 //! pipeline's delay jitters by some milliseconds, which smears the motors' response.
 use colcos_bridge::identify::{Excitation, FitOptions, identify};
-use colcos_bridge::live::{LiveOptions, LiveSession};
-use colcos_bridge::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::protocol::swarmcon::{FrameTransform, HeaderForm};
+use colcos_bridge::rig::{LiveOptions, LiveSession};
 use colcos_bridge::twin::{TrackerServer, Twin, UdpChannel};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::behaviour::WheelCommand;
@@ -61,7 +61,7 @@ fn the_twin_drives_its_hidden_truth_and_identification_finds_it() {
     let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
     let url = format!("udp://{}", channel.local_addr().unwrap());
     let mut twin = Twin::new(&twin_sc, tracker, Box::new(channel), None).unwrap();
-    assert!(twin.plant().world().actuation(0).is_some());
+    assert!(twin.arena().world().actuation(0).is_some());
     let stop = Arc::new(AtomicBool::new(false));
     let ts = stop.clone();
     let twin = std::thread::spawn(move || twin.run(Some(seconds + 2.0), &ts));

@@ -1,6 +1,6 @@
 //! JSON pose messages: arbitrary bytes never panic, and every valid pose survives a round trip.
 
-use colcos_bridge::udp_pose::JsonPose;
+use colcos_bridge::protocol::udp_pose::JsonPose;
 use proptest::prelude::*;
 
 proptest! {

@@ -1,7 +1,7 @@
 //! The Colias serial framing in both directions: any bytes, split anywhere, never panic, the frames
 //! found do not depend on the split, and every payload decodes and encodes back to the same bytes.
 #![no_main]
-use colcos_bridge::colias::{CommandDecoder, CommandPacket, Telemetry, TelemetryDecoder};
+use colcos_bridge::protocol::colias::{CommandDecoder, CommandPacket, Telemetry, TelemetryDecoder};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -1,7 +1,7 @@
 //! The SwarmCon tracker stream: any bytes, split anywhere, never panic, and the messages do not
 //! depend on how the stream was split; every slot converts to a pose in the simulator's frame.
 #![no_main]
-use colcos_bridge::swarmcon::{
+use colcos_bridge::protocol::swarmcon::{
     Calibrate, FrameTransform, StreamParser, TrackerMessage, parse_line,
 };
 use libfuzzer_sys::fuzz_target;

@@ -1,7 +1,7 @@
 //! The JSON pose datagrams: any bytes never panic; an accepted pose is finite, in range, and its
 //! JSON parses back to the same pose.
 #![no_main]
-use colcos_bridge::udp_pose::JsonPose;
+use colcos_bridge::protocol::udp_pose::JsonPose;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

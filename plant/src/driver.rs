@@ -2,11 +2,11 @@
 //! recorded rig run fed tick by tick; and the twin a `plant="twin"` starts in this process when it is
 //! given no addresses.
 use crate::PlantError;
-use colcos_bridge::colias::LegacyDrive;
-use colcos_bridge::host::Host;
-use colcos_bridge::live::replay::{RecordedTick, feed};
-use colcos_bridge::live::{LiveSession, LoopCore};
-use colcos_bridge::swarmcon::HeaderForm;
+use colcos_bridge::protocol::colias::LegacyDrive;
+use colcos_bridge::protocol::swarmcon::HeaderForm;
+use colcos_bridge::rig::HostWorld;
+use colcos_bridge::rig::replay::{RecordedTick, feed};
+use colcos_bridge::rig::{LiveSession, LoopCore};
 use colcos_bridge::twin::{TrackerServer, Twin, UdpChannel};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;
@@ -55,10 +55,10 @@ impl Driver {
             Driver::Replay { core, .. } | Driver::Closed { core } => core,
         }
     }
-    pub fn host(&self) -> &Host {
+    pub fn host(&self) -> &HostWorld {
         self.core().host()
     }
-    pub fn host_mut(&mut self) -> &mut Host {
+    pub fn host_mut(&mut self) -> &mut HostWorld {
         match self {
             Driver::Live { session, .. } => session.core_mut().host_mut(),
             Driver::Replay { core, .. } | Driver::Closed { core } => core.host_mut(),
@@ -238,7 +238,7 @@ impl Driver {
 /// `episode_end` events: a reset's go-to drive lies between two episodes), or, in a log without
 /// them, one episode from the first tick with poses to the end.
 pub(crate) fn episode_ranges(
-    log: &[colcos_bridge::recorder::Recorded],
+    log: &[colcos_bridge::rig::recorder::Recorded],
     ticks: &[RecordedTick],
 ) -> Vec<(usize, usize)> {
     let at = |tick: u64| {
@@ -248,7 +248,7 @@ pub(crate) fn episode_ranges(
             .unwrap_or(ticks.len())
     };
     let events: Vec<(bool, usize)> = (log.iter())
-        .filter(|m| m.topic == colcos_bridge::recorder::Topic::Events)
+        .filter(|m| m.topic == colcos_bridge::rig::recorder::Topic::Events)
         .filter_map(|m| serde_json::from_slice::<serde_json::Value>(&m.data).ok())
         .filter_map(|v| {
             let start = match v["kind"].as_str()? {

@@ -3,10 +3,10 @@ use crate::calibration_gate;
 use crate::driver::{self, Driver, TwinThread};
 use crate::{GoTo, PlantError, PlantKind, PlantOptions};
 use colcos_bridge::calibrate::RigCalibration;
-use colcos_bridge::colias::LegacyDrive;
-use colcos_bridge::frames::FrameServer;
-use colcos_bridge::host::Host;
-use colcos_bridge::live::{LiveOptions, LiveSession, LoopCore, replay};
+use colcos_bridge::protocol::colias::LegacyDrive;
+use colcos_bridge::rig::HostWorld;
+use colcos_bridge::rig::{LiveOptions, LiveSession, LoopCore, replay};
+use colcos_bridge::transport::FrameServer;
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_env::task::registry;
 use colcos_env::world_output::render_world;
@@ -57,7 +57,7 @@ pub struct LiveEnv {
     /// The outputs of one world (`[1, N, ...]`), as the batch's.
     out: Outputs,
     /// The live loop's report as it was when the plant was closed.
-    closed: Option<Option<colcos_bridge::live::LiveReport>>,
+    closed: Option<Option<colcos_bridge::rig::LiveReport>>,
 }
 
 impl LiveEnv {
@@ -127,7 +127,7 @@ impl LiveEnv {
             let bytes = std::fs::read(path)
                 .map_err(|e| PlantError::option("replay", format!("{}: {e}", path.display())))?;
             refuse_another_scenario(&bytes, path, scenario)?;
-            let log = colcos_bridge::recorder::read_log(&bytes);
+            let log = colcos_bridge::rig::recorder::read_log(&bytes);
             let ticks = replay::ticks_of(&log, scenario.robot_count())?;
             let episodes = driver::episode_ranges(&log, &ticks);
             return Ok(Driver::Replay {
@@ -232,7 +232,7 @@ impl LiveEnv {
         &self.scenario
     }
     /// The host: the tracked poses as used, the fields, the robots' observations.
-    pub fn host(&self) -> &Host {
+    pub fn host(&self) -> &HostWorld {
         self.driver.host()
     }
     pub fn episode(&self) -> u64 {
@@ -450,7 +450,7 @@ impl LiveEnv {
 
     /// The live loop's measurements so far (ticks, overruns, shield, stops, `shutdown` for each
     /// stop on closing or asked for); None for a replay.
-    pub fn live_report(&self) -> Option<colcos_bridge::live::LiveReport> {
+    pub fn live_report(&self) -> Option<colcos_bridge::rig::LiveReport> {
         if let Some(r) = &self.closed {
             return r.clone();
         }
@@ -472,7 +472,7 @@ fn refuse_another_scenario(
     path: &std::path::Path,
     scenario: &Scenario,
 ) -> Result<(), PlantError> {
-    let rig = colcos_bridge::recorder::read_metadata(bytes)
+    let rig = colcos_bridge::rig::recorder::read_metadata(bytes)
         .into_iter()
         .find(|(name, _)| name == "rig");
     let Some((_, meta)) = rig else {

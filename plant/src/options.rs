@@ -1,6 +1,6 @@
 //! What a plant is asked for ([`PlantKind`], [`PlantOptions`]) and what can go wrong ([`PlantError`]).
 use crate::TwinScenario;
-use colcos_bridge::live::replay;
+use colcos_bridge::rig::replay;
 use colcos_env::EnvError;
 use std::path::PathBuf;
 

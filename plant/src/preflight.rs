@@ -6,7 +6,7 @@
 use crate::PlantError;
 use crate::driver::TwinThread;
 use colcos_bridge::calibrate::RigCalibration;
-use colcos_bridge::live::{LiveOptions, LiveSession};
+use colcos_bridge::rig::{LiveOptions, LiveSession};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;

@@ -7,7 +7,8 @@
 //! so the file keeps the matrix and reports the gain as its mean diagonal per ms.
 use super::CalibrationError;
 /// The file format and the fitted model live in the simulator, which reads the screen through them.
-pub use colcos_sim::sensors::{ColourCalibration, RobotColour, SensorFit};
+pub use colcos_sim::sensors::ColourCalibration;
+pub(crate) use colcos_sim::sensors::{RobotColour, SensorFit};
 use nalgebra::{Matrix4, Vector4};
 use serde::{Deserialize, Serialize};
 
@@ -16,7 +17,7 @@ const SATURATED: f64 = 65_535.0;
 
 /// Mean raw counts (r, g, b) of one sensor under mean screen levels (r, g, b, 0..=255).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ColourSample {
+pub(crate) struct ColourSample {
     pub levels: [f64; 3],
     pub counts: [f64; 3],
 }
@@ -47,7 +48,7 @@ fn fit_channel(samples: &[ColourSample], c: usize, gamma: f64) -> Option<([f64; 
 
 /// Fits one sensor to its samples (ramps of each primary and black, at least): the gamma by a
 /// golden-section search over [1, 4], the rest by linear least squares at each gamma.
-pub fn fit_sensor(
+pub(crate) fn fit_sensor(
     samples: &[ColourSample],
     integration_ms: f64,
 ) -> Result<SensorFit, CalibrationError> {
@@ -110,7 +111,7 @@ pub fn fit_sensor(
 
 /// The screen levels shown for a colour calibration: black, then ramps of red, green and blue in
 /// `steps` steps each (these are fitted), then mixed colours (held out, to check the fit).
-pub fn ramp_levels(steps: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+pub(crate) fn ramp_levels(steps: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let steps = steps.max(2);
     let mut fitted = vec![[0.0; 3]];
     for k in 0..3 {

@@ -2,18 +2,18 @@
 //!
 //! - **capture to receipt**: each tracker block's frame time (the camera's capture, on the
 //!   tracker's clock) against the moment it arrived here. With the clocks in step (one machine, or
-//!   NTP) that difference is the latency; [`crate::clock::ClockOffset`] gives the fastest delivery,
+//!   NTP) that difference is the latency; [`crate::transport::ClockOffset`] gives the fastest delivery,
 //!   which is what the live loop's pose ages leave out.
 //! - **render to photon**: a fiducial moving at a known speed on the screen; where the tracker
 //!   sees it lags where it was drawn by `offset / speed` seconds.
 //! - **command to motion seen**: a parked robot sent a forward command; when its tracked position
 //!   starts to move, less the time the motor model needs to cover the detection threshold.
-use crate::clock::ClockOffset;
+use crate::transport::ClockOffset;
 use serde::{Deserialize, Serialize};
 
 /// A distribution of delays, s.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Stage {
+pub struct StageDelays {
     pub median: f64,
     pub mean: f64,
     /// 5th and 95th percentiles.
@@ -24,9 +24,9 @@ pub struct Stage {
     pub samples: usize,
 }
 
-impl Stage {
+impl StageDelays {
     /// `None` without samples.
-    pub fn of(values: &[f64]) -> Option<Stage> {
+    pub fn of(values: &[f64]) -> Option<StageDelays> {
         let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
         if v.is_empty() {
             return None;
@@ -36,7 +36,7 @@ impl Stage {
         let at = |q: f64| v[((q * (n - 1) as f64).round() as usize).min(n - 1)];
         let mean = v.iter().sum::<f64>() / n as f64;
         let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n as f64;
-        Some(Stage {
+        Some(StageDelays {
             median: at(0.5),
             mean,
             p5: at(0.05),
@@ -49,13 +49,13 @@ impl Stage {
 
 /// A tracker block: its frame time (tracker clock, epoch s) and when it arrived (host epoch s).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BlockTiming {
+pub(crate) struct BlockTiming {
     pub frame_t: f64,
     pub receipt: f64,
 }
 
 /// Capture to receipt, and the clock offset estimate (`receipt - frame_t` at its fastest).
-pub fn capture_to_receipt(blocks: &[BlockTiming]) -> Option<(Stage, f64)> {
+pub(crate) fn capture_to_receipt(blocks: &[BlockTiming]) -> Option<(StageDelays, f64)> {
     let mut clock = ClockOffset::default();
     let mut delays = Vec::with_capacity(blocks.len());
     // Blocks that repeat a frame (the server writes every ~30 ms whether or not a new frame came)
@@ -69,13 +69,13 @@ pub fn capture_to_receipt(blocks: &[BlockTiming]) -> Option<(Stage, f64)> {
         clock.observe(b.frame_t, b.receipt);
         delays.push(b.receipt - b.frame_t);
     }
-    Stage::of(&delays).map(|s| (s, clock.offset()))
+    StageDelays::of(&delays).map(|s| (s, clock.offset()))
 }
 
 /// A sighting of the moving fiducial: when it arrived (host epoch s), its capture time (tracker
 /// clock, epoch s) and its position along the motion (m, our frame).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MarkerSighting {
+pub(crate) struct MarkerSighting {
     pub receipt: f64,
     pub capture: f64,
     pub position: f64,
@@ -83,12 +83,12 @@ pub struct MarkerSighting {
 
 /// The moving fiducial: drawn at `x0 + speed * (t - t0)` (host epoch s). Returns (render to
 /// receipt, render to capture): the second is render to photon when the clocks are in step.
-pub fn moving_marker(
+pub(crate) fn moving_marker(
     sightings: &[MarkerSighting],
     t0: f64,
     x0: f64,
     speed: f64,
-) -> Option<(Stage, Stage)> {
+) -> Option<(StageDelays, StageDelays)> {
     if speed.abs() < 1e-6 {
         return None;
     }
@@ -104,12 +104,12 @@ pub fn moving_marker(
         total.push(s.receipt - drawn);
         photon.push(s.capture - drawn);
     }
-    Some((Stage::of(&total)?, Stage::of(&photon)?))
+    Some((StageDelays::of(&total)?, StageDelays::of(&photon)?))
 }
 
 /// Time a robot starting from rest takes to cover `distance` at `speed` behind a first-order motor
 /// of time constant `lag`: `speed * (t - lag * (1 - exp(-t / lag))) = distance`.
-pub fn time_to_cover(distance: f64, speed: f64, lag: f64) -> f64 {
+pub(crate) fn time_to_cover(distance: f64, speed: f64, lag: f64) -> f64 {
     let covered = |t: f64| {
         speed
             * if lag > 0.0 {
@@ -133,7 +133,7 @@ pub fn time_to_cover(distance: f64, speed: f64, lag: f64) -> f64 {
 /// Command to motion: the command went out at `sent` (host epoch s); `track` holds (capture time,
 /// distance from the start, m). The first capture beyond `threshold`, less the motor model's time to
 /// cover it, is when the robot started.
-pub fn command_to_motion(
+pub(crate) fn command_to_motion(
     sent: f64,
     track: &[(f64, f64)],
     threshold: f64,
@@ -148,13 +148,13 @@ pub fn command_to_motion(
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LatencyReport {
     pub date: String,
-    pub capture_to_receipt: Option<Stage>,
+    pub capture_to_receipt: Option<StageDelays>,
     /// `receipt - frame time` at its fastest, s: the tracker clock's offset plus the fastest
     /// delivery (0.04 for a 40 ms tracker on this machine's clock).
     pub clock_offset: Option<f64>,
-    pub render_to_receipt: Option<Stage>,
-    pub render_to_photon: Option<Stage>,
-    pub command_to_motion: Option<Stage>,
+    pub render_to_receipt: Option<StageDelays>,
+    pub render_to_photon: Option<StageDelays>,
+    pub command_to_motion: Option<StageDelays>,
     /// For the scenario's `[tracker] latency` (the simulator's model): capture to receipt, median.
     pub tracker_latency: Option<f64>,
     /// For `[rig] latency` (the compensation): what the live loop's pose ages leave out (the fastest

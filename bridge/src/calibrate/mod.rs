@@ -1,21 +1,27 @@
 //! Sim-to-real calibration of the rig, proved on the digital twin whose true values are known:
-//! the screen against the camera ([`screen`]: a homography with the markers' parallax, the
-//! heading's sign and offset), the latency of each stage ([`latency`]), and each robot's colour
-//! sensors ([`colour`]). [`session`] runs them over the rig's wire formats; each writes a file that
-//! the scenario's `[rig]` section names and the bridge loads ([`RigCalibration`]).
-pub mod colour;
-pub mod homography;
-pub mod latency;
-pub mod run_colour;
-pub mod run_latency;
-pub mod run_screen;
-pub mod screen;
-pub mod screen_map;
-pub mod session;
+//! the screen against the camera ([`calibrate_screen`]: a homography with the markers' parallax, the
+//! heading's sign and offset), the latency of each stage ([`calibrate_latency`]), and each robot's
+//! colour sensors ([`calibrate_colour`]). Each runs over the rig's wire formats through a
+//! [`CalibrationRig`] and writes a file that the scenario's `[rig]` section names and the bridge
+//! loads ([`RigCalibration`]).
+mod colour;
+mod latency;
+mod run_colour;
+mod run_latency;
+mod run_screen;
+mod screen;
+mod session;
 
 pub use colour::ColourCalibration;
-pub use screen::ScreenCalibration;
-pub use screen_map::ScreenMap;
+pub use latency::{LatencyReport, StageDelays};
+pub use run_colour::{ColourRunOptions, calibrate_colour};
+pub use run_latency::{LatencyRunOptions, calibrate_latency};
+pub use run_screen::{ScreenRunOptions, calibrate_screen};
+pub use screen::{FiducialSighting, ScreenCalibration};
+// The twin's camera tests show the same fiducials the screen calibration does.
+#[cfg(test)]
+pub(crate) use screen::render_fiducials;
+pub use session::{CalibrationRig, RawTracker};
 
 use colcos_sim::scenario::Scenario;
 use std::path::Path;
@@ -114,8 +120,11 @@ impl RigCalibration {
     }
 
     /// The tracker-to-simulator conversion for `scenario`, with the screen calibration if any.
-    pub fn frame_transform(&self, scenario: &Scenario) -> crate::swarmcon::FrameTransform {
-        let t = crate::swarmcon::FrameTransform::new(scenario.arena_size().y as f64);
+    pub fn frame_transform(
+        &self,
+        scenario: &Scenario,
+    ) -> crate::protocol::swarmcon::FrameTransform {
+        let t = crate::protocol::swarmcon::FrameTransform::new(scenario.arena_size().y as f64);
         match &self.screen {
             Some(cal) => t.with_screen(cal.map()),
             None => t,
@@ -124,7 +133,7 @@ impl RigCalibration {
 }
 
 /// Now, UTC, as `YYYY-MM-DDTHH:MM:SSZ`.
-pub fn utc_now() -> String {
+pub(crate) fn utc_now() -> String {
     let secs = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_secs() as i64)

@@ -5,8 +5,8 @@ use super::CalibrationError;
 use super::colour::{
     ColourCalibration, ColourSample, RobotColour, SensorFit, fit_sensor, ramp_levels,
 };
-use super::session::Rig;
-use crate::colias::{HostCommand, colour_to_sim};
+use super::session::CalibrationRig;
+use crate::protocol::colias::{HostCommand, colour_to_sim};
 use colcos_sim::scenario::Scenario;
 use image::{Rgb, RgbImage};
 use std::time::{Duration, Instant};
@@ -36,7 +36,7 @@ impl Default for ColourRunOptions {
 
 /// Each robot's raw counts (simulator sensor order) at `levels`, averaged over `readings`.
 fn read_level(
-    rig: &mut Rig,
+    rig: &mut CalibrationRig,
     radio: &[u8],
     levels: [f64; 3],
     opts: &ColourRunOptions,
@@ -51,7 +51,8 @@ fn read_level(
     rig.show(&frame);
     let mut sums = vec![[[0.0f64; 3]; 4]; radio.len()];
     let mut got = vec![0usize; radio.len()];
-    let link_err = |e: crate::link::LinkError| CalibrationError::Run(format!("robot link: {e}"));
+    let link_err =
+        |e: crate::transport::LinkError| CalibrationError::Run(format!("robot link: {e}"));
     for (i, &id) in radio.iter().enumerate() {
         let link = rig.link.as_mut().ok_or_else(|| {
             CalibrationError::Run("the colour calibration reads robots: give --robots".into())
@@ -98,7 +99,7 @@ fn read_level(
 
 /// Runs the ramps and fits every robot of `scenario` (all of them parked on the screen).
 pub fn calibrate_colour(
-    rig: &mut Rig,
+    rig: &mut CalibrationRig,
     scenario: &Scenario,
     opts: &ColourRunOptions,
 ) -> Result<ColourCalibration, CalibrationError> {

@@ -1,13 +1,13 @@
 //! `colcos calibrate latency`: listens to the tracker (capture to receipt), moves a fiducial across
 //! the screen at a known speed (render to photon), and starts a parked robot (command to motion).
 use super::latency::{
-    BlockTiming, LatencyReport, MarkerSighting, Stage, capture_to_receipt, command_to_motion,
+    BlockTiming, LatencyReport, MarkerSighting, StageDelays, capture_to_receipt, command_to_motion,
     moving_marker,
 };
 use super::screen::render_fiducials;
-use super::session::{Rig, fiducials_in, fresh_slot};
+use super::session::{CalibrationRig, fiducials_in, fresh_slot};
 use super::{CalibrationError, utc_now};
-use crate::swarmcon::FrameTransform;
+use crate::protocol::swarmcon::FrameTransform;
 use colcos_sim::scenario::Scenario;
 use std::time::{Duration, Instant};
 
@@ -44,7 +44,7 @@ impl Default for LatencyRunOptions {
 /// Every stage `opts` asks for; `transform` converts tracker coordinates (the bridge's, with the
 /// screen calibration if there is one).
 pub fn calibrate_latency(
-    rig: &mut Rig,
+    rig: &mut CalibrationRig,
     scenario: &Scenario,
     transform: &FrameTransform,
     opts: &LatencyRunOptions,
@@ -101,11 +101,11 @@ pub fn calibrate_latency(
 
 /// A fiducial moving along x at mid-height; the tracker's sightings against where it was drawn.
 fn run_marker(
-    rig: &mut Rig,
+    rig: &mut CalibrationRig,
     scenario: &Scenario,
     transform: &FrameTransform,
     opts: &LatencyRunOptions,
-) -> Result<(Stage, Stage), CalibrationError> {
+) -> Result<(StageDelays, StageDelays), CalibrationError> {
     let s = &scenario.spec.screen;
     let size = [s.size[0] as f64, s.size[1] as f64];
     let resolution = s.resolution;
@@ -148,9 +148,9 @@ fn run_marker(
         }
     }
     let start = Instant::now();
-    let t0 = crate::clock::epoch_s();
+    let t0 = crate::transport::epoch_s();
     let mut sightings = Vec::new();
-    let mut collect = |rig: &mut Rig| {
+    let mut collect = |rig: &mut CalibrationRig| {
         for (receipt, b) in rig.tracker.take() {
             if let [f] = fiducials_in(&b)[..] {
                 let (x, _, _) = transform.to_sim_f64(f[0], f[1], 0.0);
@@ -166,7 +166,7 @@ fn run_marker(
     };
     while start.elapsed().as_secs_f64() < opts.marker_seconds {
         // Drawn where it is at the moment of showing, on this machine's clock.
-        let x = x0 + opts.marker_speed * (crate::clock::epoch_s() - t0);
+        let x = x0 + opts.marker_speed * (crate::transport::epoch_s() - t0);
         rig.show(&render_fiducials(
             &[to_px(x)],
             radius_px,
@@ -189,19 +189,19 @@ fn run_marker(
 
 /// Starts robot `robot` from rest a few times (forward, back, ...) and times its first movement.
 fn run_motion(
-    rig: &mut Rig,
+    rig: &mut CalibrationRig,
     scenario: &Scenario,
     transform: &FrameTransform,
     robot: usize,
     opts: &LatencyRunOptions,
-) -> Result<Stage, CalibrationError> {
+) -> Result<StageDelays, CalibrationError> {
     let spec = &scenario.spec.rig;
     let id = spec.tracker_id(robot);
     let radio = spec
         .radio_id(robot)
         .ok_or_else(|| CalibrationError::Run(format!("robot {robot} has no radio address")))?;
     let lag = scenario.spec.robot.motor_lag as f64;
-    let pos = |b: &crate::swarmcon::TrackerFrame| {
+    let pos = |b: &crate::protocol::swarmcon::TrackerFrame| {
         fresh_slot(b, id).map(|(x, y, yaw)| {
             let (x, y, _) = transform.to_sim_f64(x, y, yaw);
             (b.t_us as f64 * 1e-6, x, y)
@@ -233,7 +233,7 @@ fn run_motion(
         } else {
             -opts.motion_speed
         };
-        let sent = crate::clock::epoch_s();
+        let sent = crate::transport::epoch_s();
         let mut blocks = Vec::new();
         rig.drive(radio, speed, speed, 0.5, &mut blocks)?;
         let track: Vec<_> = blocks
@@ -248,7 +248,7 @@ fn run_motion(
         delays.push(d);
     }
     rig.stop_all()?;
-    Ok(Stage::of(&delays).unwrap_or_default())
+    Ok(StageDelays::of(&delays).unwrap_or_default())
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@ use super::screen::{
     FiducialSighting, ScreenCalibration, ScreenFitOptions, fiducial_layout, fit_heading,
     fit_screen, render_fiducials,
 };
-use super::session::{Rig, fiducials_in, fresh_slot};
+use super::session::{CalibrationRig, fiducials_in, fresh_slot};
 use colcos_sim::scenario::Scenario;
 use image::RgbImage;
 use std::time::{Duration, Instant};
@@ -51,7 +51,7 @@ impl Default for ScreenRunOptions {
 /// Waits for tracker frames in which `want(fiducials)` holds, re-showing `frame` every 100 ms;
 /// returns the fiducials of up to `count` distinct such frames.
 fn wait_frames(
-    rig: &mut Rig,
+    rig: &mut CalibrationRig,
     frame: &RgbImage,
     count: usize,
     timeout: f64,
@@ -81,8 +81,8 @@ fn wait_frames(
 }
 
 /// Shows every fiducial in turn and reads where the tracker sees it.
-pub fn sight_fiducials(
-    rig: &mut Rig,
+pub(crate) fn sight_fiducials(
+    rig: &mut CalibrationRig,
     scenario: &Scenario,
     opts: &ScreenRunOptions,
 ) -> Result<Vec<FiducialSighting>, CalibrationError> {
@@ -128,7 +128,7 @@ pub fn sight_fiducials(
 
 /// The whole screen calibration: fiducials, the fit, then the heading if a robot is named.
 pub fn calibrate_screen(
-    rig: &mut Rig,
+    rig: &mut CalibrationRig,
     scenario: &Scenario,
     opts: &ScreenRunOptions,
 ) -> Result<(ScreenCalibration, Vec<FiducialSighting>), CalibrationError> {
@@ -156,7 +156,7 @@ pub fn calibrate_screen(
 /// Drives robot `robot` straight, turns it a quarter turn in place, drives it straight again, and
 /// fits the heading to its track.
 fn drive_for_heading(
-    rig: &mut Rig,
+    rig: &mut CalibrationRig,
     scenario: &Scenario,
     cal: &ScreenCalibration,
     robot: usize,

@@ -1,9 +1,9 @@
 //! Screen <-> camera calibration: fiducials shown at known pixels, where the tracker saw them, a
 //! robust homography fit, the parallax of the markers' height, the heading's sign and offset from a
 //! robot driven straight; stored in a file the bridge loads.
-use super::homography::{Homography, fit_ransac, residual};
-use super::screen_map::{ScreenMap, wrap_pi};
 use super::{CalibrationError, utc_now};
+use crate::geometry::{Homography, fit_ransac, residual};
+use crate::geometry::{ScreenMap, wrap_pi};
 use image::{Rgb, RgbImage};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -134,7 +134,7 @@ impl ScreenCalibration {
 
 /// Where the fiducials go, screen pixels (centres): the four SwarmCon calibration corners inset by
 /// the robot radius, then a `grid` (columns, rows) over the same inset rectangle.
-pub fn fiducial_layout(
+pub(crate) fn fiducial_layout(
     resolution: [u32; 2],
     size: [f64; 2],
     inset: f64,
@@ -157,7 +157,7 @@ pub fn fiducial_layout(
 
 /// A black frame `width` x `height` px of a `resolution` panel with a white disc of `radius_px`
 /// screen pixels at each of `centres` (screen pixels).
-pub fn render_fiducials(
+pub(crate) fn render_fiducials(
     centres: &[[f64; 2]],
     radius_px: f64,
     resolution: [u32; 2],
@@ -197,7 +197,7 @@ pub struct FiducialSighting {
 
 /// What the fit needs besides the sightings.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ScreenFitOptions {
+pub(crate) struct ScreenFitOptions {
     pub resolution: [u32; 2],
     pub size: [f64; 2],
     /// Residuals above this, mm on the screen, mark a sighting as an outlier.
@@ -211,7 +211,7 @@ pub struct ScreenFitOptions {
 /// The homography from the sightings (RANSAC, then a least-squares refit on the inliers), with its
 /// reprojection error in mm; the heading is left at the plain conversion (sign 1, offset 0) until
 /// [`fit_heading`] sets it.
-pub fn fit_screen(
+pub(crate) fn fit_screen(
     sightings: &[FiducialSighting],
     opts: &ScreenFitOptions,
 ) -> Result<ScreenCalibration, CalibrationError> {
@@ -264,7 +264,7 @@ pub fn fit_screen(
 /// a turn in place, straight again: one direction cannot tell the sign): `track` holds its tracker
 /// readings in order (x, y, yaw_deg as on the wire); the direction of motion, through `map`, is the
 /// robot's heading wherever the yaw holds still. Returns (sign, offset rad, rms rad).
-pub fn fit_heading(
+pub(crate) fn fit_heading(
     map: &ScreenMap,
     track: &[(f64, f64, f64)],
 ) -> Result<(f64, f64, f64), CalibrationError> {

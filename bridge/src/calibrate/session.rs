@@ -2,10 +2,10 @@
 //! unidentified `-01` slots are the fiducials), patterns shown through the frame stream (the
 //! display), and the robots driven and asked for telemetry over their link.
 use super::CalibrationError;
-use crate::colias::{BROADCAST_ID, CommandPacket, HostCommand};
-use crate::frames::FrameServer;
-use crate::link::RobotLink;
-use crate::swarmcon::{SlotState, StreamParser, TrackerFrame, TrackerMessage};
+use crate::protocol::colias::{BROADCAST_ID, CommandPacket, HostCommand};
+use crate::protocol::swarmcon::{SlotState, StreamParser, TrackerFrame, TrackerMessage};
+use crate::transport::FrameServer;
+use crate::transport::RobotLink;
 use image::RgbImage;
 use std::io::Read;
 use std::net::{TcpStream, ToSocketAddrs};
@@ -47,7 +47,7 @@ impl RawTracker {
                     match stream.read(&mut buf) {
                         Ok(0) => break,
                         Ok(n) => {
-                            let receipt = crate::clock::epoch_s();
+                            let receipt = crate::transport::epoch_s();
                             parser.feed_into(&buf[..n], &mut out);
                             if let Ok(mut b) = b.lock() {
                                 for m in out.drain(..) {
@@ -88,7 +88,7 @@ impl Drop for RawTracker {
 }
 
 /// The unidentified (`-01`) slots of a block, seen in its frame: fiducials.
-pub fn fiducials_in(frame: &TrackerFrame) -> Vec<[f64; 2]> {
+pub(crate) fn fiducials_in(frame: &TrackerFrame) -> Vec<[f64; 2]> {
     frame
         .robots
         .iter()
@@ -98,7 +98,7 @@ pub fn fiducials_in(frame: &TrackerFrame) -> Vec<[f64; 2]> {
 }
 
 /// Robot `id`'s slot in a block when it was seen in that frame: (x, y, yaw_deg).
-pub fn fresh_slot(frame: &TrackerFrame, id: i32) -> Option<(f64, f64, f64)> {
+pub(crate) fn fresh_slot(frame: &TrackerFrame, id: i32) -> Option<(f64, f64, f64)> {
     frame
         .robots
         .iter()
@@ -108,16 +108,20 @@ pub fn fresh_slot(frame: &TrackerFrame, id: i32) -> Option<(f64, f64, f64)> {
 
 /// What a calibration talks to: the tracker, the display's frame stream, and (for the steps that
 /// drive or read robots) the radio link.
-pub struct Rig {
+pub struct CalibrationRig {
     pub tracker: RawTracker,
     pub frames: FrameServer,
     pub link: Option<Box<dyn RobotLink>>,
     start: Instant,
 }
 
-impl Rig {
-    pub fn new(tracker: RawTracker, frames: FrameServer, link: Option<Box<dyn RobotLink>>) -> Rig {
-        Rig {
+impl CalibrationRig {
+    pub fn new(
+        tracker: RawTracker,
+        frames: FrameServer,
+        link: Option<Box<dyn RobotLink>>,
+    ) -> CalibrationRig {
+        CalibrationRig {
             tracker,
             frames,
             link,
@@ -202,7 +206,7 @@ impl Rig {
     }
 }
 
-impl Drop for Rig {
+impl Drop for CalibrationRig {
     fn drop(&mut self) {
         if self.link.is_some() {
             let _ = self.stop_all();

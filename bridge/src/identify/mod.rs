@@ -17,8 +17,8 @@ pub use excite::Excitation;
 pub use fit::{FitOptions, Param, RobotFit, fit_robot};
 pub use series::{RobotSeries, SeriesError, robot_series};
 
-use crate::live::replay;
-use crate::recorder::{read_log, read_metadata};
+use crate::rig::recorder::{read_log, read_metadata};
+use crate::rig::replay;
 use colcos_sim::scenario::Scenario;
 
 /// What identification found in one log.

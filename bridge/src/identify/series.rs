@@ -2,8 +2,8 @@
 //! command frames on the wire) and the poses the tracker delivered, stamped with their capture time
 //! (the tick's time less the pose's age), so that the tracker's latency is not mistaken for the
 //! robot's.
-use crate::colias::{CommandDecoder, CommandPacket, HostCommand};
-use crate::live::replay::RecordedTick;
+use crate::protocol::colias::{CommandDecoder, CommandPacket, HostCommand};
+use crate::rig::replay::RecordedTick;
 use colcos_sim::scenario::{BROADCAST_ID, Scenario};
 
 /// One robot's commands and poses.

@@ -2,7 +2,7 @@
 //! block, takes `PWP` and `PRN`, runs the policy on its own readings every control tick while it is
 //! on, and goes back to the host's commands on any motion command or when its link falls silent.
 use super::OnboardFirmware;
-use crate::colias::{HostCommand, OnboardStatus, PolicyMode};
+use crate::protocol::colias::{HostCommand, OnboardStatus, PolicyMode};
 use colcos_sim::behaviour::WheelCommand;
 
 struct Robot {

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 const MAX_MANIFEST_BYTES: u64 = 1 << 20;
 
 /// The format this bridge reads.
-pub const FORMAT: &str = "colcos-onboard-policy/1";
+pub(crate) const FORMAT: &str = "colcos-onboard-policy/1";
 
 /// The encoding the policy was exported with (the simulator's sensor model and wheel limit).
 #[derive(Clone, Debug, PartialEq, Deserialize)]

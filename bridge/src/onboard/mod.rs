@@ -12,25 +12,26 @@ mod upload;
 pub use firmware::OnboardFirmware;
 pub use fleet::OnboardFleet;
 pub use manifest::{ManifestEncoding, OnboardManifest};
-pub use upload::{robot_params, upload_packets};
+pub use upload::robot_params;
+pub(crate) use upload::upload_packets;
 
 /// f32 values in the runtime parameter block (`<PREFIX>_N_RUNTIME`).
 pub const RUNTIME_LEN: usize = 59;
 /// Index of the largest wheel speed, m/s.
-pub const P_MAX_SPEED: usize = 0;
+pub(crate) const P_MAX_SPEED: usize = 0;
 /// Index of its reciprocal.
-pub const P_INV_MAX_SPEED: usize = 1;
+pub(crate) const P_INV_MAX_SPEED: usize = 1;
 /// Index of the IR bumpers' span (counts, emitter on minus off, at contact).
-pub const P_BUMPER_SPAN: usize = 2;
+pub(crate) const P_BUMPER_SPAN: usize = 2;
 /// Values per colour sensor: dark R, G, B; gain x integration; 1 / gamma; inverse crosstalk (9).
-pub const SENSOR_BLOCK: usize = 14;
+pub(crate) const SENSOR_BLOCK: usize = 14;
 
 /// First index of colour sensor `w`'s block (telemetry order: front, back, left, right).
-pub const fn sensor_offset(w: usize) -> usize {
+pub(crate) const fn sensor_offset(w: usize) -> usize {
     3 + SENSOR_BLOCK * w
 }
 
 /// Whether index `i` holds a scale or a span (which must stay > 0), as the C's check.
-pub fn positive_slot(i: usize) -> bool {
+pub(crate) fn positive_slot(i: usize) -> bool {
     i <= P_BUMPER_SPAN || matches!((i - 3) % SENSOR_BLOCK, 3 | 4)
 }

@@ -2,7 +2,7 @@
 use super::{
     OnboardManifest, P_INV_MAX_SPEED, P_MAX_SPEED, RUNTIME_LEN, SENSOR_BLOCK, sensor_offset,
 };
-use crate::colias::{CommandPacket, HostCommand, TELEMETRY_TO_SIM};
+use crate::protocol::colias::{CommandPacket, HostCommand, TELEMETRY_TO_SIM};
 use colcos_sim::sensors::{ColourCalibration, invert3};
 
 /// Robot `radio`'s parameters: the manifest's defaults; `max_wheel_speed` (m/s: the rig's limit, which
@@ -43,7 +43,7 @@ pub fn robot_params(
 }
 
 /// `params` as `PWP` frames of five values each, for robot `radio`.
-pub fn upload_packets(radio: u8, t_ms: u32, params: &[f32]) -> Vec<CommandPacket> {
+pub(crate) fn upload_packets(radio: u8, t_ms: u32, params: &[f32]) -> Vec<CommandPacket> {
     params
         .chunks(5)
         .enumerate()

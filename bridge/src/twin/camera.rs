@@ -2,7 +2,7 @@
 //! the screen, so that the screen-to-image map is a true homography and a marker on top of a robot
 //! shows the parallax a real one does; pixel noise and the odd wild detection; and the tracker's
 //! detection of calibration fiducials (white discs on a black frame) in the frames the bridge shows.
-use crate::calibrate::homography::Homography;
+use crate::geometry::Homography;
 use image::RgbImage;
 
 /// A camera looking down at the screen. Our frame: x right, y up, z up from the screen, m.
@@ -90,7 +90,7 @@ impl CameraModel {
             from.push(px);
             to.push(self.project(m)?);
         }
-        crate::calibrate::homography::fit_dlt(&from, &to)
+        crate::geometry::fit_dlt(&from, &to)
     }
 
     /// What the tracker reports for a robot at `(x, y)` heading `heading` (our frame): its marker's
@@ -227,7 +227,7 @@ pub fn detect_fiducials(frame: &RgbImage, size: [f64; 2]) -> Vec<[f64; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calibrate::screen::render_fiducials;
+    use crate::calibrate::render_fiducials;
 
     #[test]
     fn the_screen_maps_to_the_image_by_a_homography() {

@@ -9,16 +9,16 @@ mod robot_end;
 mod tracker_server;
 
 pub use camera::{CameraModel, Noise, detect_fiducials};
-pub use plant::{FIRMWARE_TIMEOUT, TwinPlant};
+pub use plant::{FIRMWARE_TIMEOUT, TwinArena};
 pub use robot_end::{
     BUMPER_DARK, BUMPER_SPAN, ByteChannel, PtyChannel, Received, RobotEnd, RobotFaults, UdpChannel,
     bumper_reading, motion as legacy_motion_wheels,
 };
 pub use tracker_server::{TrackerFaults, TrackerServer};
 
-use crate::frames::FrameClient;
 use crate::onboard::{OnboardFirmware, OnboardFleet, OnboardManifest};
-use crate::swarmcon::FrameTransform;
+use crate::protocol::swarmcon::FrameTransform;
+use crate::transport::FrameClient;
 use colcos_sim::scenario::Scenario;
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -28,7 +28,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 type FiducialHistory = std::collections::VecDeque<(f64, Vec<[f64; 2]>)>;
 
 pub struct Twin {
-    plant: TwinPlant,
+    arena: TwinArena,
     tracker: TrackerServer,
     robots: RobotEnd,
     frames: Option<FrameClient>,
@@ -56,9 +56,9 @@ impl Twin {
         channel: Box<dyn ByteChannel>,
         frames: Option<SocketAddr>,
     ) -> colcos_sim::error::Result<Twin> {
-        let plant = TwinPlant::new(scenario)?;
+        let arena = TwinArena::new(scenario)?;
         let rig = &scenario.spec.rig;
-        let n = plant.robot_count();
+        let n = arena.robot_count();
         let radio = rig.radio_addresses(n)?;
         let rate = scenario.spec.tracker.rate_hz.max(1.0) as f64;
         let mut robots = RobotEnd::new(channel, radio);
@@ -67,7 +67,7 @@ impl Twin {
             robots.set_onboard(Some(OnboardFleet::new(firmware, n)));
         }
         Ok(Twin {
-            plant,
+            arena,
             tracker,
             robots,
             frames: frames.map(FrameClient::connect),
@@ -80,11 +80,11 @@ impl Twin {
         })
     }
 
-    pub fn plant(&self) -> &TwinPlant {
-        &self.plant
+    pub fn arena(&self) -> &TwinArena {
+        &self.arena
     }
-    pub fn plant_mut(&mut self) -> &mut TwinPlant {
-        &mut self.plant
+    pub fn arena_mut(&mut self) -> &mut TwinArena {
+        &mut self.arena
     }
     /// Sees the arena through `camera` (noise drawn from `seed`); `None`: the tracker reports the
     /// nominal frame change of the true tracked poses, as without calibration.
@@ -112,25 +112,25 @@ impl Twin {
         if let Some((img, t)) = &latest
             && *t != self.fiducials.0
         {
-            let size = self.plant.world().screen().size;
+            let size = self.arena.world().screen().size;
             let seen = detect_fiducials(img, [size[0] as f64, size[1] as f64]);
             self.fiducials.0 = *t;
-            self.fiducials.1.push_back((self.plant.time(), seen));
+            self.fiducials.1.push_back((self.arena.time(), seen));
             // A second of history is more than any tracker latency.
             while self.fiducials.1.len() > 2
                 && self
                     .fiducials
                     .1
                     .get(1)
-                    .is_some_and(|(at, _)| self.plant.time() - at > 1.0)
+                    .is_some_and(|(at, _)| self.arena.time() - at > 1.0)
             {
                 self.fiducials.1.pop_front();
             }
         }
         let frame = latest.map(|(img, _)| img);
-        self.robots.poll(&mut self.plant, frame.as_deref());
-        self.plant.step();
-        let now = self.plant.time();
+        self.robots.poll(&mut self.arena, frame.as_deref());
+        self.arena.step();
+        let now = self.arena.time();
         if now - self.last_block >= self.block_period - 1e-9 {
             self.last_block = now;
             self.publish();
@@ -144,9 +144,9 @@ impl Twin {
             .duration_since(UNIX_EPOCH)
             .map(|d| d.as_micros() as i64)
             .unwrap_or(0);
-        let now = self.plant.time();
+        let now = self.arena.time();
         let epoch = |t: f32| wall_us - ((now - t as f64) * 1e6).round() as i64;
-        let tracked = self.plant.tracked();
+        let tracked = self.arena.tracked();
         let frame_t = tracked
             .iter()
             .filter(|p| p.seen)
@@ -194,7 +194,7 @@ impl Twin {
     /// Runs in real time at the scenario's `dt` until `stop` is set or `duration` s have passed; the
     /// tracker then says `Closed`.
     pub fn run(&mut self, duration: Option<f64>, stop: &AtomicBool) {
-        let dt = Duration::from_secs_f64(self.plant.world().dt() as f64);
+        let dt = Duration::from_secs_f64(self.arena.world().dt() as f64);
         let start = Instant::now();
         let mut next = start;
         while !stop.load(Ordering::Relaxed)

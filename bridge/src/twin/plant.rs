@@ -16,7 +16,7 @@ use image::RgbImage;
 /// How long a robot keeps its last command without hearing another, s (the firmware's timeout).
 pub const FIRMWARE_TIMEOUT: f64 = 0.5;
 
-pub struct TwinPlant {
+pub struct TwinArena {
     world: World,
     commands: Vec<WheelCommand>,
     /// Twin time each robot last heard a command for it, s.
@@ -25,12 +25,12 @@ pub struct TwinPlant {
     telemetry_rng: Vec<SimRng>,
 }
 
-impl TwinPlant {
-    pub fn new(scenario: &Scenario) -> Result<TwinPlant> {
+impl TwinArena {
+    pub fn new(scenario: &Scenario) -> Result<TwinArena> {
         let world = World::new(scenario)?;
         let n = world.robot_count();
         let seed = scenario.spec.seed;
-        Ok(TwinPlant {
+        Ok(TwinArena {
             world,
             commands: vec![WheelCommand::STOP; n],
             heard: vec![f64::NEG_INFINITY; n],

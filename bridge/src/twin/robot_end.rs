@@ -1,12 +1,12 @@
 //! The robots' end of the serial protocol, for the twin: reads host command frames from a byte
 //! channel (a pseudo-terminal, so the bridge's real serial code runs, or UDP), applies them to the
 //! simulated robots, and answers data requests with 96-byte telemetry frames.
-use super::plant::{FIRMWARE_TIMEOUT, TwinPlant};
-use crate::colias::{
+use super::plant::{FIRMWARE_TIMEOUT, TwinArena};
+use crate::onboard::OnboardFleet;
+use crate::protocol::colias::{
     BROADCAST_ID, COMMAND_LEN, CommandPacket, FrameDecoder, HostCommand, MotionKind, Telemetry,
     colour_from_sim,
 };
-use crate::onboard::OnboardFleet;
 use colcos_sim::behaviour::WheelCommand;
 use image::RgbImage;
 use std::io::{Read, Write};
@@ -171,7 +171,7 @@ impl RobotEnd {
 
     /// Handles every frame that arrived: commands go to `plant`, data requests are answered with
     /// telemetry read from `frame` (the displayed screen).
-    pub fn poll(&mut self, plant: &mut TwinPlant, frame: Option<&RgbImage>) {
+    pub fn poll(&mut self, plant: &mut TwinArena, frame: Option<&RgbImage>) {
         self.bytes.clear();
         self.channel.read_available(&mut self.bytes);
         self.payloads.clear();
@@ -231,7 +231,7 @@ impl RobotEnd {
     }
 
     /// One control tick of every robot running its on-board policy, on its own readings.
-    fn run_onboard(&mut self, plant: &mut TwinPlant, frame: Option<&RgbImage>) {
+    fn run_onboard(&mut self, plant: &mut TwinArena, frame: Option<&RgbImage>) {
         let Some(fleet) = &mut self.onboard else {
             return;
         };
@@ -252,7 +252,7 @@ impl RobotEnd {
         }
     }
 
-    fn telemetry(&self, plant: &mut TwinPlant, i: usize, frame: Option<&RgbImage>) -> Telemetry {
+    fn telemetry(&self, plant: &mut TwinArena, i: usize, frame: Option<&RgbImage>) -> Telemetry {
         let colour = colour_from_sim(plant.colour_counts(i, frame));
         let (tcrt_on, tcrt_off) = bumper_counts(plant.bumpers(i));
         let mut t = Telemetry {

@@ -1,7 +1,7 @@
 //! The twin's SwarmCon position server: serves blocks in the exact text format to every client on a
 //! TCP port, as the real server does, with faults on demand (silence, split and merged reads, garbage
 //! bytes, a clock offset).
-use crate::swarmcon::{
+use crate::protocol::swarmcon::{
     HeaderForm, SlotPose, SlotState, TrackerEvent, TrackerFrame, write_block, write_event,
 };
 use std::io::Write;

@@ -2,10 +2,10 @@
 // Each test file uses part of this.
 #![allow(dead_code)]
 
-use colcos_bridge::calibrate::session::{RawTracker, Rig};
-use colcos_bridge::frames::FrameServer;
+use colcos_bridge::calibrate::{CalibrationRig, RawTracker};
 use colcos_bridge::open_robot_link;
-use colcos_bridge::swarmcon::HeaderForm;
+use colcos_bridge::protocol::swarmcon::HeaderForm;
+use colcos_bridge::transport::FrameServer;
 use colcos_bridge::twin::{CameraModel, TrackerServer, Twin, UdpChannel};
 use colcos_sim::scenario::Scenario;
 use std::net::SocketAddr;
@@ -60,7 +60,7 @@ pub fn scenario_with_screen(rig: &str, resolution: [u32; 2]) -> Scenario {
 }
 
 pub struct TwinRun {
-    pub rig: Rig,
+    pub rig: CalibrationRig,
     pub tracker_addr: SocketAddr,
     twin: Option<std::thread::JoinHandle<Twin>>,
     stop: Arc<AtomicBool>,
@@ -94,7 +94,7 @@ impl TwinRun {
         let tracker = RawTracker::connect(&tracker_addr.to_string()).unwrap();
         let link = open_robot_link(&link_url).unwrap();
         TwinRun {
-            rig: Rig::new(tracker, frames, Some(link)),
+            rig: CalibrationRig::new(tracker, frames, Some(link)),
             tracker_addr,
             twin: Some(handle),
             stop,
