@@ -1,14 +1,36 @@
 //! The hand-written behaviours as baseline policies over a batch: one controller per (world, agent),
 //! either a sim behaviour deciding the wheels from the raw sensor readings the agent's observation
 //! vector is made of, or one of the tasks' own policies ([`crate::policy`]) deciding the whole action,
-//! deposit rates included, from the agent's observation row.
+//! deposit rates included, from the agent's observation row. It drives any [`Arenas`]: the batch's
+//! simulated worlds or a plant's arena (a twin, the rig), so a hand-written behaviour is evaluated
+//! where a learned policy is.
 use crate::encoding::command_to_action;
 use crate::error::{EnvError, Result};
+use crate::outputs::Outputs;
 use crate::policy::{self, AgentPolicy};
-use crate::vec_env::VecEnv;
+use crate::spaces::EnvSpec;
 use colcos_sim::behaviour::{Behaviour, registry};
 use colcos_sim::rng::{self, SimRng, Stream};
 use colcos_sim::robot::ColiasParams;
+use colcos_sim::world::ArenaView;
+
+/// What a policy reads of an environment of a task: its spec, each arena's raw readings and episode
+/// counters, and the agents' observation rows. The batch ([`crate::VecEnv`]) and the plants'
+/// arena implement it.
+pub trait Arenas {
+    fn spec(&self) -> &EnvSpec;
+    /// The scenario the arenas were made from (its `[robot]` builds the behaviours).
+    fn scenario(&self) -> &colcos_sim::scenario::Scenario;
+    /// Arena `w` (`w < spec().num_envs`).
+    fn arena(&self, w: usize) -> &dyn ArenaView;
+    /// Number of arena `w`'s current episode.
+    fn episode(&self, w: usize) -> u64;
+    /// Steps taken in arena `w`'s current episode.
+    fn episode_steps(&self, w: usize) -> u64;
+    fn outputs(&self) -> &Outputs;
+    /// Entries of an agent's continuous action (the wheels and the deposit actions).
+    fn action_width(&self) -> usize;
+}
 
 /// One agent's controller.
 enum Controller {
@@ -35,7 +57,12 @@ pub struct BaselinePolicy {
 impl BaselinePolicy {
     /// Behaviour `name` from the sim registry with `params` (a JSON object), or the task policy
     /// `name` (no parameters), for every agent of `env`.
-    pub fn new(env: &VecEnv, name: &str, params: &serde_json::Value, seed: u64) -> Result<Self> {
+    pub fn new(
+        env: &dyn Arenas,
+        name: &str,
+        params: &serde_json::Value,
+        seed: u64,
+    ) -> Result<Self> {
         let params: toml::Table = match params {
             serde_json::Value::Null => toml::Table::new(),
             v => toml::Table::try_from(v).map_err(|e| {
@@ -62,7 +89,7 @@ impl BaselinePolicy {
             params,
             robot,
             seed,
-            width: env.action_decoder().width(),
+            width: env.action_width(),
             slots: Vec::new(),
             seen: Vec::new(),
         };
@@ -97,7 +124,7 @@ impl BaselinePolicy {
 
     /// Continuous actions `[E, N, width]` for the env's current observations (a behaviour lays
     /// nothing: its deposit rates are 0).
-    pub fn act(&mut self, env: &VecEnv, out: &mut [f32]) -> Result<()> {
+    pub fn act(&mut self, env: &dyn Arenas, out: &mut [f32]) -> Result<()> {
         let spec = env.spec();
         let (e, n, a) = (spec.num_envs, spec.num_agents, self.width);
         if self.seen.len() != e || out.len() != e * n * a {
@@ -107,7 +134,7 @@ impl BaselinePolicy {
                 e * n * a
             )));
         }
-        let d = env.obs_dim();
+        let d = spec.observation.flat_len();
         let obs = env.outputs().obs();
         for w in 0..e {
             let now = (env.episode(w), env.episode_steps(w));
@@ -117,7 +144,7 @@ impl BaselinePolicy {
                 }
             }
             self.seen[w] = now;
-            let world = env.world(w).expect("w < num_envs");
+            let world = env.arena(w);
             let max = world.robot_params().max_wheel_speed;
             for (i, &robot) in spec.agent_robots.iter().enumerate() {
                 let k = w * n + i;

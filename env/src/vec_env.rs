@@ -425,3 +425,27 @@ impl VecEnv {
         Ok(render_world(&slot.world, self.task.agents(), width))
     }
 }
+
+impl crate::baseline::Arenas for VecEnv {
+    fn spec(&self) -> &EnvSpec {
+        &self.spec
+    }
+    fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+    fn arena(&self, w: usize) -> &dyn colcos_sim::world::ArenaView {
+        &self.slots[w].world
+    }
+    fn episode(&self, w: usize) -> u64 {
+        self.slots[w].episode.index
+    }
+    fn episode_steps(&self, w: usize) -> u64 {
+        self.slots[w].episode.steps
+    }
+    fn outputs(&self) -> &Outputs {
+        &self.out
+    }
+    fn action_width(&self) -> usize {
+        self.decoder.width()
+    }
+}

@@ -465,6 +465,31 @@ impl LiveEnv {
     }
 }
 
+/// A plant's arena as the one arena a policy reads (a hand-written baseline on the twin or the rig).
+impl colcos_env::baseline::Arenas for LiveEnv {
+    fn spec(&self) -> &EnvSpec {
+        &self.spec
+    }
+    fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+    fn arena(&self, _w: usize) -> &dyn colcos_sim::world::ArenaView {
+        self.driver.host()
+    }
+    fn episode(&self, _w: usize) -> u64 {
+        self.episode.index
+    }
+    fn episode_steps(&self, _w: usize) -> u64 {
+        self.episode.steps
+    }
+    fn outputs(&self) -> &Outputs {
+        &self.out
+    }
+    fn action_width(&self) -> usize {
+        self.decoder.width()
+    }
+}
+
 /// A rig log recorded with another scenario (its `rig` metadata names it and its robot count) is
 /// refused: its poses would be fed to the wrong robots. Logs without that metadata are taken.
 fn refuse_another_scenario(

@@ -1,9 +1,12 @@
-//! `colcos._core.Baseline`: the paper's hand-written behaviours as policies over a `VecEnv`.
-//! Locks are taken with the GIL released, the env's before the policy's (one order, no deadlock).
+//! `colcos._core.Baseline`: the paper's hand-written behaviours as policies over a `VecEnv` or a
+//! `Plant` (a twin, the rig). Locks are taken with the GIL released, the env's before the policy's
+//! (one order, no deadlock).
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
+use crate::plant::PyPlant;
 use crate::vec_env::PyVecEnv;
-use colcos_env::baseline::BaselinePolicy;
+use colcos_env::EnvError;
+use colcos_env::baseline::{Arenas, BaselinePolicy};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use std::sync::Mutex;
@@ -33,7 +36,6 @@ impl PyBaseline {
         seed: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         guard(|| {
-            let env = env_of(env)?;
             let name = args::text(name, "name")?;
             let params = match args::opt_text(params_json, "params_json")? {
                 Some(s) => serde_json::from_str(&s).map_err(|e| {
@@ -45,16 +47,12 @@ impl PyBaseline {
                 Some(s) => args::seed(s, "seed")?,
                 None => 0,
             };
-            let me: &PyVecEnv = env.get();
-            let (policy, shape) = py
-                .detach(|| {
-                    let g = me.lock();
-                    let s = g.env.spec();
-                    BaselinePolicy::new(&g.env, &name, &params, seed)
-                        .map(|p| (p.width(), p))
-                        .map(|(w, p)| (p, [s.num_envs, s.num_agents, w]))
-                })
-                .map_err(to_py)?;
+            let (policy, shape) = with_arenas(py, env, |a| {
+                let s = a.spec();
+                BaselinePolicy::new(a, &name, &params, seed)
+                    .map(|p| (p.width(), p))
+                    .map(|(w, p)| (p, [s.num_envs, s.num_agents, w]))
+            })?;
             Ok(PyBaseline {
                 state: Mutex::new(State {
                     policy,
@@ -69,35 +67,40 @@ impl PyBaseline {
     /// the deposit rates: 0 for a sim behaviour, chosen by a task's own policy).
     fn act<'py>(&self, py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
-            let env = env_of(env)?;
-            let me: &PyVecEnv = env.get();
-            let out = py
-                .detach(|| {
-                    let g = me.lock();
-                    let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
-                    let State { policy, out } = &mut *st;
-                    let s = g.env.spec();
-                    if out.len() != s.num_envs * s.num_agents * g.env.action_decoder().width() {
-                        return Err(colcos_env::EnvError::State(
-                            "this policy was made for another environment (its sizes differ)"
-                                .into(),
-                        ));
-                    }
-                    policy.act(&g.env, out).map(|()| out.clone())
-                })
-                .map_err(to_py)?;
+            let out = with_arenas(py, env, |a| {
+                let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
+                let State { policy, out } = &mut *st;
+                let s = a.spec();
+                if out.len() != s.num_envs * s.num_agents * a.action_width() {
+                    return Err(EnvError::State(
+                        "this policy was made for another environment (its sizes differ)".into(),
+                    ));
+                }
+                policy.act(a, out).map(|()| out.clone())
+            })?;
             Ok(PyArray1::from_vec(py, out).reshape(self.shape)?.into_any())
         })
     }
 }
 
-fn env_of<'a, 'py>(env: &'a Bound<'py, PyAny>) -> PyResult<&'a Bound<'py, PyVecEnv>> {
-    env.cast::<PyVecEnv>().map_err(|_| {
-        Kind::ArgumentType.err(format!(
-            "env must be a colcos._core.VecEnv, got {}",
-            args::show(env)
-        ))
-    })
+/// `f` on the arenas of `env` (a `VecEnv` or a `Plant`), under its lock with the GIL released.
+fn with_arenas<R: Send>(
+    py: Python<'_>,
+    env: &Bound<'_, PyAny>,
+    f: impl FnOnce(&dyn Arenas) -> Result<R, EnvError> + Send,
+) -> PyResult<R> {
+    if let Ok(venv) = env.cast::<PyVecEnv>() {
+        let me: &PyVecEnv = venv.get();
+        return py.detach(|| f(&me.lock().env)).map_err(to_py);
+    }
+    if let Ok(plant) = env.cast::<PyPlant>() {
+        let me: &PyPlant = plant.get();
+        return py.detach(|| f(&*me.lock())).map_err(to_py);
+    }
+    Err(Kind::ArgumentType.err(format!(
+        "env must be a colcos._core.VecEnv or a colcos._core.Plant, got {}",
+        args::show(env)
+    )))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -1,7 +1,9 @@
-"""The paper's hand-written behaviours as baseline policies over a `colcos.vector.VecEnv`.
+"""The paper's hand-written behaviours as baseline policies over a `colcos.vector.VecEnv` or a
+`colcos.parallel_env(...)` on any plant (the simulator, a twin, the rig).
 
 A behaviour decides from the same raw sensor readings an agent's observation vector is built from
-(and keeps its own state, e.g. a turn in progress), so it is evaluated in Rust next to the worlds.
+(and keeps its own state, e.g. a turn in progress), so it is evaluated in Rust next to the worlds, or
+next to the host's arena on a twin or the rig.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import numpy as np
 from gymnasium import spaces
 
 from colcos import _checks, _core
+from colcos.pettingzoo_env import ColcosParallelEnv
 from colcos.vector import VecEnv
 
 __all__ = ["Baseline", "RandomPolicy"]
@@ -26,12 +29,23 @@ class Baseline:
     >>> policy = Baseline(venv, "avoid", speed=0.1)
     >>> obs, _ = venv.reset(seed=0)
     >>> obs, rew, term, trunc, _ = venv.step(policy.act())
+
+    On a `parallel_env` (one arena; `plant="twin"` or `"rig"` too) `actions()` gives the PettingZoo
+    action dict of the agents still running:
+
+    >>> env = colcos.parallel_env(task="aggregation", plant="twin")
+    >>> follower = Baseline(env, "aggregation_follower")
+    >>> obs, _ = env.reset(seed=1)
+    >>> obs, rew, term, trunc, _ = env.step(follower.actions())
     """
 
-    def __init__(self, env: VecEnv, name: str, seed: int = 0, **params: Any) -> None:
-        if not isinstance(env, VecEnv):
-            raise _core.ArgumentTypeError(f"env must be a colcos.vector.VecEnv, got {type(env).__name__}")
-        if not env.continuous:
+    def __init__(self, env: VecEnv | ColcosParallelEnv, name: str, seed: int = 0, **params: Any) -> None:
+        if not isinstance(env, (VecEnv, ColcosParallelEnv)):
+            raise _core.ArgumentTypeError(
+                f"env must be a colcos.vector.VecEnv or a colcos.parallel_env, got {type(env).__name__}"
+            )
+        continuous = env.continuous if isinstance(env, VecEnv) else env._continuous
+        if not continuous:
             raise _core.TaskError("baseline policies produce continuous wheel speeds; make the env with continuous=True")
         self.env = env
         self.name = name
@@ -42,6 +56,14 @@ class Baseline:
         """Actions (E, N, 2 + D) float32 for the env's current sensor readings (`obs` is ignored): the
         wheels, then the deposit rates (0 from a behaviour; a task policy chooses them)."""
         return self._policy.act(self.env._core)
+
+    def actions(self) -> dict[str, np.ndarray]:
+        """For a `parallel_env`: `{agent: action}` of the agents still running (PettingZoo's form)."""
+        env = self.env
+        if not isinstance(env, ColcosParallelEnv):
+            raise _core.TaskError("actions() is for a colcos.parallel_env; use act() on a VecEnv")
+        acts = self.act()[0]
+        return {a: acts[env._index[a]] for a in env.agents}
 
 
 class RandomPolicy:
