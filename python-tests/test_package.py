@@ -35,6 +35,10 @@ def test_metadata_complete():
     assert meta["Description-Content-Type"].startswith("text/markdown") and "pip install" in meta.get_payload()
     requires = meta.get_all("Requires-Dist") or []
     assert {re.split(r"[<>=; ]", r, maxsplit=1)[0] for r in requires} >= {"numpy", "gymnasium", "pettingzoo"}
+    # The licence texts travel with the package (PEP 639 `License-File`, under dist-info/licenses).
+    assert set(meta.get_all("License-File") or []) >= {"LICENSE-MIT", "LICENSE-APACHE"}
+    files = {f.name for f in md.files("colcos") or []}
+    assert {"LICENSE-MIT", "LICENSE-APACHE"} <= files
 
 
 def test_abi3_native_module_and_typing_marker():
