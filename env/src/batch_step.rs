@@ -97,6 +97,22 @@ pub(crate) struct Lengths {
 }
 
 impl Buffers<'_> {
+    /// The same buffers, borrowed again (for a step that walks the batch twice).
+    #[cfg(feature = "gpu")]
+    pub(crate) fn reborrow(&mut self) -> Buffers<'_> {
+        Buffers {
+            obs: self.obs,
+            rewards: self.rewards,
+            terminated: self.terminated,
+            truncated: self.truncated,
+            state: self.state,
+            patch: self.patch,
+            final_obs: self.final_obs,
+            final_mask: self.final_mask,
+            shield: self.shield,
+        }
+    }
+
     /// World `i`'s slices.
     pub(crate) fn world(&mut self, i: usize, len: Lengths) -> Out<'_> {
         let part = |n: usize| i * n..(i + 1) * n;
@@ -182,7 +198,7 @@ fn step_chunk(
 }
 
 /// The buffers cut into chunks of `c` worlds.
-fn split(
+pub(crate) fn split(
     buffers: Buffers<'_>,
     c: usize,
     len: Lengths,

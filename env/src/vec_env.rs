@@ -33,6 +33,9 @@ pub struct VecEnv {
     slots: Vec<WorldSlot>,
     /// The chunks the worlds are stepped in, with their rapier hosts (see `batch_step`).
     chunks: Chunks,
+    /// Every world's grid pheromones resident on the GPU (`backend = "gpu"` where they allow it).
+    #[cfg(feature = "gpu")]
+    gpu: Option<crate::gpu_stage::GpuStage>,
     obs: Vec<f32>,
     rewards: Vec<f32>,
     terminated: Vec<bool>,
@@ -69,7 +72,8 @@ impl VecEnv {
         if let Some(p) = cfg.physics {
             scenario.spec.physics = p;
         }
-        let mut backend = EnvBackend::resolve(scenario.spec.field.backend)?;
+        let mut backend =
+            EnvBackend::resolve(scenario.spec.field.backend, cfg.num_envs, &scenario)?;
         let max_cycles = if cfg.max_cycles > 0 {
             cfg.max_cycles
         } else {
@@ -165,6 +169,11 @@ impl VecEnv {
         let mut chunks = Chunks::new(&scenario, &slots);
         pool.install(|| chunks.attach_all(&mut slots));
         backend.settle(&slots[0].world);
+        #[cfg(feature = "gpu")]
+        let gpu = match backend.batch_context() {
+            Some(ctx) => Some(crate::gpu_stage::GpuStage::new(ctx.clone(), &mut slots)?),
+            None => None,
+        };
         let mut env = VecEnv {
             spec,
             task,
@@ -175,6 +184,8 @@ impl VecEnv {
             pool,
             slots,
             chunks,
+            #[cfg(feature = "gpu")]
+            gpu,
             obs: vec![0.0; e * n * obs_dim],
             rewards: vec![0.0; e * n],
             terminated: vec![false; e * n],
@@ -465,6 +476,15 @@ impl VecEnv {
             shield: &mut self.shield_flags,
         };
         let (slots, chunks) = (&mut self.slots, &mut self.chunks);
+        #[cfg(feature = "gpu")]
+        if let (Some(stage), Some(_)) = (self.gpu.as_mut(), actions) {
+            let (commands, rates) = (&self.commands, &self.deposit_rates);
+            return self.pool.install(|| {
+                crate::gpu_step::step_batch_gpu(
+                    &ctx, slots, chunks, stage, commands, rates, buffers, len,
+                )
+            });
+        }
         if actions.is_none() {
             return self
                 .pool
@@ -530,7 +550,18 @@ impl VecEnv {
         self.shield_flags.fill(0);
     }
 
-    /// The screen with the robots drawn on it, `width` pixels wide, of world `e`.
+    /// Brings the worlds' grid pheromones on the CPU ([`VecEnv::world`]'s `pheromones()`) up to date
+    /// with the GPU batch that steps them (nothing to do on the CPU backend, where they always are).
+    pub fn sync_fields(&mut self) -> Result<()> {
+        #[cfg(feature = "gpu")]
+        if let Some(stage) = &self.gpu {
+            stage.sync(&mut self.slots)?;
+        }
+        Ok(())
+    }
+
+    /// The screen with the robots drawn on it, `width` pixels wide, of world `e` (with the GPU batch,
+    /// its fields as of the last [`VecEnv::sync_fields`]).
     pub fn render(&self, e: usize, width: u32) -> Result<image::RgbImage> {
         let slot = self.slots.get(e).ok_or_else(|| {
             EnvError::param(

@@ -129,6 +129,24 @@ impl World {
     pub fn set_field_backend(&mut self, backend: Option<Box<dyn FieldBackend>>) {
         self.fields.set_backend(backend);
     }
+    /// Hands the grid pheromones to an owner outside the world, or takes them back (see
+    /// [`super::FieldSet::set_external_grids`]; a step then ends with [`World::sense_from_sums`]).
+    pub fn set_external_grids(&mut self, external: bool) {
+        self.fields.set_external_grids(external);
+    }
+    /// Whether the grid pheromones live outside the world.
+    pub fn external_grids(&self) -> bool {
+        self.fields.external_grids()
+    }
+    /// The trail segments of the last step, in scenario order.
+    pub fn trail_segments(&self) -> &[super::TrailSegment] {
+        self.injection.segments()
+    }
+    /// Robot `i`'s four colour sensors' screen points at the current poses (see
+    /// [`super::Sensing::footprint_points`]).
+    pub fn footprint_points(&self, i: usize) -> [[Vec2; crate::sensors::RING_POINTS + 1]; 4] {
+        self.sensing.footprint_points(i)
+    }
     /// The installed field backend's description, or `None` for the CPU.
     pub fn field_backend(&self) -> Option<String> {
         self.fields.backend_description()

@@ -1,0 +1,127 @@
+//! The field stage of a batch on the GPU: every world's grid pheromones resident in one
+//! [`colcos_gpu::WorldFields`] batch for the environment's life. A step's worlds move on the CPU, then
+//! this stage steps all their fields, lays all their trails and senses every robot's colour sensors
+//! in one dispatch sequence, and only the sensors' level sums come back; the worlds then read them
+//! into observations (`World::sense_from_sums`) and the tasks hand out rewards on the CPU.
+//!
+//! A world built on the CPU (a new episode, its fields on the CPU) is loaded into the batch before the
+//! first step it steps in; until then the batch's copy of its fields is stale and unused (its
+//! sensors' sums this step are not read).
+use crate::error::{EnvError, Result};
+use crate::world_slot::WorldSlot;
+use crate::world_step::Begun;
+
+/// A GPU error as the environment's.
+fn backend_error(e: colcos_gpu::GpuError) -> EnvError {
+    EnvError::Backend(format!("GPU field stage: {e}"))
+}
+
+/// The batch's grids on the GPU, and the sums of the last step's sensing.
+pub(crate) struct GpuStage {
+    fields: colcos_gpu::WorldFields,
+    /// Footprint level sums of the last sensing, four per robot, `[E, R, 4]`.
+    sums: Vec<[u32; 3]>,
+    /// Robots a world has.
+    robots: usize,
+    /// How each world began the current step.
+    pub(crate) begun: Vec<Begun>,
+}
+
+impl GpuStage {
+    /// The batch of `slots`' worlds on `ctx`, each world's grids loaded.
+    pub(crate) fn new(
+        ctx: std::sync::Arc<colcos_gpu::GpuContext>,
+        slots: &mut [WorldSlot],
+    ) -> Result<Self> {
+        let first = &slots[0].world;
+        let fields = colcos_gpu::WorldFields::new(
+            ctx,
+            first.pheromones(),
+            slots.len(),
+            first.screen().clone(),
+        )
+        .map_err(backend_error)?;
+        let mut stage = GpuStage {
+            fields,
+            sums: Vec::new(),
+            robots: first.robot_count(),
+            begun: vec![Begun::Stepped; slots.len()],
+        };
+        stage.load_fresh(slots, |_| true)?;
+        Ok(stage)
+    }
+
+    /// Loads the worlds that are fresh and for which `now(w)` holds.
+    fn load_fresh(&mut self, slots: &mut [WorldSlot], now: impl Fn(usize) -> bool) -> Result<()> {
+        for (w, slot) in slots.iter_mut().enumerate() {
+            if slot.fresh && now(w) {
+                self.fields
+                    .load_world(w, slot.world.pheromones())
+                    .map_err(backend_error)?;
+                slot.fresh = false;
+            }
+        }
+        Ok(())
+    }
+
+    /// The step's field work for every world, after each began its step as `self.begun` says (the
+    /// worlds that stepped have moved and injected): fields stepped, trails laid, every robot's
+    /// colour sensors sensed.
+    pub(crate) fn run(&mut self, slots: &mut [WorldSlot], dt: f32) -> Result<()> {
+        let begun = std::mem::take(&mut self.begun);
+        let result = self.run_with(slots, &begun, dt);
+        self.begun = begun;
+        result
+    }
+
+    fn run_with(&mut self, slots: &mut [WorldSlot], begun: &[Begun], dt: f32) -> Result<()> {
+        // New episodes that step now start from their CPU fields.
+        self.load_fresh(slots, |w| begun[w] != Begun::Reset)?;
+        for (w, slot) in slots.iter().enumerate() {
+            if begun[w] != Begun::Reset {
+                (self.fields)
+                    .add_segments(w, slot.world.trail_segments())
+                    .map_err(backend_error)?;
+            }
+        }
+        self.fields.step(dt).map_err(backend_error)?;
+        for (w, slot) in slots.iter().enumerate() {
+            for i in 0..self.robots {
+                for points in slot.world.footprint_points(i) {
+                    self.fields.add_sensor(w, points).map_err(backend_error)?;
+                }
+            }
+        }
+        self.fields.sense(&mut self.sums).map_err(backend_error)
+    }
+
+    /// World `w`'s footprint level sums of the last sensing, four per robot.
+    pub(crate) fn sums_of(&self, w: usize) -> &[[u32; 3]] {
+        let n = 4 * self.robots;
+        &self.sums[w * n..(w + 1) * n]
+    }
+
+    /// Copies every world's grids back into its CPU fields (for what reads them there: patches,
+    /// tasks written in Python, renders); a world built since the last load already has them there.
+    pub(crate) fn sync(&self, slots: &mut [WorldSlot]) -> Result<()> {
+        for (w, slot) in slots.iter_mut().enumerate() {
+            if slot.fresh {
+                continue;
+            }
+            let values = self.fields.read_world(w).map_err(backend_error)?;
+            write_values(slot.world.pheromones_mut(), &values);
+        }
+        Ok(())
+    }
+}
+
+/// Overwrites the grid pheromones' values with `values` (one per grid pheromone, in order).
+fn write_values(pheromones: &mut [colcos_sim::field::Pheromone], values: &[Vec<f32>]) {
+    let grids = pheromones.iter_mut().filter_map(|p| match &mut p.model {
+        colcos_sim::field::FieldModel::Grid(g) => Some(g),
+        _ => None,
+    });
+    for (g, v) in grids.zip(values) {
+        g.values_mut().copy_from_slice(v);
+    }
+}

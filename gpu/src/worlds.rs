@@ -1,0 +1,244 @@
+//! Many worlds' grid pheromones resident on the GPU (a vector environment's): each step's field
+//! passes, every world's trail deposits and every robot's colour sensing as one dispatch sequence,
+//! and only the sensors' level sums read back.
+//!
+//! The worlds share one scenario, so their grids have one spec: world `w`'s pheromone `j` is field
+//! `w * P + j` of a [`GpuGrids`] batch (`P` pheromones a world). A batch larger than the adapter's
+//! largest storage binding is cut into parts of whole worlds, each stepped and sensed on its own.
+use crate::screen::{GpuScreen, POINTS_PER_SENSOR, ScreenLayer, ScreenScene, SensorQuery};
+use crate::{Deposit, GpuContext, GpuError, GpuGrids, Result};
+use colcos_sim::field::{FieldModel, GridField, GridParams, GridSpec, Pheromone};
+use colcos_sim::screen::ScreenSpec;
+use colcos_sim::world::TrailSegment;
+use glam::Vec2;
+use std::sync::Arc;
+
+/// Most fields one part may hold (the batch's workgroup limit along z).
+const MAX_PART_FIELDS: usize = 65_535;
+
+/// Worlds `first..first + worlds` of the batch: their grids and their screens' layers.
+struct Part {
+    first: usize,
+    worlds: usize,
+    grids: GpuGrids,
+    scene: ScreenScene,
+    deposits: Vec<Deposit>,
+    queries: Vec<SensorQuery>,
+}
+
+/// The grid pheromones of `worlds` worlds of one scenario, on one device.
+pub struct WorldFields {
+    ctx: Arc<GpuContext>,
+    spec: GridSpec,
+    screen_spec: ScreenSpec,
+    /// Pheromones a world has (all grids).
+    per_world: usize,
+    parts: Vec<Part>,
+    screen: GpuScreen,
+}
+
+/// Why a world's pheromones cannot live in a [`WorldFields`] batch, or `None` if they can: every
+/// pheromone a grid, all of one spec.
+pub fn unsupported(pheromones: &[Pheromone]) -> Option<String> {
+    let mut spec = None;
+    for p in pheromones {
+        match &p.model {
+            FieldModel::Grid(g) => {
+                if spec.is_some_and(|s| s != *g.spec()) {
+                    return Some("the grid pheromones have different grids".into());
+                }
+                spec = Some(*g.spec());
+            }
+            FieldModel::Gaussian(_) => {
+                return Some(format!("pheromone {:?} is Gaussian", p.name));
+            }
+        }
+    }
+    spec.is_none().then(|| "no grid pheromones".into())
+}
+
+fn grids_of(pheromones: &[Pheromone]) -> impl Iterator<Item = &GridField> {
+    pheromones.iter().filter_map(|p| match &p.model {
+        FieldModel::Grid(g) => Some(g),
+        FieldModel::Gaussian(_) => None,
+    })
+}
+
+impl WorldFields {
+    /// A batch of `worlds` worlds whose pheromones are like `pheromones` (colours, grid, parameters),
+    /// all zero until [`WorldFields::load_world`]; `screen` is the scenario's screen.
+    pub fn new(
+        ctx: Arc<GpuContext>,
+        pheromones: &[Pheromone],
+        worlds: usize,
+        screen: ScreenSpec,
+    ) -> Result<Self> {
+        if let Some(why) = unsupported(pheromones) {
+            return Err(GpuError::Invalid(why));
+        }
+        let first = grids_of(pheromones).next().expect("checked above");
+        let spec = *first.spec();
+        let params: Vec<GridParams> = grids_of(pheromones).map(|g| *g.params()).collect();
+        let per_world = params.len();
+        // Worlds a part: as many as one binding of two slots per field holds.
+        let world_bytes = 2 * spec.len() as u64 * per_world as u64 * 4;
+        let fit = (ctx.max_binding() / world_bytes.max(1)) as usize;
+        let per_part = fit.min(MAX_PART_FIELDS / per_world).max(1);
+        let colours: Vec<[f32; 3]> = pheromones.iter().map(|p| p.colour).collect();
+        let mut parts = Vec::new();
+        let mut first_world = 0;
+        while first_world < worlds {
+            let n = per_part.min(worlds - first_world);
+            let all: Vec<GridParams> = (0..n).flat_map(|_| params.iter().copied()).collect();
+            let grids = GpuGrids::new(ctx.clone(), spec, &all)?;
+            let scene = ScreenScene {
+                worlds: (0..n)
+                    .map(|w| {
+                        (colours.iter().enumerate())
+                            .map(|(j, &colour)| ScreenLayer::Grid {
+                                colour,
+                                field: w * per_world + j,
+                            })
+                            .collect()
+                    })
+                    .collect(),
+            };
+            parts.push(Part {
+                first: first_world,
+                worlds: n,
+                grids,
+                scene,
+                deposits: Vec::new(),
+                queries: Vec::new(),
+            });
+            first_world += n;
+        }
+        Ok(WorldFields {
+            screen: GpuScreen::new(ctx.clone())?,
+            ctx,
+            spec,
+            screen_spec: screen,
+            per_world,
+            parts,
+        })
+    }
+
+    pub fn context(&self) -> &Arc<GpuContext> {
+        &self.ctx
+    }
+    /// Worlds in the batch.
+    pub fn len(&self) -> usize {
+        self.parts.iter().map(|p| p.worlds).sum()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// How many parts the batch is cut into (one where the adapter's bindings hold every world).
+    pub fn parts(&self) -> usize {
+        self.parts.len()
+    }
+    pub fn spec(&self) -> &GridSpec {
+        &self.spec
+    }
+
+    /// The part of world `w` and the world's index in it.
+    fn locate(&self, w: usize) -> Result<(usize, usize)> {
+        let k = self
+            .parts
+            .iter()
+            .position(|p| (p.first..p.first + p.worlds).contains(&w))
+            .ok_or_else(|| {
+                GpuError::Invalid(format!("world {w} of a batch of {} worlds", self.len()))
+            })?;
+        Ok((k, w - self.parts[k].first))
+    }
+
+    /// Overwrites world `w`'s fields with `pheromones`' (a world just built: values, parameters,
+    /// static maps, decay state).
+    pub fn load_world(&mut self, w: usize, pheromones: &[Pheromone]) -> Result<()> {
+        let (k, i) = self.locate(w)?;
+        if grids_of(pheromones).count() != self.per_world || pheromones.len() != self.per_world {
+            return Err(GpuError::Invalid(format!(
+                "world {w}: {} pheromones for a batch of {} grid pheromones a world",
+                pheromones.len(),
+                self.per_world
+            )));
+        }
+        let part = &mut self.parts[k];
+        for (j, g) in grids_of(pheromones).enumerate() {
+            part.grids.load(i * self.per_world + j, g)?;
+        }
+        Ok(())
+    }
+
+    /// World `w`'s field values, one `Vec` per pheromone (blocking).
+    pub fn read_world(&self, w: usize) -> Result<Vec<Vec<f32>>> {
+        let (k, i) = self.locate(w)?;
+        (0..self.per_world)
+            .map(|j| self.parts[k].grids.read_field(i * self.per_world + j))
+            .collect()
+    }
+
+    /// Queues world `w`'s trail segments of this step for [`WorldFields::step`], in order.
+    pub fn add_segments(&mut self, w: usize, segments: &[TrailSegment]) -> Result<()> {
+        let (k, i) = self.locate(w)?;
+        let per_world = self.per_world;
+        for s in segments {
+            if s.pheromone >= per_world {
+                return Err(GpuError::Invalid(format!(
+                    "world {w}: a trail on pheromone {} of {per_world}",
+                    s.pheromone
+                )));
+            }
+            self.parts[k].deposits.push(Deposit {
+                field: i * per_world + s.pheromone,
+                kernel: s.kernel,
+                a: s.from,
+                b: s.to,
+                amount: s.amount,
+            });
+        }
+        Ok(())
+    }
+
+    /// Queues a colour sensor of world `w` whose footprint averages `points`: its level sum comes
+    /// back from [`WorldFields::sense`], after the ones queued before it.
+    pub fn add_sensor(&mut self, w: usize, points: [Vec2; POINTS_PER_SENSOR]) -> Result<()> {
+        let (k, i) = self.locate(w)?;
+        self.parts[k].queries.push(SensorQuery {
+            world: i as u32,
+            points,
+        });
+        Ok(())
+    }
+
+    /// Steps every world's fields by `dt` (the passes of [`GridField::step`]), then lays the trail
+    /// segments queued since the last call, in the order of a world's step on the CPU.
+    pub fn step(&mut self, dt: f32) -> Result<()> {
+        for part in &mut self.parts {
+            part.grids.step(dt)?;
+            let deposits = std::mem::take(&mut part.deposits);
+            part.grids.deposit(&deposits)?;
+            part.deposits = deposits;
+            part.deposits.clear();
+        }
+        Ok(())
+    }
+
+    /// The 8-bit screen level sums (r, g, b) of the sensors queued since the last call, in the order
+    /// queued (worlds of a later part after those of an earlier one), at the fields as they are now.
+    pub fn sense(&mut self, out: &mut Vec<[u32; 3]>) -> Result<()> {
+        out.clear();
+        for part in &mut self.parts {
+            let sums = self.screen.sense(
+                Some(&part.grids),
+                &part.scene,
+                &self.screen_spec,
+                &part.queries,
+            )?;
+            out.extend_from_slice(&sums);
+            part.queries.clear();
+        }
+        Ok(())
+    }
+}
