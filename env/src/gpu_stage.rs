@@ -10,6 +10,7 @@
 use crate::error::{EnvError, Result};
 use crate::world_slot::WorldSlot;
 use crate::world_step::Begun;
+use rayon::prelude::*;
 
 /// A GPU error as the environment's.
 fn backend_error(e: colcos_gpu::GpuError) -> EnvError {
@@ -38,6 +39,7 @@ impl GpuStage {
             ctx,
             first.pheromones(),
             slots.len(),
+            4 * first.robot_count(),
             first.screen().clone(),
         )
         .map_err(backend_error)?;
@@ -51,12 +53,23 @@ impl GpuStage {
         Ok(stage)
     }
 
-    /// Loads the worlds that are fresh and for which `now(w)` holds.
+    /// Loads the worlds that are fresh and for which `now(w)` holds: their fields and their sensors'
+    /// footprints.
     fn load_fresh(&mut self, slots: &mut [WorldSlot], now: impl Fn(usize) -> bool) -> Result<()> {
+        let mut sets = Vec::with_capacity(4 * self.robots);
         for (w, slot) in slots.iter_mut().enumerate() {
             if slot.fresh && now(w) {
+                let world = &slot.world;
+                (self.fields)
+                    .load_world(w, world.pheromones())
+                    .map_err(backend_error)?;
+                sets.clear();
+                for i in 0..self.robots {
+                    let set = self.fields.footprint(&world.footprint_offsets(i));
+                    sets.extend([set; 4]);
+                }
                 self.fields
-                    .load_world(w, slot.world.pheromones())
+                    .set_footprints(w, &sets)
                     .map_err(backend_error)?;
                 slot.fresh = false;
             }
@@ -85,13 +98,16 @@ impl GpuStage {
             }
         }
         self.fields.step(dt).map_err(backend_error)?;
-        for (w, slot) in slots.iter().enumerate() {
-            for i in 0..self.robots {
-                for points in slot.world.footprint_points(i) {
-                    self.fields.add_sensor(w, points).map_err(backend_error)?;
+        let robots = self.robots;
+        (self.fields.centres_mut().par_chunks_mut(4 * robots.max(1)))
+            .zip(slots.par_iter_mut())
+            .for_each(|(centres, slot)| {
+                for (i, c) in centres.chunks_exact_mut(4).enumerate() {
+                    for (c, p) in c.iter_mut().zip(slot.world.sensor_centres(i)) {
+                        *c = [p.x, p.y];
+                    }
                 }
-            }
-        }
+            });
         self.fields.sense(&mut self.sums).map_err(backend_error)
     }
 

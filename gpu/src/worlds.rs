@@ -5,8 +5,8 @@
 //! The worlds share one scenario, so their grids have one spec: world `w`'s pheromone `j` is field
 //! `w * P + j` of a [`GpuGrids`] batch (`P` pheromones a world). A batch larger than the adapter's
 //! largest storage binding is cut into parts of whole worlds, each stepped and sensed on its own.
-use crate::screen::{GpuScreen, POINTS_PER_SENSOR, ScreenLayer, ScreenScene, SensorQuery};
-use crate::{Deposit, GpuContext, GpuError, GpuGrids, Result};
+use crate::screen::{FootprintSets, GpuScreen, POINTS_PER_SENSOR, SensorBatch};
+use crate::{Deposit, GpuContext, GpuError, GpuGrids, Result, storage};
 use colcos_sim::field::{FieldModel, GridField, GridParams, GridSpec, Pheromone};
 use colcos_sim::screen::ScreenSpec;
 use colcos_sim::world::TrailSegment;
@@ -16,14 +16,13 @@ use std::sync::Arc;
 /// Most fields one part may hold (the batch's workgroup limit along z).
 const MAX_PART_FIELDS: usize = 65_535;
 
-/// Worlds `first..first + worlds` of the batch: their grids and their screens' layers.
+/// Worlds `first..first + worlds` of the batch: their grids and their sensing buffers.
 struct Part {
     first: usize,
     worlds: usize,
     grids: GpuGrids,
-    scene: ScreenScene,
+    sensing: SensorBatch,
     deposits: Vec<Deposit>,
-    queries: Vec<SensorQuery>,
 }
 
 /// The grid pheromones of `worlds` worlds of one scenario, on one device.
@@ -31,10 +30,22 @@ pub struct WorldFields {
     ctx: Arc<GpuContext>,
     spec: GridSpec,
     screen_spec: ScreenSpec,
-    /// Pheromones a world has (all grids).
+    /// Pheromones a world has (all grids), and their colours.
     per_world: usize,
+    colours: Vec<[f32; 3]>,
     parts: Vec<Part>,
     screen: GpuScreen,
+    /// Colour sensors a world has.
+    sensors: usize,
+    /// Every sensor's centre this step, `[E, sensors]`.
+    centres: Vec<[f32; 2]>,
+    /// Every sensor's footprint (a set of [`FootprintSets`]), `[E, sensors]`, and whether it changed
+    /// since the last upload.
+    sets: Vec<u32>,
+    sets_changed: bool,
+    footprints: FootprintSets,
+    /// Every part's sums together, for one read-back (several parts only).
+    all_sums: Option<wgpu::Buffer>,
 }
 
 /// Why a world's pheromones cannot live in a [`WorldFields`] batch, or `None` if they can: every
@@ -66,11 +77,13 @@ fn grids_of(pheromones: &[Pheromone]) -> impl Iterator<Item = &GridField> {
 
 impl WorldFields {
     /// A batch of `worlds` worlds whose pheromones are like `pheromones` (colours, grid, parameters),
-    /// all zero until [`WorldFields::load_world`]; `screen` is the scenario's screen.
+    /// all zero until [`WorldFields::load_world`], with `sensors` colour sensors a world; `screen` is
+    /// the scenario's screen.
     pub fn new(
         ctx: Arc<GpuContext>,
         pheromones: &[Pheromone],
         worlds: usize,
+        sensors: usize,
         screen: ScreenSpec,
     ) -> Result<Self> {
         if let Some(why) = unsupported(pheromones) {
@@ -84,42 +97,46 @@ impl WorldFields {
         let world_bytes = 2 * spec.len() as u64 * per_world as u64 * 4;
         let fit = (ctx.max_binding() / world_bytes.max(1)) as usize;
         let per_part = fit.min(MAX_PART_FIELDS / per_world).max(1);
-        let colours: Vec<[f32; 3]> = pheromones.iter().map(|p| p.colour).collect();
+        let gpu_screen = GpuScreen::new(ctx.clone())?;
         let mut parts = Vec::new();
         let mut first_world = 0;
         while first_world < worlds {
             let n = per_part.min(worlds - first_world);
             let all: Vec<GridParams> = (0..n).flat_map(|_| params.iter().copied()).collect();
-            let grids = GpuGrids::new(ctx.clone(), spec, &all)?;
-            let scene = ScreenScene {
-                worlds: (0..n)
-                    .map(|w| {
-                        (colours.iter().enumerate())
-                            .map(|(j, &colour)| ScreenLayer::Grid {
-                                colour,
-                                field: w * per_world + j,
-                            })
-                            .collect()
-                    })
-                    .collect(),
-            };
             parts.push(Part {
                 first: first_world,
                 worlds: n,
-                grids,
-                scene,
+                grids: GpuGrids::new(ctx.clone(), spec, &all)?,
+                sensing: gpu_screen.sensor_batch(n, sensors, per_world)?,
                 deposits: Vec::new(),
-                queries: Vec::new(),
             });
             first_world += n;
         }
+        let all_sums = match parts.len() {
+            1 => None,
+            _ => Some(ctx.scoped("allocating the sensor sums", || {
+                storage(
+                    &ctx,
+                    "colcos all sensor sums",
+                    (worlds * sensors) as u64 * 12,
+                    wgpu::BufferUsages::empty(),
+                )
+            })?),
+        };
         Ok(WorldFields {
-            screen: GpuScreen::new(ctx.clone())?,
+            screen: gpu_screen,
+            footprints: FootprintSets::new(ctx.clone())?,
             ctx,
             spec,
             screen_spec: screen,
             per_world,
+            colours: pheromones.iter().map(|p| p.colour).collect(),
             parts,
+            sensors,
+            centres: vec![[0.0; 2]; worlds * sensors],
+            sets: vec![0; worlds * sensors],
+            sets_changed: true,
+            all_sums,
         })
     }
 
@@ -201,15 +218,36 @@ impl WorldFields {
         Ok(())
     }
 
-    /// Queues a colour sensor of world `w` whose footprint averages `points`: its level sum comes
-    /// back from [`WorldFields::sense`], after the ones queued before it.
-    pub fn add_sensor(&mut self, w: usize, points: [Vec2; POINTS_PER_SENSOR]) -> Result<()> {
-        let (k, i) = self.locate(w)?;
-        self.parts[k].queries.push(SensorQuery {
-            world: i as u32,
-            points,
-        });
+    /// The index of the footprint whose sample points are `offsets` from a sensor's centre (see
+    /// [`colcos_sim::sensors::ColourSensor::sample_points`]), for [`WorldFields::set_footprints`].
+    pub fn footprint(&mut self, offsets: &[Vec2; POINTS_PER_SENSOR]) -> u32 {
+        self.footprints.set_of(offsets)
+    }
+
+    /// Sets world `w`'s sensors' footprints (one index of [`WorldFields::footprint`] per sensor).
+    pub fn set_footprints(&mut self, w: usize, sets: &[u32]) -> Result<()> {
+        if w >= self.len() || sets.len() != self.sensors {
+            return Err(GpuError::Invalid(format!(
+                "world {w}: {} footprints for {} sensors (worlds: {})",
+                sets.len(),
+                self.sensors,
+                self.len()
+            )));
+        }
+        self.sets[w * self.sensors..][..self.sensors].copy_from_slice(sets);
+        self.sets_changed = true;
         Ok(())
+    }
+
+    /// Every sensor's centre for the next [`WorldFields::sense`], `[E, sensors]` (world by world, a
+    /// world's sensors in the order of its footprints).
+    pub fn centres_mut(&mut self) -> &mut [[f32; 2]] {
+        &mut self.centres
+    }
+
+    /// Colour sensors a world has.
+    pub fn sensors(&self) -> usize {
+        self.sensors
     }
 
     /// Steps every world's fields by `dt` (the passes of [`GridField::step`]), then lays the trail
@@ -225,20 +263,52 @@ impl WorldFields {
         Ok(())
     }
 
-    /// The 8-bit screen level sums (r, g, b) of the sensors queued since the last call, in the order
-    /// queued (worlds of a later part after those of an earlier one), at the fields as they are now.
+    /// The 8-bit screen level sums (r, g, b) of every sensor at its centre of
+    /// [`WorldFields::centres_mut`] and its footprint, `[E, sensors]`, at the fields as they are now:
+    /// one dispatch a part, one read-back.
     pub fn sense(&mut self, out: &mut Vec<[u32; 3]>) -> Result<()> {
+        let s = self.sensors;
         out.clear();
-        for part in &mut self.parts {
-            let sums = self.screen.sense(
-                Some(&part.grids),
-                &part.scene,
-                &self.screen_spec,
-                &part.queries,
-            )?;
-            out.extend_from_slice(&sums);
-            part.queries.clear();
+        if self.parts.is_empty() {
+            return Ok(());
         }
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        for part in &mut self.parts {
+            let range = part.first * s..(part.first + part.worlds) * s;
+            let sets = self.sets_changed.then(|| &self.sets[range.clone()]);
+            self.screen.record_batch(
+                &mut enc,
+                &part.grids,
+                &self.colours,
+                &mut part.sensing,
+                &mut self.footprints,
+                &self.centres[range],
+                sets,
+                &self.screen_spec,
+            )?;
+            if let Some(all) = &self.all_sums {
+                let bytes = part.sensing.len() as u64 * 12;
+                enc.copy_buffer_to_buffer(
+                    part.sensing.out(),
+                    0,
+                    all,
+                    part.first as u64 * s as u64 * 12,
+                    bytes,
+                );
+            }
+        }
+        self.sets_changed = false;
+        self.ctx
+            .scoped("sensing", || self.ctx.queue.submit([enc.finish()]))?;
+        let src = match &self.all_sums {
+            Some(all) => all,
+            None => self.parts[0].sensing.out(),
+        };
+        let bytes = self
+            .ctx
+            .read_buffer(src, 0, self.centres.len() as u64 * 12)?;
+        let sums: &[u32] = bytemuck::cast_slice(&bytes);
+        out.extend(sums.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
         Ok(())
     }
 }

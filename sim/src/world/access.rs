@@ -142,10 +142,14 @@ impl World {
     pub fn trail_segments(&self) -> &[super::TrailSegment] {
         self.injection.segments()
     }
-    /// Robot `i`'s four colour sensors' screen points at the current poses (see
-    /// [`super::Sensing::footprint_points`]).
-    pub fn footprint_points(&self, i: usize) -> [[Vec2; crate::sensors::RING_POINTS + 1]; 4] {
-        self.sensing.footprint_points(i)
+    /// Robot `i`'s four colour sensors' centres at the current poses.
+    pub fn sensor_centres(&self, i: usize) -> [Vec2; 4] {
+        self.sensing.sensor_centres(i)
+    }
+    /// Where robot `i`'s colour sensors sample the screen, from a sensor's centre (see
+    /// [`super::Sensing::footprint_offsets`]).
+    pub fn footprint_offsets(&self, i: usize) -> [Vec2; crate::sensors::RING_POINTS + 1] {
+        self.sensing.footprint_offsets(i)
     }
     /// The installed field backend's description, or `None` for the CPU.
     pub fn field_backend(&self) -> Option<String> {

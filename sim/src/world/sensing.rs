@@ -96,15 +96,19 @@ impl Sensing {
     pub fn neighbours(&self) -> &NeighbourIndex {
         &self.neighbours
     }
-    /// The screen points robot `i`'s four colour sensors average (nine each, see
-    /// [`ColourSensor::sample_points`]) at the poses last indexed: what [`sense_from_sums`] wants the
-    /// level sums of.
-    pub fn footprint_points(&self, i: usize) -> [[Vec2; crate::sensors::RING_POINTS + 1]; 4] {
+    /// Robot `i`'s four colour sensors' centres at the poses last indexed.
+    pub fn sensor_centres(&self, i: usize) -> [Vec2; 4] {
+        self.sensor_points[i]
+    }
+    /// Where robot `i`'s colour sensors sample the screen, from each sensor's centre (the same for
+    /// its four: [`ColourSensor::sample_points`] adds a centre to them): what [`sense_from_sums`]
+    /// wants the level sums over.
+    pub fn footprint_offsets(&self, i: usize) -> [Vec2; crate::sensors::RING_POINTS + 1] {
         let sampler = self
             .robot_sensors
             .get(i)
             .map_or(&self.sensor, |own| &own.truth[0]);
-        self.sensor_points[i].map(|p| sampler.sample_points(p))
+        sampler.sample_points(Vec2::ZERO)
     }
     /// What each robot sensed last.
     pub fn observations(&self) -> &[Observation] {
@@ -155,8 +159,8 @@ pub fn sense(
 }
 
 /// Stage `sense` with the colour sensors' footprint level sums given (four per robot, in robot then
-/// sensor order, at the points of [`Sensing::footprint_points`]), e.g. from a GPU that holds the
-/// grid pheromones: the same observations and random draws as [`sense`] on a screen with those sums.
+/// sensor order, over [`Sensing::footprint_offsets`] from [`Sensing::sensor_centres`]), e.g. from a
+/// GPU that holds the grid pheromones: the same observations and random draws as [`sense`] on a screen with those sums.
 ///
 /// # Panics
 /// If `sums` does not hold four entries per robot.

@@ -131,7 +131,8 @@ impl World {
 
     /// Ends a step of a world whose grid pheromones live outside it
     /// ([`crate::world::FieldSet::set_external_grids`]): every robot's observation from the colour
-    /// sensors' footprint level sums `sums` (four per robot, at [`World::footprint_points`]), as
+    /// sensors' footprint level sums `sums` (four per robot, over [`World::footprint_offsets`] from
+    /// [`World::sensor_centres`]), as
     /// [`World::step`] would sense them on a screen with those sums.
     ///
     /// # Panics
