@@ -54,16 +54,24 @@ fn rate(
         env.step(Actions::Continuous(p))
             .map_err(|e| e.to_string())?;
     }
+    let before = env.gpu_stage_seconds();
     let t0 = Instant::now();
     for k in 0..steps {
         env.step(Actions::Continuous(&pool[k % 8]))
             .map_err(|e| e.to_string())?;
     }
     let secs = t0.elapsed().as_secs_f64();
-    Ok((
-        (worlds * s.num_agents * steps) as f64 / secs,
-        env.backend().describe().to_string(),
-    ))
+    let mut how = env.backend().describe().to_string();
+    if let (Some(a), Some(b)) = (before, env.gpu_stage_seconds()) {
+        let ms = |k: usize| (b[k] - a[k]) * 1e3 / steps as f64;
+        how.push_str(&format!(
+            "; ms a step: motion {:.2}, GPU stage {:.2}, observations and rewards {:.2}",
+            ms(0),
+            ms(1),
+            ms(2)
+        ));
+    }
+    Ok(((worlds * s.num_agents * steps) as f64 / secs, how))
 }
 
 fn main() {

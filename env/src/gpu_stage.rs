@@ -26,6 +26,9 @@ pub(crate) struct GpuStage {
     robots: usize,
     /// How each world began the current step.
     pub(crate) begun: Vec<Begun>,
+    /// Seconds spent in the three parts of the steps so far: motion, this stage, observations and
+    /// rewards.
+    pub(crate) seconds: [f64; 3],
 }
 
 impl GpuStage {
@@ -48,6 +51,7 @@ impl GpuStage {
             sums: Vec::new(),
             robots: first.robot_count(),
             begun: vec![Begun::Stepped; slots.len()],
+            seconds: [0.0; 3],
         };
         stage.load_fresh(slots, |_| true)?;
         Ok(stage)

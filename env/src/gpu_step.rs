@@ -10,6 +10,7 @@ use crate::world_slot::WorldSlot;
 use crate::world_step::{Begun, Ctx, Evaluation, after_motion, begin_world, finish_motion};
 use colcos_sim::behaviour::WheelCommand;
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// One step of every world with the fields on the GPU, on the current rayon pool.
 #[allow(clippy::too_many_arguments)]
@@ -25,6 +26,7 @@ pub(crate) fn step_batch_gpu(
 ) -> Result<()> {
     let c = chunks.size();
     let per_world = len.agents * len.deposits;
+    let t0 = Instant::now();
     // 1. Motion: decisions, shield, physics, tracking, the Gaussian fields' clocks, trail segments.
     chunks
         .par_iter_mut(slots)
@@ -60,6 +62,7 @@ pub(crate) fn step_batch_gpu(
                 result
             },
         )?;
+    let t1 = Instant::now();
     // 2. Fields, deposits and sensing of every world on the GPU.
     stage.run(slots, ctx.scenario.spec.dt)?;
     if ctx.patch.is_some() || matches!(ctx.evaluation, Evaluation::Deferred) {
@@ -67,11 +70,11 @@ pub(crate) fn step_batch_gpu(
         stage.sync(slots)?;
     }
     // 3. Observations from the sums, rewards, outputs.
-    let stage = &*stage;
-    chunks
+    let t2 = Instant::now();
+    let concluded = chunks
         .par_iter_mut(slots)
         .zip(split(buffers, c, len))
-        .zip(stage.begun.par_chunks(c))
+        .zip((*stage).begun.par_chunks(c))
         .enumerate()
         .try_for_each(|(k, (((slots, mut host), mut buffers), begun))| {
             let mut result = Ok(());
@@ -80,7 +83,7 @@ pub(crate) fn step_batch_gpu(
                     continue;
                 }
                 let w = k * c + i;
-                slot.world.sense_from_sums(stage.sums_of(w));
+                slot.world.sense_from_sums((*stage).sums_of(w));
                 let mut out = buffers.world(i, len);
                 let in_host = host.as_deref_mut().map(|h| (h, i));
                 let done = after_motion(ctx, w, slot, &mut out, in_host);
@@ -89,5 +92,10 @@ pub(crate) fn step_batch_gpu(
                 }
             }
             result
-        })
+        });
+    let t3 = Instant::now();
+    for (total, (a, b)) in stage.seconds.iter_mut().zip([(t0, t1), (t1, t2), (t2, t3)]) {
+        *total += (b - a).as_secs_f64();
+    }
+    concluded
 }

@@ -550,6 +550,15 @@ impl VecEnv {
         self.shield_flags.fill(0);
     }
 
+    /// Seconds spent since construction in the parts of a step with the GPU batch: motion, the GPU
+    /// stage, observations and rewards (`None` without the batch).
+    pub fn gpu_stage_seconds(&self) -> Option<[f64; 3]> {
+        #[cfg(feature = "gpu")]
+        return self.gpu.as_ref().map(|g| g.seconds);
+        #[cfg(not(feature = "gpu"))]
+        None
+    }
+
     /// Brings the worlds' grid pheromones on the CPU ([`VecEnv::world`]'s `pheromones()`) up to date
     /// with the GPU batch that steps them (nothing to do on the CPU backend, where they always are).
     pub fn sync_fields(&mut self) -> Result<()> {

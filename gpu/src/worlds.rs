@@ -86,6 +86,19 @@ impl WorldFields {
         sensors: usize,
         screen: ScreenSpec,
     ) -> Result<Self> {
+        Self::in_parts(ctx, pheromones, worlds, sensors, screen, usize::MAX)
+    }
+
+    /// [`WorldFields::new`] with at most `part` worlds a part (fewer where the adapter's bindings
+    /// hold fewer): smaller buffers, and a way to test batches of several parts.
+    pub fn in_parts(
+        ctx: Arc<GpuContext>,
+        pheromones: &[Pheromone],
+        worlds: usize,
+        sensors: usize,
+        screen: ScreenSpec,
+        part: usize,
+    ) -> Result<Self> {
         if let Some(why) = unsupported(pheromones) {
             return Err(GpuError::Invalid(why));
         }
@@ -96,7 +109,7 @@ impl WorldFields {
         // Worlds a part: as many as one binding of two slots per field holds.
         let world_bytes = 2 * spec.len() as u64 * per_world as u64 * 4;
         let fit = (ctx.max_binding() / world_bytes.max(1)) as usize;
-        let per_part = fit.min(MAX_PART_FIELDS / per_world).max(1);
+        let per_part = fit.min(MAX_PART_FIELDS / per_world).min(part).max(1);
         let gpu_screen = GpuScreen::new(ctx.clone())?;
         let mut parts = Vec::new();
         let mut first_world = 0;
