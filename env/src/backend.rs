@@ -37,10 +37,17 @@ impl EnvBackend {
     /// else the CPU.
     #[cfg(feature = "gpu")]
     pub fn resolve(choice: BackendChoice, worlds: usize, scenario: &Scenario) -> Result<Self> {
-        if choice == BackendChoice::Auto && worlds < AUTO_GPU_MIN_WORLDS {
+        let resolve = |choice: BackendChoice| {
+            colcos_gpu::SharedBackend::resolve(choice)
+                .map_err(|e| EnvError::Backend(format!("field backend {choice}: {e}")))
+        };
+        let shared = resolve(choice)?;
+        if choice == BackendChoice::Auto
+            && shared.context().is_some()
+            && worlds < AUTO_GPU_MIN_WORLDS
+        {
             return Ok(EnvBackend {
-                shared: colcos_gpu::SharedBackend::resolve(BackendChoice::Cpu)
-                    .map_err(|e| EnvError::Backend(format!("field backend cpu: {e}")))?,
+                shared: resolve(BackendChoice::Cpu)?,
                 description: format!(
                     "cpu (auto: {worlds} worlds, the GPU pays from {AUTO_GPU_MIN_WORLDS})"
                 ),
@@ -48,8 +55,6 @@ impl EnvBackend {
                 batched: false,
             });
         }
-        let shared = colcos_gpu::SharedBackend::resolve(choice)
-            .map_err(|e| EnvError::Backend(format!("field backend {choice}: {e}")))?;
         let mut description = shared.selection().to_string();
         let gpu = shared.context().is_some();
         let mut batched = false;

@@ -10,6 +10,7 @@
 use crate::error::{EnvError, Result};
 use crate::world_slot::WorldSlot;
 use crate::world_step::Begun;
+use colcos_sim::field::{FieldModel, GridField, Pheromone};
 use rayon::prelude::*;
 
 /// A GPU error as the environment's.
@@ -32,6 +33,17 @@ pub(crate) struct GpuStage {
 }
 
 impl GpuStage {
+    /// The batch of `slots`' worlds where `backend` keeps their grids in one, each world's loaded.
+    pub(crate) fn for_backend(
+        backend: &crate::backend::EnvBackend,
+        slots: &mut [WorldSlot],
+    ) -> Result<Option<Self>> {
+        match backend.batch_context() {
+            Some(ctx) => Self::new(ctx.clone(), slots).map(Some),
+            None => Ok(None),
+        }
+    }
+
     /// The batch of `slots`' worlds on `ctx`, each world's grids loaded.
     pub(crate) fn new(
         ctx: std::sync::Arc<colcos_gpu::GpuContext>,
@@ -135,10 +147,40 @@ impl GpuStage {
     }
 }
 
+impl GpuStage {
+    /// World `w`'s pheromones with the batch's values (the world's own where it was built since the
+    /// last load), for a render.
+    pub(crate) fn pheromones_of(&self, w: usize, slot: &WorldSlot) -> Result<Vec<Pheromone>> {
+        let values = if slot.fresh {
+            Vec::new()
+        } else {
+            self.fields.read_world(w).map_err(backend_error)?
+        };
+        let mut copy: Vec<Pheromone> = (slot.world.pheromones().iter())
+            .filter_map(|p| match &p.model {
+                FieldModel::Grid(g) => {
+                    let mut grid = GridField::new(*g.spec(), *g.params());
+                    grid.values_mut().copy_from_slice(g.values());
+                    Some(Pheromone {
+                        name: p.name.clone(),
+                        colour: p.colour,
+                        model: FieldModel::Grid(grid),
+                    })
+                }
+                FieldModel::Gaussian(_) => None,
+            })
+            .collect();
+        if !values.is_empty() {
+            write_values(&mut copy, &values);
+        }
+        Ok(copy)
+    }
+}
+
 /// Overwrites the grid pheromones' values with `values` (one per grid pheromone, in order).
-fn write_values(pheromones: &mut [colcos_sim::field::Pheromone], values: &[Vec<f32>]) {
+fn write_values(pheromones: &mut [Pheromone], values: &[Vec<f32>]) {
     let grids = pheromones.iter_mut().filter_map(|p| match &mut p.model {
-        colcos_sim::field::FieldModel::Grid(g) => Some(g),
+        FieldModel::Grid(g) => Some(g),
         _ => None,
     });
     for (g, v) in grids.zip(values) {

@@ -11,8 +11,8 @@ use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
 use crate::error::{EnvError, Result};
 use crate::spaces::{EnvSpec, Space};
 use crate::task::{Task, registry};
-pub use crate::world_output::render_world;
 use crate::world_output::{obs_dim, write_patch, write_state, write_task_obs};
+pub use crate::world_output::{render_world, render_world_with};
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
 use crate::world_step::{Ctx, Evaluation, step_world};
@@ -170,10 +170,7 @@ impl VecEnv {
         pool.install(|| chunks.attach_all(&mut slots));
         backend.settle(&slots[0].world);
         #[cfg(feature = "gpu")]
-        let gpu = match backend.batch_context() {
-            Some(ctx) => Some(crate::gpu_stage::GpuStage::new(ctx.clone(), &mut slots)?),
-            None => None,
-        };
+        let gpu = crate::gpu_stage::GpuStage::for_backend(&backend, &mut slots)?;
         let mut env = VecEnv {
             spec,
             task,
@@ -478,12 +475,10 @@ impl VecEnv {
         let (slots, chunks) = (&mut self.slots, &mut self.chunks);
         #[cfg(feature = "gpu")]
         if let (Some(stage), Some(_)) = (self.gpu.as_mut(), actions) {
-            let (commands, rates) = (&self.commands, &self.deposit_rates);
-            return self.pool.install(|| {
-                crate::gpu_step::step_batch_gpu(
-                    &ctx, slots, chunks, stage, commands, rates, buffers, len,
-                )
-            });
+            let (cmds, rates) = (&self.commands, &self.deposit_rates);
+            let step = crate::gpu_step::step_batch_gpu;
+            return (self.pool)
+                .install(|| step(&ctx, slots, chunks, stage, cmds, rates, buffers, len));
         }
         if actions.is_none() {
             return self
@@ -550,8 +545,7 @@ impl VecEnv {
         self.shield_flags.fill(0);
     }
 
-    /// Seconds spent since construction in the parts of a step with the GPU batch: motion, the GPU
-    /// stage, observations and rewards (`None` without the batch).
+    /// Seconds in the parts of the steps with the GPU batch: motion, GPU stage, observations.
     pub fn gpu_stage_seconds(&self) -> Option<[f64; 3]> {
         #[cfg(feature = "gpu")]
         return self.gpu.as_ref().map(|g| g.seconds);
@@ -569,8 +563,7 @@ impl VecEnv {
         Ok(())
     }
 
-    /// The screen with the robots drawn on it, `width` pixels wide, of world `e` (with the GPU batch,
-    /// its fields as of the last [`VecEnv::sync_fields`]).
+    /// The screen with the robots drawn on it, `width` pixels wide, of world `e`.
     pub fn render(&self, e: usize, width: u32) -> Result<image::RgbImage> {
         let slot = self.slots.get(e).ok_or_else(|| {
             EnvError::param(
@@ -578,6 +571,16 @@ impl VecEnv {
                 format!("{e} is not below num_envs = {}", self.spec.num_envs),
             )
         })?;
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            let world = (&slot.world, &g.pheromones_of(e, slot)?);
+            return Ok(render_world_with(
+                world.0,
+                world.1,
+                self.task.agents(),
+                width,
+            ));
+        }
         Ok(render_world(&slot.world, self.task.agents(), width))
     }
 }

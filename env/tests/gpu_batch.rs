@@ -187,11 +187,55 @@ fn deposit_actions_with_diffusion_equal_the_cpu() {
     fields_agree(&mut gpu, &cpu);
 }
 
-/// `auto` takes the CPU for a small batch whatever the adapter, and never a software adapter.
+/// `auto` takes the CPU for a small batch whatever the adapter (and says why: the batch's size, or
+/// no hardware adapter), and never a software adapter.
 #[test]
 fn auto_takes_the_cpu_for_small_batches_and_software_adapters() {
     let env = VecEnv::new(&cfg("trail", None, 3, BackendChoice::Auto)).unwrap();
     assert_eq!(env.backend().name(), "cpu");
     let d = env.backend().describe();
-    assert!(d.contains("3 worlds") && d.contains("4096"), "{d}");
+    let why = [
+        "3 worlds, the GPU pays from 4096",
+        "software adapter",
+        "no GPU adapter",
+    ];
+    assert!(why.iter().any(|w| d.contains(w)), "{d}");
+}
+
+/// A render draws the batch's fields: the CPU backend's image within one level, where the worlds'
+/// own (stale) CPU copies of the fields lack the trails laid since the episode began.
+#[test]
+fn renders_draw_the_batch_fields() {
+    let mut c = cfg("trail", None, 2, BackendChoice::Gpu);
+    c.max_cycles = 100;
+    let Some(mut gpu) = gpu_env(&c) else { return };
+    c.backend = Some(BackendChoice::Cpu);
+    let mut cpu = VecEnv::new(&c).unwrap();
+    gpu.reset(None, None).unwrap();
+    cpu.reset(None, None).unwrap();
+    let ahead = vec![0.7f32; gpu.spec().num_envs * gpu.spec().num_agents * 2];
+    for _ in 0..40 {
+        gpu.step(Actions::Continuous(&ahead)).unwrap();
+        cpu.step(Actions::Continuous(&ahead)).unwrap();
+    }
+    let agents = gpu.task().agents().to_vec();
+    for w in 0..2 {
+        let (g, c) = (gpu.render(w, 480).unwrap(), cpu.render(w, 480).unwrap());
+        let stale = colcos_env::world_output::render_world(gpu.world(w).unwrap(), &agents, 480);
+        let worst = |a: &image::RgbImage| {
+            (a.iter().zip(c.iter()))
+                .map(|(x, y)| x.abs_diff(*y))
+                .max()
+                .unwrap()
+        };
+        assert!(
+            worst(&g) <= 1,
+            "world {w}: the renders differ by {} levels",
+            worst(&g)
+        );
+        assert!(
+            worst(&stale) > 1,
+            "world {w}: the trails laid show on the stale copy too"
+        );
+    }
 }
