@@ -55,7 +55,7 @@ impl GpuStage {
             first.pheromones(),
             slots.len(),
             4 * first.robot_count(),
-            first.screen().clone(),
+            *first.screen(),
         )
         .map_err(backend_error)?;
         let mut stage = GpuStage {
@@ -136,12 +136,11 @@ impl GpuStage {
     /// Copies every world's grids back into its CPU fields (for what reads them there: patches,
     /// tasks written in Python, renders); a world built since the last load already has them there.
     pub(crate) fn sync(&self, slots: &mut [WorldSlot]) -> Result<()> {
-        for (w, slot) in slots.iter_mut().enumerate() {
-            if slot.fresh {
-                continue;
+        let all = self.fields.read_all().map_err(backend_error)?;
+        for (slot, values) in slots.iter_mut().zip(&all) {
+            if !slot.fresh {
+                write_values(slot.world.pheromones_mut(), values);
             }
-            let values = self.fields.read_world(w).map_err(backend_error)?;
-            write_values(slot.world.pheromones_mut(), &values);
         }
         Ok(())
     }

@@ -74,7 +74,7 @@ pub(crate) fn step_batch_gpu(
     let concluded = chunks
         .par_iter_mut(slots)
         .zip(split(buffers, c, len))
-        .zip((*stage).begun.par_chunks(c))
+        .zip(stage.begun.par_chunks(c))
         .enumerate()
         .try_for_each(|(k, (((slots, mut host), mut buffers), begun))| {
             let mut result = Ok(());
@@ -83,7 +83,7 @@ pub(crate) fn step_batch_gpu(
                     continue;
                 }
                 let w = k * c + i;
-                slot.world.sense_from_sums((*stage).sums_of(w));
+                slot.world.sense_from_sums(stage.sums_of(w));
                 let mut out = buffers.world(i, len);
                 let in_host = host.as_deref_mut().map(|h| (h, i));
                 let done = after_motion(ctx, w, slot, &mut out, in_host);

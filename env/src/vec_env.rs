@@ -11,8 +11,10 @@ use crate::config::{ActionKind, AutoresetMode, EnvConfig, PatchConfig};
 use crate::error::{EnvError, Result};
 use crate::spaces::{EnvSpec, Space};
 use crate::task::{Task, registry};
+pub use crate::world_output::render_world;
+#[cfg(feature = "gpu")]
+use crate::world_output::render_world_with;
 use crate::world_output::{obs_dim, write_patch, write_state, write_task_obs};
-pub use crate::world_output::{render_world, render_world_with};
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
 use crate::world_step::{Ctx, Evaluation, step_world};
@@ -553,8 +555,7 @@ impl VecEnv {
         None
     }
 
-    /// Brings the worlds' grid pheromones on the CPU ([`VecEnv::world`]'s `pheromones()`) up to date
-    /// with the GPU batch that steps them (nothing to do on the CPU backend, where they always are).
+    /// Copies the GPU batch's fields into the worlds' CPU ones (`world(e).pheromones()`).
     pub fn sync_fields(&mut self) -> Result<()> {
         #[cfg(feature = "gpu")]
         if let Some(stage) = &self.gpu {

@@ -23,7 +23,9 @@ pub(crate) struct WorldSlot {
     pub episode: Episode,
     /// Stepped, its rewards and terminations not yet handed out (a task written in Python).
     pub awaiting: bool,
-    /// Built since the GPU batch last loaded its grids (the CPU's are the world's; see `gpu_stage`).
+    /// Built since the GPU batch last loaded its grids (the CPU's are the world's; see `gpu_stage`;
+    /// read only with the `gpu` feature).
+    #[cfg_attr(not(feature = "gpu"), allow(dead_code))]
     pub fresh: bool,
 }
 

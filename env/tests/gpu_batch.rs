@@ -239,3 +239,45 @@ fn renders_draw_the_batch_fields() {
         );
     }
 }
+
+/// A deferred step (a task written in Python) on the GPU batch: the worlds' CPU fields are brought up
+/// to date before the task's hooks would read them, and the concluded outputs are the CPU's.
+#[test]
+fn deferred_steps_see_current_fields_and_conclude_as_the_cpu() {
+    let mut c = cfg("trail", None, 3, BackendChoice::Gpu);
+    c.max_cycles = 6;
+    let Some(mut gpu) = gpu_env(&c) else { return };
+    c.backend = Some(BackendChoice::Cpu);
+    let mut cpu = VecEnv::new(&c).unwrap();
+    gpu.reset(None, None).unwrap();
+    cpu.reset(None, None).unwrap();
+    for step in 0..10 {
+        let a = actions(&gpu, step);
+        cpu.step_deferred(Actions::Continuous(&a)).unwrap();
+        gpu.step_deferred(Actions::Continuous(&a)).unwrap();
+        for w in 0..3 {
+            let (g, c) = (gpu.world(w).unwrap(), cpu.world(w).unwrap());
+            for (pg, pc) in g.pheromones().iter().zip(c.pheromones()) {
+                let (FieldModel::Grid(g), FieldModel::Grid(c)) = (&pg.model, &pc.model) else {
+                    panic!("grid pheromones")
+                };
+                let scale = c.values().iter().fold(1e-12f32, |m, v| m.max(v.abs()));
+                let err = (g.values().iter().zip(c.values()))
+                    .map(|(a, b)| (a - b).abs() / scale)
+                    .fold(0f32, f32::max);
+                assert!(
+                    err <= 1e-5,
+                    "step {step}, world {w}: stale fields ({err:e})"
+                );
+            }
+        }
+        let (r, t) = (
+            vec![0.5; cpu.rewards().len()],
+            vec![false; cpu.rewards().len()],
+        );
+        cpu.conclude(&r, &t).unwrap();
+        gpu.conclude(&r, &t).unwrap();
+        assert_eq!(gpu.obs(), cpu.obs(), "step {step}");
+        assert_eq!(gpu.truncated(), cpu.truncated(), "step {step}");
+    }
+}

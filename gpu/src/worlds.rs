@@ -209,6 +209,18 @@ impl WorldFields {
             .collect()
     }
 
+    /// Every world's field values (blocking; one read-back a part): `[world][pheromone][cell]`.
+    pub fn read_all(&self) -> Result<Vec<Vec<Vec<f32>>>> {
+        let mut out = Vec::with_capacity(self.len());
+        for part in &self.parts {
+            let mut fields = part.grids.read_all()?.into_iter();
+            for _ in 0..part.worlds {
+                out.push(fields.by_ref().take(self.per_world).collect());
+            }
+        }
+        Ok(out)
+    }
+
     /// Queues world `w`'s trail segments of this step for [`WorldFields::step`], in order.
     pub fn add_segments(&mut self, w: usize, segments: &[TrailSegment]) -> Result<()> {
         let (k, i) = self.locate(w)?;

@@ -66,7 +66,7 @@ fn worlds_sensing_from_the_batch_observe_what_cpu_worlds_observe() {
         .map(|w| World::with_index(&sc, w as u64).unwrap())
         .collect();
     let robots = gpu[0].robot_count();
-    let screen = gpu[0].screen().clone();
+    let screen = *gpu[0].screen();
     let mut fields =
         WorldFields::in_parts(ctx, gpu[0].pheromones(), n, 4 * robots, screen, 2).unwrap();
     assert_eq!(fields.parts(), 3, "five worlds in parts of two");
