@@ -17,8 +17,9 @@ export COLCOS_REQUIRE_GPU=1 COLCOS_REQUIRE_DISPLAY=1
 # GPU against CPU: every scheme and option, screens and sensors of both case studies, worlds; wgpu
 # errors and a lost device as Err values.
 cargo test --release -p colcos-gpu -- --test-threads=1
-# A vector env's worlds on the GPU (the scenario's [field] backend): the CPU's observations.
-cargo test --release -p colcos-env --features gpu --test backend -- --test-threads=1
+# A vector env's worlds on the GPU (the scenario's [field] backend): every world's fields, deposits and
+# sensing in one resident batch, the CPU's observations, rewards and resets.
+cargo test --release -p colcos-env --features gpu --test backend --test gpu_batch -- --test-threads=1
 # The window under Xvfb: screenshot against the headless PNG.
 xvfb-run -a -s "-screen 0 640x480x24" cargo test --release -p colcos-display -- --test-threads=1
 # The CLI: `gpu` on lavapipe works, `auto` prefers the CPU over a software adapter.

@@ -20,6 +20,10 @@ pub mod config;
 pub mod encoding;
 pub mod episode;
 pub mod error;
+#[cfg(feature = "gpu")]
+mod gpu_stage;
+#[cfg(feature = "gpu")]
+mod gpu_step;
 pub mod outputs;
 pub mod patch;
 pub mod policy;

@@ -176,7 +176,8 @@ impl<'a> OutSlices<'a> {
         self.reborrow().into_world(i)
     }
 
-    fn reborrow(&mut self) -> OutSlices<'_> {
+    /// The same slices, borrowed again (for a step that walks the batch twice).
+    pub fn reborrow(&mut self) -> OutSlices<'_> {
         OutSlices {
             len: self.len,
             obs: self.obs,

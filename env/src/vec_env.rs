@@ -14,6 +14,8 @@ use crate::spaces::{EnvSpec, Space};
 use crate::task::{Task, registry};
 use crate::world_output::obs_dim;
 pub use crate::world_output::render_world;
+#[cfg(feature = "gpu")]
+use crate::world_output::render_world_with;
 use crate::world_slot::WorldSlot;
 pub use crate::world_step::shield_bits;
 use crate::world_step::{Ctx, Evaluation, step_world};
@@ -33,6 +35,9 @@ pub struct VecEnv {
     slots: Vec<WorldSlot>,
     /// The chunks the worlds are stepped in, with their rapier hosts (see `batch_step`).
     chunks: Chunks,
+    /// Every world's grid pheromones resident on the GPU (`backend = "gpu"` where they allow it).
+    #[cfg(feature = "gpu")]
+    gpu: Option<crate::gpu_stage::GpuStage>,
     out: Outputs,
     writer: Writer,
     shield: Option<Shield>,
@@ -59,7 +64,8 @@ impl VecEnv {
         if let Some(p) = cfg.physics {
             scenario.spec.physics = p;
         }
-        let mut backend = EnvBackend::resolve(scenario.spec.field.backend)?;
+        let mut backend =
+            EnvBackend::resolve(scenario.spec.field.backend, cfg.num_envs, &scenario)?;
         let max_cycles = if cfg.max_cycles > 0 {
             cfg.max_cycles
         } else {
@@ -160,6 +166,8 @@ impl VecEnv {
             state: cfg.global_state,
             patch: cfg.patch,
         };
+        #[cfg(feature = "gpu")]
+        let gpu = crate::gpu_stage::GpuStage::for_backend(&backend, &mut slots)?;
         let mut env = VecEnv {
             out: Outputs::new(&spec),
             writer,
@@ -171,6 +179,8 @@ impl VecEnv {
             pool,
             slots,
             chunks,
+            #[cfg(feature = "gpu")]
+            gpu,
             shield,
             commands: vec![Default::default(); e * n],
             deposit_rates: vec![0.0; e * n * decoder.deposits()],
@@ -379,6 +389,12 @@ impl VecEnv {
         };
         let buffers = self.out.all();
         let (slots, chunks) = (&mut self.slots, &mut self.chunks);
+        #[cfg(feature = "gpu")]
+        if let (Some(stage), Some(_)) = (self.gpu.as_mut(), actions) {
+            let (cmds, rates) = (&self.commands, &self.deposit_rates);
+            let step = crate::gpu_step::step_batch_gpu;
+            return (self.pool).install(|| step(&ctx, slots, chunks, stage, cmds, rates, buffers));
+        }
         if actions.is_none() {
             return self
                 .pool
@@ -414,6 +430,23 @@ impl VecEnv {
         self.out.clear();
     }
 
+    /// Seconds in the parts of the steps with the GPU batch: motion, GPU stage, observations.
+    pub fn gpu_stage_seconds(&self) -> Option<[f64; 3]> {
+        #[cfg(feature = "gpu")]
+        return self.gpu.as_ref().map(|g| g.seconds);
+        #[cfg(not(feature = "gpu"))]
+        None
+    }
+
+    /// Copies the GPU batch's fields into the worlds' CPU ones (`world(e).pheromones()`).
+    pub fn sync_fields(&mut self) -> Result<()> {
+        #[cfg(feature = "gpu")]
+        if let Some(stage) = &self.gpu {
+            stage.sync(&mut self.slots)?;
+        }
+        Ok(())
+    }
+
     /// The screen with the robots drawn on it, `width` pixels wide, of world `e`.
     pub fn render(&self, e: usize, width: u32) -> Result<image::RgbImage> {
         let slot = self.slots.get(e).ok_or_else(|| {
@@ -422,6 +455,16 @@ impl VecEnv {
                 format!("{e} is not below num_envs = {}", self.spec.num_envs),
             )
         })?;
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            let world = (&slot.world, &g.pheromones_of(e, slot)?);
+            return Ok(render_world_with(
+                world.0,
+                world.1,
+                self.task.agents(),
+                width,
+            ));
+        }
         Ok(render_world(&slot.world, self.task.agents(), width))
     }
 }

@@ -67,10 +67,21 @@ pub fn write_patch(world: &dyn ArenaView, agents: &[usize], cfg: &PatchConfig, o
 
 /// Screen image with robots: agents white, scripted robots coloured by order of their role.
 pub fn render_world(world: &dyn ArenaView, agents: &[usize], width: u32) -> image::RgbImage {
+    render_world_with(world, world.pheromones(), agents, width)
+}
+
+/// [`render_world`] with the screen drawn from `pheromones` (the world's fields as held elsewhere:
+/// the GPU batch's).
+pub fn render_world_with(
+    world: &dyn ArenaView,
+    pheromones: &[colcos_sim::field::Pheromone],
+    agents: &[usize],
+    width: u32,
+) -> image::RgbImage {
     let screen = world.screen();
     let width = width.max(16);
     let height = ((width as f32 * screen.size[1] / screen.size[0]).round() as u32).max(1);
-    let mut img = colcos_sim::screen::render(world.pheromones(), screen, width, height);
+    let mut img = colcos_sim::screen::render(pheromones, screen, width, height);
     colcos_sim::output::draw::obstacles(&mut img, screen, world.obstacles());
     const OTHERS: [[u8; 3]; 4] = [[255, 200, 0], [255, 0, 255], [0, 200, 255], [150, 150, 150]];
     let mut roles: Vec<&str> = Vec::new();

@@ -23,6 +23,10 @@ pub(crate) struct WorldSlot {
     pub episode: Episode,
     /// Stepped, its rewards and terminations not yet handed out (a task written in Python).
     pub awaiting: bool,
+    /// Built since the GPU batch last loaded its grids (the CPU's are the world's; see `gpu_stage`;
+    /// read only with the `gpu` feature).
+    #[cfg_attr(not(feature = "gpu"), allow(dead_code))]
+    pub fresh: bool,
 }
 
 impl WorldSlot {
@@ -49,6 +53,7 @@ impl WorldSlot {
             // One still step so that the sensors see what the task changed.
             world.step_with_commands(&vec![WheelCommand::STOP; robots]);
         }
+        backend.hand_over(&mut world);
         if let Some((host, slot)) = host {
             world.attach_physics(host, slot);
         }
@@ -57,6 +62,7 @@ impl WorldSlot {
             overrides,
             episode: Episode::new(episode, agents.len()),
             awaiting: false,
+            fresh: true,
         })
     }
 }

@@ -136,11 +136,36 @@ pub(crate) fn finish_world(
     begun: Begun,
     mut host: Option<(&mut RapierHost, usize)>,
 ) -> Result<()> {
-    match (begun, host.as_mut()) {
-        (Begun::Reset, _) => return Ok(()),
-        (Begun::InHost, Some((host, _))) => slot.world.finish_step_in(host),
+    if !finish_motion(slot, begun, host.as_mut().map(|(h, _)| &mut **h)) {
+        return Ok(());
+    }
+    after_motion(ctx, w, slot, out, host)
+}
+
+/// A world's motion finished after its host's step (nothing to do for a world that stepped alone);
+/// false for a world that only reset.
+pub(crate) fn finish_motion(
+    slot: &mut WorldSlot,
+    begun: Begun,
+    host: Option<&mut RapierHost>,
+) -> bool {
+    match (begun, host) {
+        (Begun::Reset, _) => return false,
+        (Begun::InHost, Some(host)) => slot.world.finish_step_in(host),
         _ => {}
     }
+    true
+}
+
+/// The rest of a world's step once it has moved and sensed: rewards and outputs now, or later for a
+/// task written in Python.
+pub(crate) fn after_motion(
+    ctx: &Ctx,
+    w: usize,
+    slot: &mut WorldSlot,
+    out: &mut OutSlices,
+    host: Option<(&mut RapierHost, usize)>,
+) -> Result<()> {
     if let Evaluation::Deferred = ctx.evaluation {
         slot.awaiting = true;
         return Ok(());

@@ -1,7 +1,7 @@
 //! The worlds of a vector env take the field backend from the scenario's `[field] backend` (or
 //! `EnvConfig::backend`). With the `gpu` feature (`cargo test -p colcos-env --features gpu`): `gpu`
-//! runs on any adapter and gives the CPU's observations, also in worlds rebuilt by autoreset; without
-//! it, `gpu` is an error and `auto` the CPU.
+//! runs on any adapter and gives the CPU's observations, also in worlds rebuilt by autoreset
+//! (`gpu_batch.rs` compares more tasks and resets); without it, `gpu` is an error and `auto` the CPU.
 #[cfg(feature = "gpu")]
 use colcos_env::{Actions, ScenarioSource};
 use colcos_env::{EnvConfig, EnvError, VecEnv};
@@ -58,13 +58,10 @@ fn scenario_key_and_gpu_observations() {
         Err(e) => panic!("{e}"),
     };
     assert_eq!(gpu.backend().name(), "gpu", "{}", gpu.backend().describe());
-    assert!(
-        gpu.world(0)
-            .unwrap()
-            .field_backend()
-            .unwrap()
-            .starts_with("gpu")
-    );
+    // Every world's grids in the environment's GPU batch, none stepping its own.
+    assert!(gpu.backend().is_batched(), "{}", gpu.backend().describe());
+    assert!(gpu.world(0).unwrap().external_grids());
+    assert!(gpu.world(0).unwrap().field_backend().is_none());
     let mut cpu = VecEnv::new(&cfg("trail", Some(BackendChoice::Cpu))).unwrap();
     gpu.reset(None, None).unwrap();
     cpu.reset(None, None).unwrap();
@@ -86,13 +83,7 @@ fn scenario_key_and_gpu_observations() {
             .fold(0f32, f32::max);
         assert!(worst <= 1e-5, "step {step}: observations differ by {worst}");
     }
-    assert!(
-        gpu.world(2)
-            .unwrap()
-            .field_backend()
-            .unwrap()
-            .starts_with("gpu")
-    );
+    assert!(gpu.world(2).unwrap().external_grids());
     assert_eq!(gpu.world(2).unwrap().time(), cpu.world(2).unwrap().time());
 }
 

@@ -8,6 +8,8 @@
 //!   segments; values read back only when asked.
 //! * [`screen`]: eq. (1) composed into 8-bit RGB on the GPU, and the sensors' footprint sampling, so that
 //!   only the readings come back.
+//! * [`worlds`]: a vector environment's worlds' grid pheromones resident on the GPU, stepped, laid
+//!   and sensed together each step, only the sensors' readings read back.
 //! * [`backend`]: the [`FieldBackend`](colcos_sim::field::FieldBackend) that plugs the GPU into a
 //!   [`World`](colcos_sim::world::World), and the `cpu`/`gpu`/`auto` choice.
 
@@ -17,10 +19,12 @@ mod grids;
 /// The wgpu this crate is built on (for [`GpuContext`]'s device and buffers).
 pub use wgpu;
 pub mod screen;
+pub mod worlds;
 
 pub use backend::{BackendSelection, GpuWorldBackend, SharedBackend, install};
 pub use grids::{Deposit, GpuGrids};
 pub use screen::{GpuScreen, ScreenLayer, ScreenScene, SensorQuery, mean_levels};
+pub use worlds::WorldFields;
 
 use std::sync::{Arc, Mutex};
 

@@ -6,6 +6,10 @@ use crate::{GpuError, Result};
 use bytemuck::{Pod, Zeroable};
 use colcos_sim::field::{GridSpec, Kernel};
 use glam::Vec2;
+use rayon::prelude::*;
+
+/// Fewest deposits a thread takes when records are made side by side.
+const PARALLEL_MIN: usize = 4096;
 
 /// One trail deposit: `amount * kernel(distance to segment a-b)` added to every cell near the segment
 /// of field `field`, exactly as
@@ -41,6 +45,8 @@ struct DepRecord {
     amount: f32,
 }
 
+const _: () = assert!(std::mem::size_of::<DepRecord>() == 64);
+
 impl GpuGrids {
     /// Adds trail deposits, in order (deposits on one field are summed in the order given, as a
     /// sequence of [`GridField::deposit_segment`](colcos_sim::field::GridField::deposit_segment)
@@ -50,72 +56,106 @@ impl GpuGrids {
         ctx.scoped("depositing trails", || self.deposit_inner(deposits))?
     }
 
+    /// The record of deposit `d` (`None`: it lays nothing), as the shader reads it.
+    fn deposit_record(&self, d: &Deposit) -> Result<Option<DepRecord>> {
+        let GridSpec { nx, ny, .. } = self.spec;
+        if d.field >= self.fields.len() {
+            return Err(GpuError::Invalid(format!(
+                "deposit on field {} of {}",
+                d.field,
+                self.fields.len()
+            )));
+        }
+        let support = d.kernel.support();
+        if support.is_nan() || support < 0.0 || !d.a.is_finite() || !d.b.is_finite() {
+            return Ok(None);
+        }
+        let (a, b) = (d.a, d.b);
+        let (i0, i1) = self
+            .spec
+            .cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
+        let (j0, j1) = self
+            .spec
+            .cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
+        if i1 <= i0 || j1 <= j0 {
+            return Ok(None);
+        }
+        let ab = b - a;
+        let (kind, param) = match d.kernel {
+            Kernel::Disc { radius } => (0, radius),
+            Kernel::Cone { radius } => (1, radius),
+            Kernel::Gaussian { sigma } => (2, sigma),
+        };
+        Ok(Some(DepRecord {
+            field: d.field as u32,
+            slot: self.fields[d.field].slot,
+            i0: i0 as u32,
+            j0: j0 as u32,
+            w: (i1 - i0) as u32,
+            h: (j1 - j0) as u32,
+            kind,
+            _pad: 0,
+            ax: a.x,
+            ay: a.y,
+            abx: ab.x,
+            aby: ab.y,
+            len2: ab.length_squared(),
+            support,
+            param,
+            amount: d.amount,
+        }))
+    }
+
     fn deposit_inner(&mut self, deposits: &[Deposit]) -> Result<()> {
         let GridSpec { nx, ny, cell } = self.spec;
-        let mut per_field_count = vec![0usize; self.fields.len()];
-        let mut rounds: Vec<Vec<DepRecord>> = Vec::new();
-        for d in deposits {
-            if d.field >= self.fields.len() {
-                return Err(GpuError::Invalid(format!(
-                    "deposit on field {} of {}",
-                    d.field,
-                    self.fields.len()
-                )));
-            }
-            let support = d.kernel.support();
-            if support.is_nan() || support < 0.0 || !d.a.is_finite() || !d.b.is_finite() {
-                continue;
-            }
-            let (a, b) = (d.a, d.b);
-            let (i0, i1) = self
-                .spec
-                .cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
-            let (j0, j1) = self
-                .spec
-                .cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
-            if i1 <= i0 || j1 <= j0 {
-                continue;
-            }
-            let ab = b - a;
-            let (kind, param) = match d.kernel {
-                Kernel::Disc { radius } => (0, radius),
-                Kernel::Cone { radius } => (1, radius),
-                Kernel::Gaussian { sigma } => (2, sigma),
-            };
-            let rec = DepRecord {
-                field: d.field as u32,
-                slot: self.fields[d.field].slot,
-                i0: i0 as u32,
-                j0: j0 as u32,
-                w: (i1 - i0) as u32,
-                h: (j1 - j0) as u32,
-                kind,
-                _pad: 0,
-                ax: a.x,
-                ay: a.y,
-                abx: ab.x,
-                aby: ab.y,
-                len2: ab.length_squared(),
-                support,
-                param,
-                amount: d.amount,
-            };
-            let r = per_field_count[d.field];
-            per_field_count[d.field] += 1;
-            if rounds.len() <= r {
-                rounds.push(Vec::new());
-            }
-            rounds[r].push(rec);
-        }
-        if rounds.is_empty() {
+        // The records side by side (a vector env's batch lays tens of thousands a step) ...
+        let made: Vec<Option<DepRecord>> = deposits
+            .par_iter()
+            .with_min_len(PARALLEL_MIN)
+            .map(|d| self.deposit_record(d))
+            .collect::<Result<_>>()?;
+        // ... then each field's k-th deposit into round k, rounds one after the other.
+        let mut per_field = vec![0u32; self.fields.len()];
+        let mut sizes: Vec<usize> = Vec::new();
+        let mut cells: Vec<usize> = Vec::new();
+        let round_of: Vec<u32> = made
+            .iter()
+            .map(|r| {
+                let Some(r) = r else { return u32::MAX };
+                let k = per_field[r.field as usize];
+                per_field[r.field as usize] += 1;
+                if sizes.len() <= k as usize {
+                    sizes.push(0);
+                    cells.push(0);
+                }
+                sizes[k as usize] += 1;
+                cells[k as usize] = cells[k as usize].max((r.w * r.h) as usize);
+                k
+            })
+            .collect();
+        if sizes.is_empty() {
             return Ok(());
         }
-        if rounds.iter().any(|r| r.len() > MAX_GROUPS as usize) {
+        if sizes.iter().any(|&n| n > MAX_GROUPS as usize) {
             return Err(GpuError::Invalid(format!(
                 "more than {MAX_GROUPS} fields with a deposit in one call: split the call"
             )));
         }
-        let recs: Vec<DepRecord> = rounds.iter().flatten().copied().collect();
+        let mut next: Vec<usize> = sizes
+            .iter()
+            .scan(0, |start, &n| {
+                let s = *start;
+                *start += n;
+                Some(s)
+            })
+            .collect();
+        let mut recs = vec![DepRecord::default(); sizes.iter().sum()];
+        for (r, &k) in made.iter().zip(&round_of) {
+            if let Some(r) = r {
+                recs[next[k as usize]] = *r;
+                next[k as usize] += 1;
+            }
+        }
         self.ensure(
             Grown::Deposits,
             std::mem::size_of_val(recs.as_slice()) as u64,
@@ -124,16 +164,12 @@ impl GpuGrids {
             .queue
             .write_buffer(&self.deps, 0, bytemuck::cast_slice(&recs));
         let mut first = 0u32;
-        let dispatches: Vec<Dispatch> = rounds
+        let dispatches: Vec<Dispatch> = sizes
             .iter()
-            .map(|round| {
-                let cells = round
-                    .iter()
-                    .map(|r| (r.w * r.h) as usize)
-                    .max()
-                    .unwrap_or(0);
+            .zip(&cells)
+            .map(|(&size, &cells)| {
                 let (gx, gy) = groups(cells, 256);
-                let count = round.len() as u32;
+                let count = size as u32;
                 let uniform = PassUniform {
                     index: first,
                     nfields: self.fields.len() as u32,

@@ -2,6 +2,7 @@
 //! [`colcos_sim::field::GridField`], many fields per dispatch. Each field's step follows the same
 //! [`StepPlan`](colcos_sim::field::StepPlan) as the CPU's.
 mod deposit;
+mod injection;
 mod pipelines;
 mod record;
 mod step;
@@ -38,6 +39,9 @@ pub struct GpuGrids {
     inj: wgpu::Buffer,
     inj_len: u32,
     inj_data: Vec<f32>,
+    /// Offsets in `inj_data` of the distinct maps stored there: fields with equal maps (the worlds of
+    /// one scenario) share one copy.
+    inj_maps: Vec<u32>,
     coef: wgpu::Buffer,
     plan: wgpu::Buffer,
     uniforms: wgpu::Buffer,
@@ -125,6 +129,7 @@ impl GpuGrids {
             inj,
             inj_len: 0,
             inj_data: Vec::new(),
+            inj_maps: Vec::new(),
             coef,
             plan,
             uniforms,
@@ -229,58 +234,5 @@ impl GpuGrids {
             .enumerate()
             .map(|(f, st)| all[(2 * f + st.slot as usize) * n..][..n].to_vec())
             .collect())
-    }
-
-    /// Sets (or removes) the static injection map `J` of `field`.
-    pub fn set_static_injection(&mut self, field: usize, j: Option<&[f32]>) -> Result<()> {
-        let ctx = self.ctx.clone();
-        ctx.scoped("uploading an injection map", || {
-            self.set_static_injection_inner(field, j)
-        })?
-    }
-
-    fn set_static_injection_inner(&mut self, field: usize, j: Option<&[f32]>) -> Result<()> {
-        let n = self.spec.len();
-        match j {
-            None => self.fields[field].inj_offset = None,
-            Some(j) => {
-                if j.len() != n {
-                    return Err(GpuError::Invalid(format!(
-                        "injection map of field {field}: {} values for {n} cells",
-                        j.len()
-                    )));
-                }
-                let off = match self.fields[field].inj_offset {
-                    Some(o) => o as usize,
-                    None => {
-                        let o = self.inj_data.len();
-                        self.inj_data.resize(o + n, 0.0);
-                        o
-                    }
-                };
-                self.inj_data[off..off + n].copy_from_slice(j);
-                self.fields[field].inj_offset = Some(off as u32);
-                let bytes = self.inj_data.len() as u64 * 4;
-                check_size(&self.ctx, "static injection maps", bytes)?;
-                if self.inj_data.len() as u32 > self.inj_len {
-                    self.inj = storage(
-                        &self.ctx,
-                        "colcos injection maps",
-                        bytes,
-                        wgpu::BufferUsages::empty(),
-                    );
-                    self.inj_len = self.inj_data.len() as u32;
-                    self.bind = None;
-                    self.ctx
-                        .queue
-                        .write_buffer(&self.inj, 0, bytemuck::cast_slice(&self.inj_data));
-                } else {
-                    self.ctx
-                        .queue
-                        .write_buffer(&self.inj, off as u64 * 4, bytemuck::cast_slice(j));
-                }
-            }
-        }
-        Ok(())
     }
 }

@@ -37,6 +37,10 @@ pub(super) struct PassUniform {
     pub(super) _pad: u32,
 }
 
+// The shader's structs, byte for byte.
+const _: () = assert!(std::mem::size_of::<PlanEntry>() == 32);
+const _: () = assert!(std::mem::size_of::<PassUniform>() == 32);
+
 /// The kinds of pass, one shader entry point each.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Kind {

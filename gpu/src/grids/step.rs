@@ -3,6 +3,7 @@ use super::GpuGrids;
 use super::record::{Kind, PlanEntry};
 use crate::Result;
 use colcos_sim::field::{Diffusion, GridSpec, StepPlan};
+use rayon::prelude::*;
 
 /// Passes under construction, and the slot each field's current values will be in after them.
 struct Passes {
@@ -52,9 +53,11 @@ impl GpuGrids {
         let spec = self.spec;
         let GridSpec { nx, ny, .. } = spec;
         let coef_stride = 2 * (nx + ny);
+        // Each field's plan (two f64 transcendentals: side by side for a vector env's batch).
         let plans: Option<Vec<StepPlan>> = self
             .fields
-            .iter_mut()
+            .par_iter_mut()
+            .with_min_len(4096)
             .map(|st| StepPlan::new(&spec, &st.params, dt, &mut st.decay_carry))
             .collect();
         let Some(plans) = plans else {

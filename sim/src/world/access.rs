@@ -129,6 +129,28 @@ impl World {
     pub fn set_field_backend(&mut self, backend: Option<Box<dyn FieldBackend>>) {
         self.fields.set_backend(backend);
     }
+    /// Hands the grid pheromones to an owner outside the world, or takes them back (see
+    /// [`super::FieldSet::set_external_grids`]; a step then ends with [`World::sense_from_sums`]).
+    pub fn set_external_grids(&mut self, external: bool) {
+        self.fields.set_external_grids(external);
+    }
+    /// Whether the grid pheromones live outside the world.
+    pub fn external_grids(&self) -> bool {
+        self.fields.external_grids()
+    }
+    /// The trail segments of the last step, in scenario order.
+    pub fn trail_segments(&self) -> &[super::TrailSegment] {
+        self.injection.segments()
+    }
+    /// Robot `i`'s four colour sensors' centres at the current poses.
+    pub fn sensor_centres(&self, i: usize) -> [Vec2; 4] {
+        self.sensing.sensor_centres(i)
+    }
+    /// Where robot `i`'s colour sensors sample the screen, from a sensor's centre (see
+    /// [`super::Sensing::footprint_offsets`]).
+    pub fn footprint_offsets(&self, i: usize) -> [Vec2; crate::sensors::RING_POINTS + 1] {
+        self.sensing.footprint_offsets(i)
+    }
     /// The installed field backend's description, or `None` for the CPU.
     pub fn field_backend(&self) -> Option<String> {
         self.fields.backend_description()

@@ -10,6 +10,9 @@ pub struct FieldSet {
     backend: Option<Box<dyn FieldBackend>>,
     /// The Gaussian sources frozen at the time of the current observations.
     frozen: FrozenSources,
+    /// The grid pheromones live outside the world (a GPU batch of many worlds' fields): the world
+    /// neither steps them nor deposits into them nor senses them (see [`FieldSet::set_external_grids`]).
+    external_grids: bool,
 }
 
 impl FieldSet {
@@ -18,6 +21,7 @@ impl FieldSet {
             pheromones,
             backend: None,
             frozen: FrozenSources::default(),
+            external_grids: false,
         }
     }
     pub fn pheromones(&self) -> &[Pheromone] {
@@ -29,6 +33,18 @@ impl FieldSet {
     /// Installs a backend that steps the pheromones from now on (`None`: the CPU).
     pub fn set_backend(&mut self, backend: Option<Box<dyn FieldBackend>>) {
         self.backend = backend;
+    }
+    /// Hands the grid pheromones to an owner outside the world (`true`), e.g. a GPU batch that steps
+    /// many worlds' fields, deposits their trails and senses their colours at once. From then on a
+    /// step leaves the grids' CPU values as they are (they go stale), keeps its trail segments in
+    /// [`crate::world::Injection::segments`], and ends without colour sensing: the owner hands the
+    /// footprints' level sums to [`crate::world::World::sense_from_sums`].
+    pub fn set_external_grids(&mut self, external: bool) {
+        self.external_grids = external;
+    }
+    /// Whether the grid pheromones are stepped outside the world.
+    pub fn external_grids(&self) -> bool {
+        self.external_grids
     }
     /// The installed backend's description, or `None` for the CPU.
     pub fn backend_description(&self) -> Option<String> {
@@ -91,6 +107,14 @@ impl FieldSet {
 /// Reads and writes the pheromones only.
 pub fn step_fields(fields: &mut FieldSet, dt: f32, parallel: bool) {
     let pheromones = &mut fields.pheromones;
+    if fields.external_grids {
+        // The grids are stepped by their owner; the Gaussian fields' clocks still advance here.
+        pheromones
+            .iter_mut()
+            .filter(|p| !matches!(p.model, FieldModel::Grid(_)))
+            .for_each(|p| p.step(dt));
+        return;
+    }
     match fields.backend.as_mut() {
         Some(backend) => backend.step(pheromones, dt),
         None if parallel => pheromones.par_iter_mut().for_each(|p| p.step(dt)),

@@ -18,13 +18,15 @@ const BANDS: usize = 4;
 /// An emitter switched by action is on from this fraction.
 pub const EMIT_ON: f32 = 0.5;
 
-/// One robot's trail deposit of this step: the segment from where it injected last to where it is.
-struct Segment {
-    pheromone: usize,
-    kernel: Kernel,
-    from: Vec2,
-    to: Vec2,
-    amount: f32,
+/// One robot's trail deposit of this step: the segment from where it injected last to where it is,
+/// `amount * kernel(distance to the segment)` added to grid pheromone `pheromone`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrailSegment {
+    pub pheromone: usize,
+    pub kernel: Kernel,
+    pub from: Vec2,
+    pub to: Vec2,
+    pub amount: f32,
 }
 
 /// Where the host believes robot `i` is: its true pose, or its tracked one once the tracker has seen it.
@@ -44,7 +46,7 @@ fn injection_point_of(
 /// grown by the kernel's support and a cell (the margin [`GridBand::deposit_segment`] skips by, so no
 /// band it would deposit into is left out). `None` for a segment that deposits nothing.
 fn bands_reached(
-    s: &Segment,
+    s: &TrailSegment,
     spec: &GridSpec,
     rows: usize,
     count: usize,
@@ -101,7 +103,7 @@ pub struct Injection {
     action_rates: Vec<f32>,
     action_first: Vec<usize>,
     /// Scratch: this step's trail segments.
-    segments: Vec<Segment>,
+    segments: Vec<TrailSegment>,
     /// Scratch: for each band of rows of each grid field (in field order), the indices of the segments
     /// that may reach it.
     band_segments: Vec<Vec<u32>>,
@@ -159,6 +161,12 @@ impl Injection {
         }
     }
 
+    /// The trail segments of the last step, in scenario order (deposited already unless the grid
+    /// pheromones are stepped outside the world, see [`FieldSet::set_external_grids`]).
+    pub fn segments(&self) -> &[TrailSegment] {
+        &self.segments
+    }
+
     /// Where the host believes robot `i` is, or `None` if the tracker has not seen it yet.
     pub fn point(&self, poses: &[Pose], tracked: &[TrackedPose], i: usize) -> Option<Vec2> {
         injection_point_of(self.inject_at, poses, tracked, i)
@@ -167,6 +175,9 @@ impl Injection {
 
 /// Stage `inject`: every robot's trail deposits of this step (the segment from where it injected last
 /// to where the host believes it is now) and its Gaussian sources moved or refreshed there.
+///
+/// Grid pheromones stepped outside the world ([`FieldSet::set_external_grids`]) take no deposits here:
+/// the segments stay in [`Injection::segments`] for their owner.
 ///
 /// Reads `poses` (true) and `tracked`; writes the grid pheromones' values, the Gaussian sources'
 /// centres and start times, and where each robot injected last.
@@ -193,7 +204,7 @@ pub fn inject(
                 f => dep.rate * f,
             },
         };
-        injection.segments.push(Segment {
+        injection.segments.push(TrailSegment {
             pheromone: dep.pheromone,
             kernel: dep.kernel,
             from: injection.last_injection[robot].unwrap_or(to),
@@ -201,7 +212,9 @@ pub fn inject(
             amount: rate * dt,
         });
     }
-    deposit_segments(injection, fields.pheromones_mut());
+    if !fields.external_grids() {
+        deposit_segments(injection, fields.pheromones_mut());
+    }
     for (i, last) in injection.last_injection.iter_mut().enumerate() {
         if let Some(p) = point(i) {
             *last = Some(p);
@@ -327,7 +340,7 @@ mod tests {
             let rows = spec.ny.div_ceil(bands).max(1);
             let count = spec.ny.div_ceil(rows).max(1);
             let from = Vec2::new(a.0, a.1);
-            let s = Segment { pheromone: 0, kernel, from, to: from + Vec2::new(step.0, step.1), amount: 1.0 };
+            let s = TrailSegment { pheromone: 0, kernel, from, to: from + Vec2::new(step.0, step.1), amount: 1.0 };
             let (lo, hi) = bands_reached(&s, &spec, rows, count).expect("a finite segment");
             let mut g = GridField::new(spec, GridParams::default());
             for mut band in g.bands_mut(rows) {

@@ -22,7 +22,7 @@ mod view;
 
 pub use build::WorldParts;
 pub use fields::FieldSet;
-pub use inject::Injection;
+pub use inject::{Injection, TrailSegment};
 pub use robots::{RobotSet, RobotSlot};
 pub use sensing::{RobotSensors, Sensing};
 pub use tracking::Tracking;
@@ -36,7 +36,7 @@ pub mod stages {
     pub use super::robots::{
         decide, decide_and_drive, drive, finish_physics_in, physics, physics_in,
     };
-    pub use super::sensing::{index, sense};
+    pub use super::sensing::{index, sense, sense_from_sums};
     pub use super::tracking::track;
 }
 

@@ -96,6 +96,20 @@ impl Sensing {
     pub fn neighbours(&self) -> &NeighbourIndex {
         &self.neighbours
     }
+    /// Robot `i`'s four colour sensors' centres at the poses last indexed.
+    pub fn sensor_centres(&self, i: usize) -> [Vec2; 4] {
+        self.sensor_points[i]
+    }
+    /// Where robot `i`'s colour sensors sample the screen, from each sensor's centre (the same for
+    /// its four: [`ColourSensor::sample_points`] adds a centre to them): what [`sense_from_sums`]
+    /// wants the level sums over.
+    pub fn footprint_offsets(&self, i: usize) -> [Vec2; crate::sensors::RING_POINTS + 1] {
+        let sampler = self
+            .robot_sensors
+            .get(i)
+            .map_or(&self.sensor, |own| &own.truth[0]);
+        sampler.sample_points(Vec2::ZERO)
+    }
     /// What each robot sensed last.
     pub fn observations(&self) -> &[Observation] {
         &self.observations
@@ -141,6 +155,38 @@ pub fn sense(
     slots: &mut [RobotSlot],
     time: f32,
 ) {
+    sense_with(sensing, fields, screen, poses, slots, time, None);
+}
+
+/// Stage `sense` with the colour sensors' footprint level sums given (four per robot, in robot then
+/// sensor order, over [`Sensing::footprint_offsets`] from [`Sensing::sensor_centres`]), e.g. from a
+/// GPU that holds the grid pheromones: the same observations and random draws as [`sense`] on a screen with those sums.
+///
+/// # Panics
+/// If `sums` does not hold four entries per robot.
+pub fn sense_from_sums(
+    sensing: &mut Sensing,
+    fields: &mut FieldSet,
+    screen: &ScreenSpec,
+    poses: &[Pose],
+    slots: &mut [RobotSlot],
+    time: f32,
+    sums: &[[u32; 3]],
+) {
+    assert_eq!(sums.len(), 4 * slots.len(), "four footprint sums per robot");
+    sense_with(sensing, fields, screen, poses, slots, time, Some(sums));
+}
+
+/// [`sense`], with the footprint sums computed here (`None`) or given.
+fn sense_with(
+    sensing: &mut Sensing,
+    fields: &mut FieldSet,
+    screen: &ScreenSpec,
+    poses: &[Pose],
+    slots: &mut [RobotSlot],
+    time: f32,
+    given: Option<&[[u32; 3]]>,
+) {
     fields.freeze();
     let (sensor_points, forwards) = (&sensing.sensor_points, &sensing.forwards);
     let (pheromones, frozen) = (fields.pheromones(), fields.frozen());
@@ -162,17 +208,20 @@ pub fn sense(
             last_command: slot.command,
             ..Observation::default()
         };
+        let given = given.map(|g| [g[4 * i], g[4 * i + 1], g[4 * i + 2], g[4 * i + 3]]);
         match robot_sensors.get(i) {
             Some(own) => {
                 // The four footprints in one batched pass (they are all the drawn `[sensor]`
                 // section's), then each sensor's own model in order: the same draws as `read_all`'s.
-                let sums = own.truth[0].footprint_sums_printed(
-                    pheromones,
-                    frozen,
-                    screen,
-                    printed,
-                    &sensor_points[i],
-                );
+                let sums = given.unwrap_or_else(|| {
+                    own.truth[0].footprint_sums_printed(
+                        pheromones,
+                        frozen,
+                        screen,
+                        printed,
+                        &sensor_points[i],
+                    )
+                });
                 for (k, sum) in sums.into_iter().enumerate() {
                     let c = own.truth[k].counts_of_sum(sum, &mut slot.rng);
                     o.counts[k] = c;
@@ -180,14 +229,17 @@ pub fn sense(
                 }
             }
             None => {
-                (o.counts, o.intensity) = sensor.read_robot(
-                    pheromones,
-                    frozen,
-                    screen,
-                    printed,
-                    &sensor_points[i],
-                    &mut slot.rng,
-                );
+                (o.counts, o.intensity) = match &given {
+                    Some(sums) => sensor.read_robot_from_sums(sums, &mut slot.rng),
+                    None => sensor.read_robot(
+                        pheromones,
+                        frozen,
+                        screen,
+                        printed,
+                        &sensor_points[i],
+                        &mut slot.rng,
+                    ),
+                };
             }
         }
         // A robot's own gain and offset act on the counts its sensors deliver; its intensities

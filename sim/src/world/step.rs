@@ -124,7 +124,29 @@ impl World {
             self.tracking.tracked(),
             dt,
         );
-        self.sense();
+        if !self.fields.external_grids() {
+            self.sense();
+        }
+    }
+
+    /// Ends a step of a world whose grid pheromones live outside it
+    /// ([`crate::world::FieldSet::set_external_grids`]): every robot's observation from the colour
+    /// sensors' footprint level sums `sums` (four per robot, over [`World::footprint_offsets`] from
+    /// [`World::sensor_centres`]), as
+    /// [`World::step`] would sense them on a screen with those sums.
+    ///
+    /// # Panics
+    /// If `sums` does not hold four entries per robot.
+    pub fn sense_from_sums(&mut self, sums: &[[u32; 3]]) {
+        super::stages::sense_from_sums(
+            &mut self.sensing,
+            &mut self.fields,
+            &self.screen,
+            self.robots.physics.poses(),
+            &mut self.robots.slots,
+            self.time,
+            sums,
+        );
     }
 
     /// Every robot's observation from the current screen and poses (after building or moving robots).

@@ -78,6 +78,11 @@ impl GridField {
     pub fn params(&self) -> &GridParams {
         &self.params
     }
+    /// The running decay correction of the field's steps (see [`StepPlan::new`](super::StepPlan::new)):
+    /// a copy of the field stepped elsewhere (a GPU batch) starts from it to take the same decay factors.
+    pub fn decay_carry(&self) -> f64 {
+        self.decay_carry
+    }
     /// Replaces the parameters (the cached implicit coefficients are rebuilt when needed).
     pub fn set_params(&mut self, params: GridParams) {
         self.params = params;

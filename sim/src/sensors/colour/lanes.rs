@@ -44,6 +44,22 @@ impl ColourSensor {
         out
     }
 
+    /// A robot's four sensors read from their footprints' level sums (as
+    /// [`ColourSensor::footprint_sums_printed`] gives them, or a GPU's sensing pass): the same counts,
+    /// random draws and intensities as [`ColourSensor::read_robot`] at those footprints. A sum above
+    /// the largest a footprint can have reads as that largest.
+    pub fn read_robot_from_sums(
+        &self,
+        sums: &[[u32; 3]; 4],
+        rng: &mut SimRng,
+    ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
+        let lut = &self.light_by_sum;
+        let last = lut.len() - 1;
+        let light = sums.map(|sum| sum.map(|s| lut[(s as usize).min(last)]));
+        let counts = self.counts_for_lights(&light, rng);
+        (counts, self.intensities_inline(&counts))
+    }
+
     /// Calibrated inverse: counts back to screen intensity in [0, 1] per channel.
     ///
     /// Subtracts the dark counts, divides by gain and integration time, undoes the crosstalk, clamps

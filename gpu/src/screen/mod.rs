@@ -9,6 +9,12 @@
 //! Gaussian sources are evaluated in f64 as on the CPU when the device has `SHADER_F64` (lavapipe and
 //! NVIDIA do), with an f64 `exp` of our own (WGSL has none); without it, in f32, which can differ from
 //! the CPU by one level where a pixel's sum lies within a few ulps of a rounding boundary.
+mod batch;
+mod sense;
+
+pub use batch::{FootprintSets, SensorBatch};
+pub use sense::mean_levels;
+
 use crate::{GpuContext, GpuGrids, Result, storage};
 use bytemuck::{Pod, Zeroable};
 use colcos_sim::field::{FieldModel, GaussianSource, Pheromone};
@@ -84,6 +90,11 @@ struct LayerRec {
     k: [f32; 3],
     time: f32,
 }
+
+// The shader's structs, byte for byte.
+const _: () = assert!(std::mem::size_of::<LayerRec>() == 32);
+const _: () = assert!(std::mem::size_of::<SrcRec>() == 48);
+const _: () = assert!(std::mem::size_of::<Uni>() == 64);
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -185,6 +196,7 @@ pub struct GpuScreen {
     layout: wgpu::BindGroupLayout,
     render: wgpu::ComputePipeline,
     sense: wgpu::ComputePipeline,
+    sense_centres: wgpu::ComputePipeline,
     dummy: wgpu::Buffer,
     /// The last rendered image (packed RGBA8, one u32 per pixel), kept for display.
     image: Option<(wgpu::Buffer, u32, u32)>,
@@ -238,6 +250,7 @@ impl GpuScreen {
                 entry(4, wgpu::BufferBindingType::Storage { read_only: false }),
                 entry(5, ro),
                 entry(6, ro),
+                entry(7, ro),
             ],
         });
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -257,12 +270,14 @@ impl GpuScreen {
         };
         let render = pipe("render");
         let sense = pipe("sense");
+        let sense_centres = pipe("sense_centres");
         let dummy = storage(&ctx, "colcos dummy", 16, wgpu::BufferUsages::empty());
         GpuScreen {
             ctx,
             layout,
             render,
             sense,
+            sense_centres,
             dummy,
             image: None,
         }
@@ -431,6 +446,7 @@ impl GpuScreen {
                     e(4, out),
                     e(5, &pb),
                     e(6, &qb),
+                    e(7, &self.dummy),
                 ],
             });
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
@@ -518,72 +534,4 @@ impl GpuScreen {
         }
         Ok(img)
     }
-
-    /// Sums of the 8-bit screen levels (r, g, b) over each query's points; the mean level that
-    /// [`colcos_sim::sensors::ColourSensor::screen_levels`] returns is `sum / POINTS_PER_SENSOR`
-    /// (see [`mean_levels`]). One dispatch for every sensor of every world; only the sums come back.
-    pub fn sense(
-        &self,
-        grids: Option<&GpuGrids>,
-        scene: &ScreenScene,
-        screen: &ScreenSpec,
-        queries: &[SensorQuery],
-    ) -> Result<Vec<[u32; 3]>> {
-        if queries.is_empty() {
-            return Ok(Vec::new());
-        }
-        let n = queries.len();
-        let points: Vec<[f32; 2]> = queries
-            .iter()
-            .flat_map(|q| q.points.iter().map(|p| [p.x, p.y]))
-            .collect();
-        let worlds: Vec<u32> = queries.iter().map(|q| q.world).collect();
-        if worlds.iter().any(|&w| w as usize >= scene.worlds.len()) {
-            return Err(crate::GpuError::Invalid(
-                "sensor query for a world the scene does not have".into(),
-            ));
-        }
-        let out = self.ctx.scoped("allocating the sensor sums", || {
-            storage(
-                &self.ctx,
-                "colcos sensor sums",
-                n as u64 * 12,
-                wgpu::BufferUsages::empty(),
-            )
-        })?;
-        let (gx, gy) = groups(n, 64);
-        let spec = grids.map(|g| *g.spec());
-        let ps = screen.pixel_size();
-        let uni = Uni {
-            width: POINTS_PER_SENSOR as u32,
-            nx: spec.map_or(1, |s| s.nx as u32),
-            ny: spec.map_or(1, |s| s.ny as u32),
-            groups_x: gx,
-            count: n as u32,
-            cell: spec.map_or(1.0, |s| s.cell),
-            ps_x: ps.x,
-            ps_y: ps.y,
-            res_x: screen.resolution[0],
-            res_y: screen.resolution[1],
-            ..Default::default()
-        };
-        self.dispatch(
-            grids,
-            scene,
-            uni,
-            &self.sense,
-            &out,
-            bytemuck::cast_slice(&points),
-            bytemuck::cast_slice(&worlds),
-            (gx, gy),
-        )?;
-        let bytes = self.ctx.read_buffer(&out, 0, n as u64 * 12)?;
-        let sums: &[u32] = bytemuck::cast_slice(&bytes);
-        Ok(sums.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
-    }
-}
-
-/// Mean levels from the sums of [`GpuScreen::sense`], as the CPU computes them.
-pub fn mean_levels(sum: [u32; 3]) -> [f32; 3] {
-    sum.map(|s| s as f32 / POINTS_PER_SENSOR as f32)
 }

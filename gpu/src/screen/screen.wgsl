@@ -159,3 +159,28 @@ fn sense(@builtin(global_invocation_id) gid: vec3<u32>) {
     outp[3u * s + 1u] = sum.y;
     outp[3u * s + 2u] = sum.z;
 }
+
+// The footprint offsets of the sensors of `sense_centres`, `u.width` a set.
+@group(0) @binding(7) var<storage, read> offsets: array<vec2<f32>>;
+
+// One sensor per thread, given as its centre (`points[s]`) and its footprint's set of offsets
+// (`qworld[s]`): its points are `offset + centre`, the f32 sums of the CPU's `sample_points`. Sensor
+// `s` belongs to world `s / u.height`.
+@compute @workgroup_size(64)
+fn sense_centres(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let s = gid.x + gid.y * u.groups_x * 64u;
+    if (s >= u.count) { return; }
+    let first = (s / u.height) * u.nlayers;
+    let c = points[s];
+    let fset = qworld[s] * u.width;
+    var sum = vec3<u32>(0u, 0u, 0u);
+    for (var q = 0u; q < u.width; q = q + 1u) {
+        let p = offsets[fset + q] + c;
+        let x = pixel_centre(p.x, u.ps_x, u.res_x);
+        let y = pixel_centre(p.y, u.ps_y, u.res_y);
+        sum = sum + compose(first, x, y);
+    }
+    outp[3u * s] = sum.x;
+    outp[3u * s + 1u] = sum.y;
+    outp[3u * s + 2u] = sum.z;
+}

@@ -1,0 +1,102 @@
+//! A step of a batch whose grid pheromones live on the GPU, in three stages: every world moves on the
+//! CPU (chunk by chunk, each chunk's rapier host stepping its worlds together), the GPU stage does
+//! every world's field work at once, and every world reads its sensors' sums into observations and
+//! hands out rewards on the CPU. The chunks are those of `batch_step`, so results do not depend on
+//! the number of threads.
+use crate::batch_step::Chunks;
+use crate::error::Result;
+use crate::gpu_stage::GpuStage;
+use crate::outputs::OutSlices;
+use crate::world_slot::WorldSlot;
+use crate::world_step::{Begun, Ctx, Evaluation, after_motion, begin_world, finish_motion};
+use colcos_sim::behaviour::WheelCommand;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// One step of every world with the fields on the GPU, on the current rayon pool.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn step_batch_gpu(
+    ctx: &Ctx,
+    slots: &mut [WorldSlot],
+    chunks: &mut Chunks,
+    stage: &mut GpuStage,
+    commands: &[WheelCommand],
+    rates: &[f32],
+    mut buffers: OutSlices,
+) -> Result<()> {
+    let c = chunks.size();
+    let n = ctx.task.agents().len();
+    let per_world = n * ctx.deposits;
+    let t0 = Instant::now();
+    // 1. Motion: decisions, shield, physics, tracking, the Gaussian fields' clocks, trail segments.
+    chunks
+        .par_iter_mut(slots)
+        .zip(commands.par_chunks(c * n))
+        .zip(buffers.reborrow().par_chunks(c))
+        .zip(stage.begun.par_chunks_mut(c))
+        .enumerate()
+        .try_for_each(
+            |(k, ((((slots, mut host), commands), mut buffers), begun))| {
+                let mut result = Ok(());
+                for (i, slot) in slots.iter_mut().enumerate() {
+                    let w = k * c + i;
+                    let cmds = &commands[i * n..(i + 1) * n];
+                    let lay = &rates[w * per_world..(w + 1) * per_world];
+                    let mut out = buffers.world(i);
+                    let in_host = host.as_deref_mut().map(|h| (h, i));
+                    begun[i] = match begin_world(ctx, w, slot, (cmds, lay), &mut out, in_host) {
+                        Ok(b) => b,
+                        Err(err) => {
+                            if result.is_ok() {
+                                result = Err(err);
+                            }
+                            Begun::Reset
+                        }
+                    };
+                }
+                if let Some(host) = host.as_deref_mut() {
+                    host.step(ctx.scenario.spec.dt);
+                    for (slot, &b) in slots.iter_mut().zip(begun.iter()) {
+                        finish_motion(slot, b, Some(&mut *host));
+                    }
+                }
+                result
+            },
+        )?;
+    let t1 = Instant::now();
+    // 2. Fields, deposits and sensing of every world on the GPU.
+    stage.run(slots, ctx.scenario.spec.dt)?;
+    if ctx.writer.patch.is_some() || matches!(ctx.evaluation, Evaluation::Deferred) {
+        // Patches and a task written in Python read the fields on the CPU.
+        stage.sync(slots)?;
+    }
+    // 3. Observations from the sums, rewards, outputs.
+    let t2 = Instant::now();
+    let concluded = chunks
+        .par_iter_mut(slots)
+        .zip(buffers.par_chunks(c))
+        .zip(stage.begun.par_chunks(c))
+        .enumerate()
+        .try_for_each(|(k, (((slots, mut host), mut buffers), begun))| {
+            let mut result = Ok(());
+            for (i, slot) in slots.iter_mut().enumerate().rev() {
+                if begun[i] == Begun::Reset {
+                    continue;
+                }
+                let w = k * c + i;
+                slot.world.sense_from_sums(stage.sums_of(w));
+                let mut out = buffers.world(i);
+                let in_host = host.as_deref_mut().map(|h| (h, i));
+                let done = after_motion(ctx, w, slot, &mut out, in_host);
+                if result.is_ok() {
+                    result = done;
+                }
+            }
+            result
+        });
+    let t3 = Instant::now();
+    for (total, (a, b)) in stage.seconds.iter_mut().zip([(t0, t1), (t1, t2), (t2, t3)]) {
+        *total += (b - a).as_secs_f64();
+    }
+    concluded
+}

@@ -1,0 +1,138 @@
+//! Many worlds' grids in one resident batch ([`WorldFields`], cut into parts of two worlds here):
+//! worlds that hand their grids to the batch and sense from its sums observe what worlds stepping on
+//! the CPU observe, step for step, through a world rebuilt mid-run; their fields stay within 1e-5.
+mod common;
+use colcos_gpu::WorldFields;
+use colcos_sim::field::FieldModel;
+use colcos_sim::prelude::*;
+use common::{compare, ctx};
+
+/// Three grid pheromones with static maps (one diffusing) and a cone trail laid by every robot.
+const SCENARIO: &str = r#"
+name = "batch"
+duration = 4.0
+seed = 9
+[screen]
+resolution = [3840, 2160]
+size = [1.439, 0.809]
+[field]
+cell = 0.01
+[[pheromones]]
+name = "red"
+colour = [255, 0, 0]
+evaporation = 5.0
+[[pheromones.maps]]
+polyline = [[0.2, 0.2], [1.2, 0.2], [1.2, 0.6]]
+width = 0.03
+rate = 0.2
+[[pheromones]]
+name = "green"
+colour = [0, 255, 0]
+evaporation = 8.0
+diffusion = 1e-5
+[[pheromones.maps]]
+polyline = [[0.2, 0.6], [0.7, 0.4], [1.2, 0.6]]
+width = 0.05
+rate = 0.15
+[[pheromones]]
+name = "blue"
+colour = [40, 0, 255]
+evaporation = 3.0
+[[robots]]
+count = 5
+behaviour = "follow"
+params = { channel = "r", speed = 0.1, sensitivity = 0.5, threshold = 0.05 }
+deposits = [{ pheromone = "blue", kernel = { shape = "cone", radius = 0.012 }, rate = 5.0 }]
+"#;
+
+/// Loads world `w` into the batch: its fields and its sensors' footprints.
+fn load(fields: &mut WorldFields, w: usize, world: &World) {
+    fields.load_world(w, world.pheromones()).unwrap();
+    let sets: Vec<u32> = (0..world.robot_count())
+        .flat_map(|i| [fields.footprint(&world.footprint_offsets(i)); 4])
+        .collect();
+    fields.set_footprints(w, &sets).unwrap();
+}
+
+#[test]
+fn worlds_sensing_from_the_batch_observe_what_cpu_worlds_observe() {
+    let Some(ctx) = ctx() else { return };
+    let sc = Scenario::from_toml_str(SCENARIO, ".").unwrap();
+    let n = 5;
+    let mut cpu: Vec<World> = (0..n)
+        .map(|w| World::with_index(&sc, w as u64).unwrap())
+        .collect();
+    let mut gpu: Vec<World> = (0..n)
+        .map(|w| World::with_index(&sc, w as u64).unwrap())
+        .collect();
+    let robots = gpu[0].robot_count();
+    let screen = *gpu[0].screen();
+    let mut fields =
+        WorldFields::in_parts(ctx, gpu[0].pheromones(), n, 4 * robots, screen, 2).unwrap();
+    assert_eq!(fields.parts(), 3, "five worlds in parts of two");
+    for (w, world) in gpu.iter_mut().enumerate() {
+        load(&mut fields, w, world);
+        world.set_external_grids(true);
+    }
+    let dt = sc.spec.dt;
+    let mut sums = Vec::new();
+    for step in 1..=60 {
+        if step == 25 {
+            // A new episode of world 3 on both sides.
+            cpu[3] = World::with_index(&sc, 103).unwrap();
+            gpu[3] = World::with_index(&sc, 103).unwrap();
+            load(&mut fields, 3, &gpu[3]);
+            gpu[3].set_external_grids(true);
+        }
+        cpu.iter_mut().for_each(World::step);
+        for (w, world) in gpu.iter_mut().enumerate() {
+            world.step();
+            fields.add_segments(w, world.trail_segments()).unwrap();
+        }
+        fields.step(dt).unwrap();
+        let per_world = 4 * robots;
+        for (c, world) in fields.centres_mut().chunks_mut(per_world).zip(&gpu) {
+            for i in 0..robots {
+                for (k, p) in world.sensor_centres(i).iter().enumerate() {
+                    c[4 * i + k] = [p.x, p.y];
+                }
+            }
+        }
+        fields.sense(&mut sums).unwrap();
+        assert_eq!(sums.len(), n * per_world);
+        for (w, world) in gpu.iter_mut().enumerate() {
+            world.sense_from_sums(&sums[w * per_world..(w + 1) * per_world]);
+            for (i, (a, b)) in cpu[w]
+                .observations()
+                .iter()
+                .zip(world.observations())
+                .enumerate()
+            {
+                assert_eq!(a.counts, b.counts, "step {step}, world {w}, robot {i}");
+                assert_eq!(
+                    a.intensity, b.intensity,
+                    "step {step}, world {w}, robot {i}"
+                );
+            }
+            assert_eq!(cpu[w].poses(), world.poses(), "step {step}, world {w}");
+        }
+    }
+    let mut laid = 0;
+    for (w, world) in cpu.iter().enumerate() {
+        let got = fields.read_world(w).unwrap();
+        for (k, p) in world.pheromones().iter().enumerate() {
+            let FieldModel::Grid(g) = &p.model else {
+                panic!("grid pheromones")
+            };
+            let (err, _) = compare(&got[k], g.values());
+            assert!(
+                err <= 1e-5,
+                "world {w}, pheromone {k}: relative error {err:e}"
+            );
+            if k == 2 {
+                laid += g.values().iter().filter(|&&v| v > 0.0).count();
+            }
+        }
+    }
+    assert!(laid > 100, "the robots laid {laid} cells of blue");
+}
