@@ -42,8 +42,10 @@ class View:
     wheel commands m/s, `obs` (E, N, 17) the agents' sensor values (`intensities` (E, N, 4, 3) in
     [0, 1], sensors right, front, left, back; `bumpers` (E, N, 3)), `deposit_actions` (E, N, D) the
     rate fractions the agents chose, `steps` (E,) steps of the episode so far, `episode` (E,),
-    `time` (E,) s. Fixed: `agent_robots` (N,), `roles` [R], `arena` (w, h) m, `pheromones` [F]
-    names, `max_wheel_speed`, `wheel_base`, `dt`. `fields(points)` samples every pheromone.
+    `time` (E,) s; `headings` (E, R, 2) each robot's (cos, sin) of its true heading. Fixed:
+    `agent_robots` (N,), `roles` [R], `arena` (w, h) m, `pheromones` [F] names, `colours` (F, 3)
+    their screen levels per unit (r, g, b), `max_wheel_speed`, `wheel_base`, `dt`.
+    `fields(points)` samples every pheromone; `gradients(points)` also gives their gradients.
     """
 
     def __init__(self, core: _core.VecEnv | _core.Plant, info: dict[str, Any], agent_robots: np.ndarray) -> None:
@@ -61,9 +63,11 @@ class View:
         self.time: np.ndarray = d["time"]
         self.obs: np.ndarray = d["obs"]
         self.agent_robots = agent_robots
+        self._headings: np.ndarray | None = None
         self.roles: list[str] = info["roles"]
         self.arena: tuple[float, float] = (float(info["arena"][0]), float(info["arena"][1]))
         self.pheromones: list[str] = info["pheromones"]
+        self.colours: np.ndarray = np.asarray(info["colours"], np.float32).reshape(-1, 3)
         self.max_wheel_speed = np.float32(info["max_wheel_speed"])
         self.wheel_base = np.float32(info["wheel_base"])
         self.dt = np.float32(info["dt"])
@@ -76,6 +80,14 @@ class View:
     def bumpers(self) -> np.ndarray:
         return self.obs[..., 12:15]
 
+    @property
+    def headings(self) -> np.ndarray:
+        """Each robot's heading as a unit vector (cos, sin), (E, R, 2) float32, with the simulator's
+        own sine and cosine (numpy's float32 ones differ from it in the last bit)."""
+        if self._headings is None:
+            self._headings = _core.unit_vectors(np.ascontiguousarray(self.poses[..., 2]))
+        return self._headings
+
     def agents(self, per_robot: np.ndarray) -> np.ndarray:
         """The agents' rows of a per-robot array `(E, R, ...)`: `(E, N, ...)`."""
         return per_robot[:, self.agent_robots]
@@ -83,6 +95,12 @@ class View:
     def fields(self, points: np.ndarray) -> np.ndarray:
         """Every pheromone's value at `points` (E, P, 2) m of each world: (E, P, F) float32."""
         return _core.sample_fields(self._core, np.ascontiguousarray(points, dtype=np.float32))
+
+    def gradients(self, points: np.ndarray, step: float = 0.005) -> tuple[np.ndarray, np.ndarray]:
+        """Every pheromone's value at `points` (E, P, 2) m of each world as the sensors read it this
+        step, and its gradient per m: (E, P, F) and (E, P, F, 2) float32. Gaussian sources give their
+        gradient analytically, grids by central differences `step` m apart (as the built-in tasks)."""
+        return _core.sample_gradients(self._core, np.ascontiguousarray(points, dtype=np.float32), float(step))
 
 
 class ResetContext:
