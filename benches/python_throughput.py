@@ -9,7 +9,7 @@ task's scenario with one more follower, so 4 agents as in VMAS's rows) at 1 / 32
 rapier (the default contact solver) and at 32 / 1,024 worlds with the disc solver; colcos
 parallel_env through the PettingZoo dict API (same scenario); the same 1,024 worlds with the task
 written in Python (`examples/tasks/aggregation.py`, same scenario), right after the Rust task's row,
-and its ratio to it (target >= 0.5); VMAS navigation and
+and its ratio to it (target >= 0.5; the two taken in turn, medians of 7 each); VMAS navigation and
 dispersion (4 agents, CPU torch) at 1 / 32 / 1,024 worlds; mpe2 simple_spread_v3 at 3 and 50 agents.
 Random actions are drawn before timing from a small pool, identically for every library, so the
 figures measure the environments. Each figure is the median of 3 repetitions.
@@ -27,6 +27,7 @@ from collections.abc import Callable
 import numpy as np
 
 REPS = 3
+PAIRED_REPS = 7  # the Rust / Python task pair: repetitions of each, in turn
 TARGET_BATCHED = 1_000_000  # agent-steps/s, 1,024 worlds, 2 cores
 TARGET_DICT = 100_000
 TARGET_PYTHON_TASK = 0.5  # the Python task's agent-steps/s over the Rust task's, same run
@@ -59,7 +60,10 @@ def python_aggregation() -> object:
     return module.Aggregation()
 
 
-def colcos_batched(num_envs: int, steps: int, threads: int | None, physics: str, task: object = "aggregation") -> float:
+def colcos_runner(
+    num_envs: int, steps: int, threads: int | None, physics: str, task: object = "aggregation"
+) -> Callable[[], tuple[int, float]]:
+    """A warmed-up batch of `task` and one repetition of `steps` steps of it."""
     from colcos.vector import VecEnv
 
     v = VecEnv(task, num_envs=num_envs, num_threads=threads, max_cycles=500, scenario=FOUR_AGENTS, physics=physics)
@@ -75,7 +79,23 @@ def colcos_batched(num_envs: int, steps: int, threads: int | None, physics: str,
             v.step(pool[k % 8])
         return steps * num_envs * v.num_agents, time.perf_counter() - t
 
-    return median_rate(run)
+    return run
+
+
+def colcos_batched(num_envs: int, steps: int, threads: int | None, physics: str) -> float:
+    return median_rate(colcos_runner(num_envs, steps, threads, physics))
+
+
+def rust_and_python_task(num_envs: int, steps: int, threads: int | None) -> tuple[float, float]:
+    """The Rust `aggregation` and its Python re-write, repetitions taken in turn (so that a busy
+    spell of a shared machine weighs on both): their median rates."""
+    runs = [colcos_runner(num_envs, steps, threads, "rapier", task) for task in ("aggregation", python_aggregation())]
+    rates: list[list[float]] = [[], []]
+    for _ in range(PAIRED_REPS):
+        for run, out in zip(runs, rates, strict=True):
+            n, secs = run()
+            out.append(n / secs)
+    return statistics.median(rates[0]), statistics.median(rates[1])
 
 
 def pettingzoo_dict(make: Callable[[], object], steps: int) -> float:
@@ -165,17 +185,13 @@ def main() -> None:
         for e, n in sizes:
             if args.python_task and (physics, e) != ("rapier", 1024):
                 continue
-            add(
-                f"colcos VecEnv ({physics})",
-                f"aggregation, 4 agents, {e} worlds",
-                lambda e=e, n=n, physics=physics: colcos_batched(e, s(n), args.threads, physics),
-            )
-            if (physics, e) == ("rapier", 1024):
-                add(
-                    PYTHON_TASK,
-                    f"aggregation, 4 agents, {e} worlds",
-                    lambda e=e, n=n: colcos_batched(e, s(n), args.threads, "rapier", python_aggregation()),
-                )
+            setup = f"aggregation, 4 agents, {e} worlds"
+            if (physics, e) != ("rapier", 1024):
+                add(f"colcos VecEnv ({physics})", setup, lambda e=e, n=n, ph=physics: colcos_batched(e, s(n), args.threads, ph))
+                continue
+            rust_rate, python_rate = rust_and_python_task(e, s(n), args.threads)
+            add(f"colcos VecEnv ({physics})", setup, lambda r=rust_rate: r)
+            add(PYTHON_TASK, setup, lambda r=python_rate: r)
     if args.python_task:
         python_task_ratio()
         return

@@ -70,7 +70,7 @@ def test_python_rewrites_of_the_builtin_tasks_match_them_exactly(name, cls):
         a[..., 2:] = rng.uniform(0.0, 1.0, (6, rust.num_agents, width - 2))  # pheromone actions
         r1 = rust.step(a)
         r2 = py.step(a)
-        for what, x, y in zip(("obs", "rewards", "terminated", "truncated"), r1[:4], r2[:4]):
+        for what, x, y in zip(("obs", "rewards", "terminated", "truncated"), r1[:4], r2[:4], strict=True):
             assert np.array_equal(x, y), f"{name}: {what} differ at step {t}"
         ended += int(r1[2].sum() + r1[3].sum())
         events += _events(name, r1[0], r1[1])

@@ -11,6 +11,7 @@ use colcos_env::encoding::OBS_DIM;
 use colcos_env::{Actions, VecEnv};
 use colcos_plant::LiveEnv;
 use colcos_sim::field::Pheromone;
+use colcos_sim::robot::Pose;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
@@ -330,6 +331,54 @@ fn sample_gradients<'py>(
     })
 }
 
+/// Moves robots as worlds start an episode: `worlds` int64 `[W]`, `robots` int64 `[K]`, `poses`
+/// float32 `[W, K, 3]` (x m, y m, heading rad). A plant's robots are where they are: refused.
+#[pyfunction]
+fn place_robots(
+    py: Python<'_>,
+    env: &Bound<'_, PyAny>,
+    worlds: PyReadonlyArrayDyn<'_, i64>,
+    robots: PyReadonlyArrayDyn<'_, i64>,
+    poses: PyReadonlyArrayDyn<'_, f32>,
+) -> PyResult<()> {
+    guard(|| {
+        let worlds: Vec<i64> = worlds.as_array().iter().copied().collect();
+        let robots: Vec<i64> = robots.as_array().iter().copied().collect();
+        let shape = poses.shape().to_vec();
+        if shape != [worlds.len(), robots.len(), 3] {
+            return Err(Kind::Action.err(format!(
+                "poses must have shape ({}, {}, 3) = (worlds, robots, x y heading), got {shape:?}",
+                worlds.len(),
+                robots.len()
+            )));
+        }
+        let p: Vec<f32> = poses.as_array().iter().copied().collect();
+        let index = |i: i64, what: &str| {
+            usize::try_from(i).map_err(|_| Kind::Action.err(format!("{what} {i} is negative")))
+        };
+        let robots = (robots.iter().map(|&i| index(i, "robot"))).collect::<PyResult<Vec<_>>>()?;
+        let Core::Batch(env) = core_of(env)? else {
+            return Err(Kind::State.err(
+                "robots are placed only in a simulated batch (VecEnv): a plant's robots are where they are",
+            ));
+        };
+        let mut placed = Vec::with_capacity(worlds.len());
+        for (k, &w) in worlds.iter().enumerate() {
+            let row = &p[k * robots.len() * 3..(k + 1) * robots.len() * 3];
+            let each = robots.iter().zip(row.chunks_exact(3));
+            let poses = each.map(|(&i, q)| (i, Pose::new(q[0], q[1], q[2]))).collect();
+            placed.push((index(w, "world")?, poses));
+        }
+        py.detach(|| {
+            let mut g = env.lock();
+            placed
+                .iter()
+                .try_for_each(|(w, poses): &(usize, Vec<(usize, Pose)>)| g.env.place(*w, poses))
+        })
+        .map_err(to_py)
+    })
+}
+
 /// The unit vectors `(cos a, sin a)` of float32 angles `[...]` (rad), float32 `[..., 2]`: the same
 /// `f32` sine and cosine as the simulator and the built-in tasks use (numpy's differ in the last bit).
 #[pyfunction]
@@ -353,6 +402,7 @@ fn unit_vectors<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sample_gradients, m)?)?;
     m.add_function(wrap_pyfunction!(unit_vectors, m)?)?;
+    m.add_function(wrap_pyfunction!(place_robots, m)?)?;
     m.add_function(wrap_pyfunction!(step_deferred, m)?)?;
     m.add_function(wrap_pyfunction!(conclude, m)?)?;
     m.add_function(wrap_pyfunction!(task_view, m)?)?;
