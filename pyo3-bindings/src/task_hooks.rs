@@ -325,8 +325,12 @@ fn sample_gradients<'py>(
         };
         let (values, grads, e, p, f) = sampled.map_err(|m| Kind::Action.err(m))?;
         Ok((
-            PyArray1::from_vec(py, values).reshape([e, p, f])?.into_any(),
-            PyArray1::from_vec(py, grads).reshape([e, p, f, 2])?.into_any(),
+            PyArray1::from_vec(py, values)
+                .reshape([e, p, f])?
+                .into_any(),
+            PyArray1::from_vec(py, grads)
+                .reshape([e, p, f, 2])?
+                .into_any(),
         ))
     })
 }
@@ -366,7 +370,9 @@ fn place_robots(
         for (k, &w) in worlds.iter().enumerate() {
             let row = &p[k * robots.len() * 3..(k + 1) * robots.len() * 3];
             let each = robots.iter().zip(row.chunks_exact(3));
-            let poses = each.map(|(&i, q)| (i, Pose::new(q[0], q[1], q[2]))).collect();
+            let poses = each
+                .map(|(&i, q)| (i, Pose::new(q[0], q[1], q[2])))
+                .collect();
             placed.push((index(w, "world")?, poses));
         }
         py.detach(|| {
