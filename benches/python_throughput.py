@@ -2,11 +2,14 @@
 
     python benches/python_throughput.py            # everything (needs vmas, mpe2, torch)
     python benches/python_throughput.py --quick    # fewer steps
+    python benches/python_throughput.py --python-task   # only the Rust / Python aggregation pair
 
 Rows: colcos batched core (aggregation with 4 learning followers + leader + predator per world, the
 task's scenario with one more follower, so 4 agents as in VMAS's rows) at 1 / 32 / 1,024 worlds with
 rapier (the default contact solver) and at 32 / 1,024 worlds with the disc solver; colcos
-parallel_env through the PettingZoo dict API (same scenario); VMAS navigation and
+parallel_env through the PettingZoo dict API (same scenario); the same 1,024 worlds with the task
+written in Python (`examples/tasks/aggregation.py`, same scenario), right after the Rust task's row,
+and its ratio to it (target >= 0.5; the two taken in turn, medians of 7 each); VMAS navigation and
 dispersion (4 agents, CPU torch) at 1 / 32 / 1,024 worlds; mpe2 simple_spread_v3 at 3 and 50 agents.
 Random actions are drawn before timing from a small pool, identically for every library, so the
 figures measure the environments. Each figure is the median of 3 repetitions.
@@ -24,8 +27,11 @@ from collections.abc import Callable
 import numpy as np
 
 REPS = 3
+PAIRED_REPS = 7  # the Rust / Python task pair: repetitions of each, in turn
 TARGET_BATCHED = 1_000_000  # agent-steps/s, 1,024 worlds, 2 cores
 TARGET_DICT = 100_000
+TARGET_PYTHON_TASK = 0.5  # the Python task's agent-steps/s over the Rust task's, same run
+PYTHON_TASK = "colcos VecEnv (rapier), Python task"
 
 # The aggregation task's own scenario with four learning followers instead of three.
 _SCENARIO = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "env", "scenarios", "aggregation.toml")
@@ -42,12 +48,25 @@ def median_rate(run: Callable[[], tuple[int, float]]) -> float:
     return statistics.median(rates)
 
 
-def colcos_batched(num_envs: int, steps: int, threads: int | None, physics: str) -> float:
+def python_aggregation() -> object:
+    """The `aggregation` task written in Python (examples/tasks/aggregation.py)."""
+    import importlib.util
+
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples", "tasks", "aggregation.py")
+    spec = importlib.util.spec_from_file_location("bench_aggregation", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.Aggregation()
+
+
+def colcos_runner(
+    num_envs: int, steps: int, threads: int | None, physics: str, task: object = "aggregation"
+) -> Callable[[], tuple[int, float]]:
+    """A warmed-up batch of `task` and one repetition of `steps` steps of it."""
     from colcos.vector import VecEnv
 
-    v = VecEnv(
-        "aggregation", num_envs=num_envs, num_threads=threads, max_cycles=500, scenario=FOUR_AGENTS, physics=physics
-    )
+    v = VecEnv(task, num_envs=num_envs, num_threads=threads, max_cycles=500, scenario=FOUR_AGENTS, physics=physics)
     rng = np.random.default_rng(0)
     pool = [rng.uniform(-1, 1, (num_envs, v.num_agents, 2)).astype(np.float32) for _ in range(8)]
     v.reset(seed=0)
@@ -60,7 +79,23 @@ def colcos_batched(num_envs: int, steps: int, threads: int | None, physics: str)
             v.step(pool[k % 8])
         return steps * num_envs * v.num_agents, time.perf_counter() - t
 
-    return median_rate(run)
+    return run
+
+
+def colcos_batched(num_envs: int, steps: int, threads: int | None, physics: str) -> float:
+    return median_rate(colcos_runner(num_envs, steps, threads, physics))
+
+
+def rust_and_python_task(num_envs: int, steps: int, threads: int | None) -> tuple[float, float]:
+    """The Rust `aggregation` and its Python re-write, repetitions taken in turn (so that a busy
+    spell of a shared machine weighs on both): their median rates."""
+    runs = [colcos_runner(num_envs, steps, threads, "rapier", task) for task in ("aggregation", python_aggregation())]
+    rates: list[list[float]] = [[], []]
+    for _ in range(PAIRED_REPS):
+        for run, out in zip(runs, rates, strict=True):
+            n, secs = run()
+            out.append(n / secs)
+    return statistics.median(rates[0]), statistics.median(rates[1])
 
 
 def pettingzoo_dict(make: Callable[[], object], steps: int) -> float:
@@ -116,10 +151,14 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--quick", action="store_true")
     p.add_argument("--threads", type=int, default=None, help="colcos worker threads (default: all cores)")
+    p.add_argument("--python-task", action="store_true", help="only the Rust / Python aggregation rows")
     args = p.parse_args()
     scale = 0.25 if args.quick else 1.0
     s = lambda n: max(10, int(n * scale))  # noqa: E731
     rows: list[tuple[str, str, float | None]] = []
+
+    def rate(lib: str, setup: str) -> float | None:
+        return next((r for l_, s_, r in rows if l_ == lib and s_ == setup), None)
 
     def add(lib: str, setup: str, fn: Callable[[], float]) -> None:
         try:
@@ -133,13 +172,29 @@ def main() -> None:
     print(f"cores: {os.cpu_count()}, python {sys.version.split()[0]}")
     import colcos
 
-    for physics, sizes in (("rapier", [(1, 4000), (32, 1000), (1024, 100)]), ("discs", [(32, 1000), (1024, 100)])):
+    def python_task_ratio() -> None:
+        rust = rate("colcos VecEnv (rapier)", "aggregation, 4 agents, 1024 worlds")
+        py = rate(PYTHON_TASK, "aggregation, 4 agents, 1024 worlds")
+        if rust and py:
+            verdict = "met" if py / rust >= TARGET_PYTHON_TASK else "NOT met"
+            print(f"aggregation written in Python: {py / rust:.2f}x the Rust task's agent-steps/s at 1,024 worlds, "
+                  f"target >= {TARGET_PYTHON_TASK}: {verdict}")
+
+    every = [(1, 4000), (32, 1000), (1024, 100)]
+    for physics, sizes in (("rapier", every), ("discs", [(32, 1000), (1024, 100)])):
         for e, n in sizes:
-            add(
-                f"colcos VecEnv ({physics})",
-                f"aggregation, 4 agents, {e} worlds",
-                lambda e=e, n=n, physics=physics: colcos_batched(e, s(n), args.threads, physics),
-            )
+            if args.python_task and (physics, e) != ("rapier", 1024):
+                continue
+            setup = f"aggregation, 4 agents, {e} worlds"
+            if (physics, e) != ("rapier", 1024):
+                add(f"colcos VecEnv ({physics})", setup, lambda e=e, n=n, ph=physics: colcos_batched(e, s(n), args.threads, ph))
+                continue
+            rust_rate, python_rate = rust_and_python_task(e, s(n), args.threads)
+            add(f"colcos VecEnv ({physics})", setup, lambda r=rust_rate: r)
+            add(PYTHON_TASK, setup, lambda r=python_rate: r)
+    if args.python_task:
+        python_task_ratio()
+        return
     add(
         "colcos parallel_env (dict)",
         "aggregation, 4 agents",
@@ -157,9 +212,6 @@ def main() -> None:
 
         add("mpe2 simple_spread_v3", f"{agents} agents (parallel dict API)", mpe)
 
-    def rate(lib: str, setup: str) -> float | None:
-        return next((r for l_, s_, r in rows if l_ == lib and s_ == setup), None)
-
     print("\n| library | setup | agent-steps/s |")
     print("| --- | --- | ---: |")
     for lib, setup, r in rows:
@@ -174,6 +226,7 @@ def main() -> None:
         ours = rate(f"colcos VecEnv ({physics})", "aggregation, 4 agents, 1024 worlds")
         against_target(f"batched ({physics}), 1,024 worlds", ours, TARGET_BATCHED)
     against_target("parallel_env dict", ours_dict, TARGET_DICT)
+    python_task_ratio()
     print("\nratios (colcos / peer, same number of worlds):")
     for lib, setup, r in rows:
         if r is None or lib.startswith("colcos"):

@@ -8,8 +8,9 @@ Rows (agent-steps per second, median of 5 repetitions, the same random actions f
 - `trail`, the same trail as `deposit_actions` laid at a constant half of twice the rate: the same
   deposits, chosen by the agents; the ratio to the row above is the pheromone actions' cost
   (target: at most 10 % slower);
-- `trail` and `foraging` written in Python (`examples/tasks/`), against the Rust tasks
-  (target: at least 50 % of the Rust task's agent-steps/s).
+- every built-in task written in Python (`examples/tasks/`: `trail`, `foraging`, `aggregation`,
+  `colony`, `coverage`, `alarm`), each right after the Rust task (target: at least 50 % of the
+  Rust task's agent-steps/s).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import numpy as np
 import colcos
 
 REPS = 5
+TASKS = ("trail", "foraging", "aggregation", "colony", "coverage", "alarm")
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCRIPTED = 'deposits = [{ pheromone = "red", kernel = { shape = "disc", radius = 0.008 }, rate = 3.0 }]'
 CHOSEN = 'deposit_actions = [{ pheromone = "red", kernel = { shape = "disc", radius = 0.008 }, max_rate = 6.0 }]'
@@ -76,18 +78,17 @@ def main() -> None:
     rows = {
         "trail, scripted deposits": rate("trail", e, steps),
         "trail, deposit actions": rate("trail", e, steps, scenario=trail.replace(SCRIPTED, CHOSEN), lay=0.5),
-        "trail (Rust)": rate("trail", e, steps),
-        "trail (Python task)": rate(_example("trail", "Trail"), e, steps),
-        "foraging (Rust)": rate("foraging", e, steps),
-        "foraging (Python task)": rate(_example("foraging", "Foraging"), e, steps),
     }
+    for task in TASKS:
+        rows[f"{task} (Rust)"] = rate(task, e, steps, lay=0.5)
+        rows[f"{task} (Python task)"] = rate(_example(task, task.capitalize()), e, steps, lay=0.5)
     print("\n| setup | agent-steps/s |")
     print("| --- | ---: |")
     for name, r in rows.items():
         print(f"| {name} | {r:,.0f} |")
     cost = 1.0 - rows["trail, deposit actions"] / rows["trail, scripted deposits"]
     print(f"\npheromone actions' cost: {100 * cost:.1f} % of a batched trail step (target <= 10 %)")
-    for task in ("trail", "foraging"):
+    for task in TASKS:
         ratio = rows[f"{task} (Python task)"] / rows[f"{task} (Rust)"]
         print(f"{task} written in Python: {ratio:.2f}x the Rust task's agent-steps/s (target >= 0.50)")
 

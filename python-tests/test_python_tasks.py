@@ -23,26 +23,59 @@ def _load(name: str):
     return module
 
 
-@pytest.mark.parametrize(("name", "cls"), [("trail", "Trail"), ("foraging", "Foraging")])
+# Parameters given alike to the Rust task and its Python re-write: the colony's food lies near the
+# nest so that pickups and deliveries happen within the run; captures cost something.
+PARAMS = {
+    "colony": dict(food=[[0.45, 0.45], [0.3, 0.62]], food_amount=3, pickup_reward=0.25, step_penalty=0.01),
+    "coverage": dict(cell=0.1, bump_penalty=0.05),
+    "alarm": dict(capture_penalty=0.5),
+}
+
+
+def _events(name: str, obs: np.ndarray, rewards: np.ndarray) -> int:
+    """How often what the task is about happened in one step of the Rust task (0 if never)."""
+    if name == "colony":
+        return int(obs[..., -1].sum()) + int((rewards > 0.5).sum())  # carrying; a delivery paid
+    if name == "alarm":
+        return int(obs[..., -1].sum()) + int((rewards < 0).sum())  # predator sensed; captured
+    if name == "coverage":
+        return int((rewards >= 1.0).sum())  # a new cell
+    if name == "aggregation":
+        return int((rewards < -1.0).sum())  # captured, or far from the leader in the alarm
+    return 1
+
+
+@pytest.mark.parametrize(
+    ("name", "cls"),
+    [("trail", "Trail"), ("foraging", "Foraging"), ("aggregation", "Aggregation"), ("colony", "Colony"),
+     ("coverage", "Coverage"), ("alarm", "Alarm")],
+)
 def test_python_rewrites_of_the_builtin_tasks_match_them_exactly(name, cls):
-    task = getattr(_load(name), cls)()
+    params = PARAMS.get(name, {})
+    task = getattr(_load(name), cls)(**params)
     kw = dict(num_envs=6, seed=4, max_cycles=300, num_threads=2)
-    rust = colcos.vector.VecEnv(name, **kw)
+    rust = colcos.vector.VecEnv(name, **kw, **params)
     py = colcos.vector.VecEnv(task, **kw)
     assert py.single_observation_space == rust.single_observation_space
+    assert py.single_action_space == rust.single_action_space
     o1, _ = rust.reset(seed=4)
     o2, _ = py.reset(seed=4)
     np.testing.assert_array_equal(o1, o2)
     rng = np.random.default_rng(0)
-    ended = 0
+    width = rust.single_action_space.shape[0]
+    ended = events = 0
     for t in range(1000):
-        a = rng.uniform(-0.3, 1.0, (6, rust.num_agents, 2)).astype(np.float32)
+        a = np.empty((6, rust.num_agents, width), np.float32)
+        a[..., :2] = rng.uniform(-0.3, 1.0, (6, rust.num_agents, 2))
+        a[..., 2:] = rng.uniform(0.0, 1.0, (6, rust.num_agents, width - 2))  # pheromone actions
         r1 = rust.step(a)
         r2 = py.step(a)
-        for what, x, y in zip(("obs", "rewards", "terminated", "truncated"), r1[:4], r2[:4]):
+        for what, x, y in zip(("obs", "rewards", "terminated", "truncated"), r1[:4], r2[:4], strict=True):
             assert np.array_equal(x, y), f"{name}: {what} differ at step {t}"
         ended += int(r1[2].sum() + r1[3].sum())
+        events += _events(name, r1[0], r1[1])
     assert ended > 0, "no episode ended: the test would not see terminations or truncations"
+    assert events > 0, f"{name}: what the task rewards never happened: the test would not see it"
 
 
 class Probe(colcos.Task):

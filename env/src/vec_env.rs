@@ -24,6 +24,8 @@ use colcos_sim::shield::Shield;
 use colcos_sim::world::World;
 use rayon::prelude::*;
 
+mod place;
+
 pub struct VecEnv {
     spec: EnvSpec,
     task: Box<dyn Task>,

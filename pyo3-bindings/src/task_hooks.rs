@@ -11,6 +11,7 @@ use colcos_env::encoding::OBS_DIM;
 use colcos_env::{Actions, VecEnv};
 use colcos_plant::LiveEnv;
 use colcos_sim::field::Pheromone;
+use colcos_sim::robot::Pose;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
@@ -188,7 +189,8 @@ fn plant_view(env: &LiveEnv) -> View {
     v
 }
 
-/// What stays fixed: `arena` (w, h) m, `roles` [R], `pheromones` [F] names, `max_wheel_speed` and
+/// What stays fixed: `arena` (w, h) m, `roles` [R], `pheromones` [F] names and their screen
+/// `colours` [F] (r, g, b levels per unit), `max_wheel_speed` and
 /// `wheel_base` m/s and m, `dt` s.
 #[pyfunction]
 fn task_info<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
@@ -198,12 +200,13 @@ fn task_info<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'p
                 .map(|i| view.map_or(String::new(), |w| w.role(i).to_string()))
                 .collect();
             let names: Vec<String> = sc.spec.pheromones.iter().map(|p| p.name.clone()).collect();
+            let colours: Vec<[f32; 3]> = sc.spec.pheromones.iter().map(|p| p.colour).collect();
             let a = sc.arena_size();
             let p = &sc.spec.robot;
             let (speed, base, dt) = (p.max_wheel_speed, p.wheel_base, sc.spec.dt);
-            ((a.x, a.y), roles, names, speed, base, dt)
+            ((a.x, a.y), roles, names, colours, speed, base, dt)
         };
-        let (arena, roles, names, speed, base, dt) = match core_of(env)? {
+        let (arena, roles, names, colours, speed, base, dt) = match core_of(env)? {
             Core::Batch(env) => py.detach(|| {
                 let g = env.lock();
                 let world = g.env.world(0).map(|w| w as &dyn ArenaView);
@@ -218,6 +221,7 @@ fn task_info<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'p
         d.set_item("arena", arena)?;
         d.set_item("roles", roles)?;
         d.set_item("pheromones", names)?;
+        d.set_item("colours", colours)?;
         d.set_item("max_wheel_speed", speed)?;
         d.set_item("wheel_base", base)?;
         d.set_item("dt", dt)?;
@@ -268,7 +272,143 @@ fn sample_fields<'py>(
     })
 }
 
+/// Every pheromone's value at `points` float32 `[E, P, 2]` (m) of each world as of the current
+/// observations, and its gradient (per m; central differences `step` m apart on a grid, analytic for
+/// Gaussian sources), exactly as a built-in task reads them: float32 `[E, P, F]` and `[E, P, F, 2]`.
+#[pyfunction]
+fn sample_gradients<'py>(
+    py: Python<'py>,
+    env: &Bound<'py, PyAny>,
+    points: PyReadonlyArrayDyn<'py, f32>,
+    step: f32,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    guard(|| {
+        if !(step.is_finite() && step > 0.0) {
+            return Err(Kind::Action.err(format!("step must be finite and > 0, got {step}")));
+        }
+        let shape = points.shape().to_vec();
+        let pts: Vec<f32> = points.as_array().iter().copied().collect();
+        let sample = |worlds: &[&dyn ArenaView]| {
+            let e = worlds.len();
+            if shape.len() != 3 || shape[0] != e || shape[2] != 2 {
+                return Err(format!(
+                    "points must have shape ({e}, P, 2) = (num_envs, points, xy), got {shape:?}"
+                ));
+            }
+            let (p, f) = (shape[1], worlds.first().map_or(0, |w| w.pheromones().len()));
+            let (mut values, mut grads) = (Vec::with_capacity(e * p * f), Vec::new());
+            grads.reserve(2 * e * p * f);
+            for (world, xy) in worlds.iter().zip(pts.chunks_exact(2 * p.max(1))) {
+                for q in xy.chunks_exact(2) {
+                    let at = colcos_sim::Vec2::new(q[0], q[1]);
+                    for index in 0..f {
+                        let (v, g) = world.pheromone_value_and_gradient_observed(index, at, step);
+                        values.push(v);
+                        grads.extend([g.x, g.y]);
+                    }
+                }
+            }
+            Ok((values, grads, e, p, f))
+        };
+        let sampled = match core_of(env)? {
+            Core::Batch(env) => py.detach(|| {
+                let g = env.lock();
+                let worlds: Vec<&dyn ArenaView> = (0..g.env.spec().num_envs)
+                    .filter_map(|w| g.env.world(w).map(|x| x as &dyn ArenaView))
+                    .collect();
+                sample(&worlds)
+            }),
+            Core::Plant(pl) => py.detach(|| {
+                let g = pl.lock();
+                sample(&[g.host() as &dyn ArenaView])
+            }),
+        };
+        let (values, grads, e, p, f) = sampled.map_err(|m| Kind::Action.err(m))?;
+        Ok((
+            PyArray1::from_vec(py, values)
+                .reshape([e, p, f])?
+                .into_any(),
+            PyArray1::from_vec(py, grads)
+                .reshape([e, p, f, 2])?
+                .into_any(),
+        ))
+    })
+}
+
+/// Moves robots as worlds start an episode: `worlds` int64 `[W]`, `robots` int64 `[K]`, `poses`
+/// float32 `[W, K, 3]` (x m, y m, heading rad). A plant's robots are where they are: refused.
+#[pyfunction]
+fn place_robots(
+    py: Python<'_>,
+    env: &Bound<'_, PyAny>,
+    worlds: PyReadonlyArrayDyn<'_, i64>,
+    robots: PyReadonlyArrayDyn<'_, i64>,
+    poses: PyReadonlyArrayDyn<'_, f32>,
+) -> PyResult<()> {
+    guard(|| {
+        let worlds: Vec<i64> = worlds.as_array().iter().copied().collect();
+        let robots: Vec<i64> = robots.as_array().iter().copied().collect();
+        let shape = poses.shape().to_vec();
+        if shape != [worlds.len(), robots.len(), 3] {
+            return Err(Kind::Action.err(format!(
+                "poses must have shape ({}, {}, 3) = (worlds, robots, x y heading), got {shape:?}",
+                worlds.len(),
+                robots.len()
+            )));
+        }
+        let p: Vec<f32> = poses.as_array().iter().copied().collect();
+        let index = |i: i64, what: &str| {
+            usize::try_from(i).map_err(|_| Kind::Action.err(format!("{what} {i} is negative")))
+        };
+        let robots = (robots.iter().map(|&i| index(i, "robot"))).collect::<PyResult<Vec<_>>>()?;
+        let Core::Batch(env) = core_of(env)? else {
+            return Err(Kind::State.err(
+                "robots are placed only in a simulated batch (VecEnv): a plant's robots are where they are",
+            ));
+        };
+        let mut placed = Vec::with_capacity(worlds.len());
+        for (k, &w) in worlds.iter().enumerate() {
+            let row = &p[k * robots.len() * 3..(k + 1) * robots.len() * 3];
+            let each = robots.iter().zip(row.chunks_exact(3));
+            let poses = each
+                .map(|(&i, q)| (i, Pose::new(q[0], q[1], q[2])))
+                .collect();
+            placed.push((index(w, "world")?, poses));
+        }
+        py.detach(|| {
+            let mut g = env.lock();
+            placed
+                .iter()
+                .try_for_each(|(w, poses): &(usize, Vec<(usize, Pose)>)| g.env.place(*w, poses))
+        })
+        .map_err(to_py)
+    })
+}
+
+/// The unit vectors `(cos a, sin a)` of float32 angles `[...]` (rad), float32 `[..., 2]`: the same
+/// `f32` sine and cosine as the simulator and the built-in tasks use (numpy's differ in the last bit).
+#[pyfunction]
+fn unit_vectors<'py>(
+    py: Python<'py>,
+    angles: PyReadonlyArrayDyn<'py, f32>,
+) -> PyResult<Bound<'py, PyAny>> {
+    guard(|| {
+        let mut shape = angles.shape().to_vec();
+        let a = angles.as_array();
+        let mut out = Vec::with_capacity(2 * a.len());
+        for &t in a.iter() {
+            let v = colcos_sim::Vec2::from_angle(t);
+            out.extend([v.x, v.y]);
+        }
+        shape.push(2);
+        Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(sample_gradients, m)?)?;
+    m.add_function(wrap_pyfunction!(unit_vectors, m)?)?;
+    m.add_function(wrap_pyfunction!(place_robots, m)?)?;
     m.add_function(wrap_pyfunction!(step_deferred, m)?)?;
     m.add_function(wrap_pyfunction!(conclude, m)?)?;
     m.add_function(wrap_pyfunction!(task_view, m)?)?;

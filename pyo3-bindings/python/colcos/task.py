@@ -5,7 +5,7 @@ Each hook runs **once per batched step over every world**, on numpy arrays (`E` 
 `R` robots): no Python loop over worlds. After the worlds have moved, the task sees a `View`:
 
 - `reset(ctx)`: worlds `ctx.worlds` start an episode (per-episode state, per-world parameters drawn
-  from `ctx.rng`, e.g. food positions);
+  from `ctx.rng`, e.g. food positions; `ctx.place(poses)` starts their robots elsewhere);
 - `observe(view) -> (E, N, k)`: extra observation entries appended to the 17 sensor values, within
   the bounds the task declares (`obs_low`, `obs_high`, `k` each);
 - `reward(view) -> (E, N)`; `terminated(view) -> (E, N)` bool (an agent that terminated stays
@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from colcos import _core
-from colcos._core import ActionError, TaskError
+from colcos._core import ActionError, ColcosError, TaskError
 from colcos._options import readonly_views
 
 OBS_DIM = 17
@@ -42,8 +42,10 @@ class View:
     wheel commands m/s, `obs` (E, N, 17) the agents' sensor values (`intensities` (E, N, 4, 3) in
     [0, 1], sensors right, front, left, back; `bumpers` (E, N, 3)), `deposit_actions` (E, N, D) the
     rate fractions the agents chose, `steps` (E,) steps of the episode so far, `episode` (E,),
-    `time` (E,) s. Fixed: `agent_robots` (N,), `roles` [R], `arena` (w, h) m, `pheromones` [F]
-    names, `max_wheel_speed`, `wheel_base`, `dt`. `fields(points)` samples every pheromone.
+    `time` (E,) s; `headings` (E, R, 2) each robot's (cos, sin) of its true heading. Fixed:
+    `agent_robots` (N,), `roles` [R], `arena` (w, h) m, `pheromones` [F] names, `colours` (F, 3)
+    their screen levels per unit (r, g, b), `max_wheel_speed`, `wheel_base`, `dt`.
+    `fields(points)` samples every pheromone; `gradients(points)` also gives their gradients.
     """
 
     def __init__(self, core: _core.VecEnv | _core.Plant, info: dict[str, Any], agent_robots: np.ndarray) -> None:
@@ -61,9 +63,14 @@ class View:
         self.time: np.ndarray = d["time"]
         self.obs: np.ndarray = d["obs"]
         self.agent_robots = agent_robots
+        a = agent_robots
+        consecutive = a.size > 0 and a[-1] - a[0] == a.size - 1 and bool((np.diff(a) == 1).all())
+        self._rows: slice | np.ndarray = slice(int(a[0]), int(a[-1]) + 1) if consecutive else a
+        self._headings: np.ndarray | None = None
         self.roles: list[str] = info["roles"]
         self.arena: tuple[float, float] = (float(info["arena"][0]), float(info["arena"][1]))
         self.pheromones: list[str] = info["pheromones"]
+        self.colours: np.ndarray = np.asarray(info["colours"], np.float32).reshape(-1, 3)
         self.max_wheel_speed = np.float32(info["max_wheel_speed"])
         self.wheel_base = np.float32(info["wheel_base"])
         self.dt = np.float32(info["dt"])
@@ -76,22 +83,50 @@ class View:
     def bumpers(self) -> np.ndarray:
         return self.obs[..., 12:15]
 
+    @property
+    def headings(self) -> np.ndarray:
+        """Each robot's heading as a unit vector (cos, sin), (E, R, 2) float32, with the simulator's
+        own sine and cosine (numpy's float32 ones differ from it in the last bit)."""
+        if self._headings is None:
+            self._headings = _core.unit_vectors(np.ascontiguousarray(self.poses[..., 2]))
+        return self._headings
+
     def agents(self, per_robot: np.ndarray) -> np.ndarray:
-        """The agents' rows of a per-robot array `(E, R, ...)`: `(E, N, ...)`."""
-        return per_robot[:, self.agent_robots]
+        """The agents' rows of a per-robot array `(E, R, ...)`: `(E, N, ...)` (a view, no copy, where
+        the agents are consecutive robots, as in every built-in scenario)."""
+        return per_robot[:, self._rows]
 
     def fields(self, points: np.ndarray) -> np.ndarray:
         """Every pheromone's value at `points` (E, P, 2) m of each world: (E, P, F) float32."""
         return _core.sample_fields(self._core, np.ascontiguousarray(points, dtype=np.float32))
 
+    def gradients(self, points: np.ndarray, step: float = 0.005) -> tuple[np.ndarray, np.ndarray]:
+        """Every pheromone's value at `points` (E, P, 2) m of each world as the sensors read it this
+        step, and its gradient per m: (E, P, F) and (E, P, F, 2) float32. Gaussian sources give their
+        gradient analytically, grids by central differences `step` m apart (as the built-in tasks)."""
+        return _core.sample_gradients(self._core, np.ascontiguousarray(points, dtype=np.float32), float(step))
+
 
 class ResetContext:
-    """Worlds starting an episode: `worlds` (indices), `view` (their state with the rest), `rng`."""
+    """Worlds starting an episode: `worlds` (indices), `view` (their state with the rest), `rng`;
+    `place(poses)` starts their robots elsewhere."""
 
-    def __init__(self, worlds: np.ndarray, view: View, rng: np.random.Generator) -> None:
+    def __init__(self, worlds: np.ndarray, view: View, rng: np.random.Generator, runner: TaskRunner) -> None:
         self.worlds = worlds
         self.view = view
         self.rng = rng
+        self._runner = runner
+        self.placed = False
+
+    def place(self, poses: np.ndarray, robots: Sequence[int] | np.ndarray | None = None) -> None:
+        """Starts robots `robots` (indices, default every robot) of the worlds `worlds` at `poses`
+        `(len(worlds), K, 3)`: x m, y m, heading rad. Each pose must be finite and hold the robot
+        inside the arena, clear of obstacles and of the other robots; else nothing of that world
+        moves and `TaskHookError` names the hook, world and robot. The observations after the
+        reset, and `view.poses` from then on, are taken where the robots now stand. Only in a
+        simulated batch: a plant's robots are where they are."""
+        self._runner.place(self.worlds, poses, robots)
+        self.placed = True
 
 
 class Task:
@@ -199,11 +234,38 @@ class TaskRunner:
         if extra is not None:
             out[..., OBS_DIM:] = extra
 
+    def place(self, worlds: np.ndarray, poses: Any, robots: Any) -> None:
+        """`ResetContext.place`: checked here for shape, in Rust for where the robots land."""
+        r = len(self.info["roles"])
+        where = f"task {self.task.name!r}: hook reset(): ctx.place"
+        ids = np.arange(r, dtype=np.int64) if robots is None else np.asarray(robots).reshape(-1)
+        if ids.dtype.kind not in "iu" or ((ids < 0) | (ids >= r)).any():
+            raise TaskHookError(f"{where}: robots must be robot indices below {r}, got {list(ids)}")
+        want = (len(worlds), len(ids), 3)
+        try:
+            a = np.asarray(poses, dtype=np.float32)
+        except (TypeError, ValueError) as e:
+            raise TaskHookError(f"{where}: poses must be an array of shape {want} (x m, y m, heading rad): {e}") from None
+        if a.shape != want:
+            raise TaskHookError(f"{where}: poses has shape {a.shape}, expected {want} (worlds, robots, x y heading)")
+        try:
+            _core.place_robots(
+                self.core, np.ascontiguousarray(worlds, np.int64), ids.astype(np.int64), np.ascontiguousarray(a)
+            )
+        except ColcosError as e:
+            raise TaskHookError(f"{where}: {e}") from None
+
+    def _reset(self, worlds: np.ndarray, view: View) -> View:
+        """The task's reset of `worlds`; the view afresh where it placed robots."""
+        ctx = ResetContext(worlds, view, self.rng, self)
+        self._call("reset", ctx)
+        return self.view() if ctx.placed else view
+
     def after_reset(self, worlds: np.ndarray) -> None:
         """Worlds `worlds` were reset (by `reset`): the task's reset, then the observations."""
         view = self.view()
         if worlds.size:
-            self._call("reset", ResetContext(worlds, view, self.rng))
+            view = self._reset(worlds, view)
         self._write_obs(self.obs, self.native["obs"], self._extra(view))
 
     def step(self, actions: np.ndarray) -> None:
@@ -212,7 +274,7 @@ class TaskRunner:
         # Worlds that only reset in this step (their episode ended at the last): a new episode.
         started = np.flatnonzero(~view.stepped)
         if started.size:
-            self._call("reset", ResetContext(started, view, self.rng))
+            view = self._reset(started, view)
         rewards = self._array("reward", self._call("reward", view), self.shape, "f")
         term = self._call("terminated", view)
         terminated = np.zeros(self.shape, np.bool_) if term is None else self._array("terminated", term, self.shape, "b")
@@ -226,8 +288,7 @@ class TaskRunner:
         if final is not None and final.any():
             # Finished worlds were reset within the step: their last observation is the final one.
             self._write_obs(self.final_obs, self.native["final_obs"], extra)
-            again = self.view()
-            self._call("reset", ResetContext(np.flatnonzero(final), again, self.rng))
+            again = self._reset(np.flatnonzero(final), self.view())
             extra = self._extra(again)
         self._write_obs(self.obs, self.native["obs"], extra)
 

@@ -14,6 +14,7 @@ mod access;
 mod build;
 mod fields;
 mod inject;
+mod place;
 mod robots;
 mod sensing;
 mod step;

@@ -20,6 +20,12 @@ impl Tracking {
             tracked,
         }
     }
+    /// Starts over from `poses` at `time`, as a tracker just switched on (robots placed by hand).
+    pub fn restart(&mut self, time: f32, poses: &[Pose]) {
+        self.tracker.reset();
+        let tracked = self.tracker.update(time, poses, &mut self.rng);
+        self.tracked.copy_from_slice(tracked);
+    }
     /// Poses as the tracker last delivered them.
     pub fn tracked(&self) -> &[TrackedPose] {
         &self.tracked
