@@ -2,7 +2,6 @@
 //! `colcos.Task.reset`): the world's robots move, and its outputs are written afresh.
 use super::VecEnv;
 use crate::error::{EnvError, Result};
-use crate::world_output::{write_patch, write_state, write_task_obs};
 use colcos_sim::robot::Pose;
 
 impl VecEnv {
@@ -25,25 +24,9 @@ impl VecEnv {
         (slot.world)
             .place_robots(placed)
             .map_err(|m| EnvError::State(format!("world {w}: {m}")))?;
-        let (n, d, sd, pl) = (
-            self.spec.num_agents,
-            self.obs_dim(),
-            self.state_dim,
-            self.patch_len,
-        );
         let slot = &self.slots[w];
-        let max_speed = self.scenario.spec.robot.max_wheel_speed;
-        let task = self.task.as_ref();
-        let obs = &mut self.obs[w * n * d..(w + 1) * n * d];
-        write_task_obs(&slot.world, task, slot.episode.task_state(), max_speed, obs);
-        if sd > 0 {
-            let state = &mut self.state[w * sd..(w + 1) * sd];
-            write_state(&slot.world, slot.episode.steps, self.spec.max_cycles, state);
-        }
-        if let Some(p) = &self.patch_cfg {
-            let patch = &mut self.patch[w * n * pl..(w + 1) * n * pl];
-            write_patch(&slot.world, task.agents(), p, patch);
-        }
+        let out = &mut self.out.world(w);
+        (self.writer).write(self.task.as_ref(), &slot.world, &slot.episode, out);
         Ok(())
     }
 }
