@@ -1,11 +1,16 @@
-//! `colcos rig identify`'s fit against known truths: robots with their own wheel scales, motor lag
-//! and command latency (`[individual]`) driven by the excitation in the simulator, their poses
-//! delivered as a tracker would (1 mm and 0.02 rad of noise, 40 ms old), recorded as the bridge's
-//! ticks; the fit must find every wheel scale within 5 %, every latency within 5 ms and every motor
-//! lag within 20 %. The arena is large (4 m) so that the robots, which no shield guards here, rarely
-//! touch a wall: on the rig the shield keeps them off. Bad input is refused with the reason.
-use colcos_bridge::colias::{CommandPacket, HostCommand};
-use colcos_bridge::identify::{Excitation, FitOptions, fit_robot, robot_series};
+//! `colcos rig identify`'s fit against known truths: robots with their own wheel scales, motor lag,
+//! command latency and colour gain and offset (`[individual]`) driven by the excitation in the
+//! simulator over a screen of printed stripes, their poses delivered as a tracker would (1 mm and
+//! 0.02 rad of noise, 40 ms old) and their colour counts as telemetry answering the loop's requests,
+//! recorded as the bridge's ticks; the fit must find every wheel scale within 5 %, every latency
+//! within 5 ms, every motor lag within 20 % and every sensor gain within 10 %. The arena is large
+//! (4 m) so that the robots, which no shield guards here, rarely touch a wall: on the rig the shield
+//! keeps them off. Bad input is refused with the reason.
+use colcos_bridge::colias::{CommandPacket, HostCommand, Telemetry, colour_from_sim};
+use colcos_bridge::identify::readings::predict_readings;
+use colcos_bridge::identify::{
+    Excitation, FitOptions, STEADY_FRACTION, fit_robot, fit_sensor, robot_series,
+};
 use colcos_bridge::live::PoseIn;
 use colcos_bridge::live::replay::RecordedTick;
 use colcos_sim::behaviour::WheelCommand;
@@ -20,7 +25,7 @@ duration = 120.0
 resolution = [200, 200]
 size = [4.0, 4.0]
 [sensor]
-noise = 0.0
+noise = 20.0
 [tracker]
 latency = 0.0
 position_noise = 0.0
@@ -32,6 +37,24 @@ behaviour = "wander"
 placement = "explicit"
 poses = [[1.5, 1.5, 0.0], [2.5, 1.5, 90.0], [2.0, 2.5, 180.0]]
 "#;
+
+/// Printed stripes over the arena: white ones along x, orange ones along y, 25 cm apart, on the
+/// black screen: what the sensors see changes every few seconds.
+fn stripes(size: f32) -> String {
+    let mut out = String::new();
+    let mut v = 0.3f32;
+    while v < size - 0.2 {
+        out += &format!(
+            "[[obstacles]]\nshape = \"wall\"\nkind = \"printed\"\ncolour = [255, 255, 255]\n\
+             points = [[0.1, {v}], [{e}, {v}]]\nthickness = 0.1\n\
+             [[obstacles]]\nshape = \"wall\"\nkind = \"printed\"\ncolour = [255, 90, 0]\n\
+             points = [[{v}, 0.1], [{v}, {e}]]\nthickness = 0.06\n",
+            e = size - 0.1
+        );
+        v += 0.25;
+    }
+    out
+}
 
 /// splitmix64-driven standard normal draws (Box-Muller), for the tracker's noise.
 struct Noise(u64);
@@ -51,9 +74,11 @@ impl Noise {
 
 /// `seconds` of excitation of a world with `truth` (inline `[individual]` entries) as the bridge's
 /// ticks: each tick the poses captured two ticks earlier, then the commands sent.
-fn record(truth: &str, seconds: f64, seed: u64) -> (Scenario, Vec<RecordedTick>) {
-    let host = Scenario::from_toml_str(SCENARIO, ".").unwrap();
-    let sc = Scenario::from_toml_str(&format!("{SCENARIO}\n{truth}"), ".").unwrap();
+/// Every tick also asks one robot (in turn) for its data, which answers in the next tick with the
+/// colour counts it read when asked. `screen`: what is printed on the screen (TOML).
+fn record(truth: &str, screen: &str, seconds: f64, seed: u64) -> (Scenario, Vec<RecordedTick>) {
+    let host = Scenario::from_toml_str(&format!("{SCENARIO}\n{screen}"), ".").unwrap();
+    let sc = Scenario::from_toml_str(&format!("{SCENARIO}\n{screen}\n{truth}"), ".").unwrap();
     let mut world = World::new(&sc).unwrap();
     let n = sc.robot_count();
     let radio = sc.spec.rig.radio_addresses(n).unwrap();
@@ -62,6 +87,7 @@ fn record(truth: &str, seconds: f64, seed: u64) -> (Scenario, Vec<RecordedTick>)
     let mut noise = Noise(seed);
     let mut history: Vec<Vec<Pose>> = Vec::new();
     let mut ticks = Vec::new();
+    let mut answer: Option<Telemetry> = None;
     for k in 0..(seconds / dt).round() as u64 {
         let t = k as f64 * dt;
         history.push(world.poses().to_vec());
@@ -70,6 +96,7 @@ fn record(truth: &str, seconds: f64, seed: u64) -> (Scenario, Vec<RecordedTick>)
             t,
             step: dt,
             stopped: vec![false; n],
+            telemetry: answer.take().into_iter().collect(),
             ..Default::default()
         };
         if k >= 2 {
@@ -96,22 +123,36 @@ fn record(truth: &str, seconds: f64, seed: u64) -> (Scenario, Vec<RecordedTick>)
             let packet = CommandPacket::new(radio[i], (t * 1000.0) as u32, cmd);
             tick.commands.push(packet.to_frame());
         }
+        // The loop asks one robot a tick; it reads as it hears (the counts of the poses now).
+        let asked = k as usize % n;
+        let request = HostCommand::RequestTelemetry(1);
+        let packet = CommandPacket::new(radio[asked], (t * 1000.0) as u32, request);
+        tick.commands.push(packet.to_frame());
+        if k > 0 {
+            answer = Some(Telemetry {
+                id: radio[asked],
+                sys_t_ms: (t * 1000.0) as u32,
+                colour: colour_from_sim(world.observations()[asked].counts),
+                ..Telemetry::default()
+            });
+        }
         world.step_with_commands(&cmds);
         ticks.push(tick);
     }
     (host, ticks)
 }
 
-/// (wheel scales, motor lag, latency) of each robot of a truth.
-type Truth = [([f64; 2], f64, f64); 3];
+/// (wheel scales, motor lag, latency, (sensor gain, offset)) of each robot of a truth.
+type Truth = [([f64; 2], f64, f64, (f64, f64)); 3];
 
 fn truth_toml(truth: &Truth) -> String {
     truth
         .iter()
         .enumerate()
-        .map(|(i, (s, lag, lat))| {
+        .map(|(i, (s, lag, lat, (g, o)))| {
             format!(
-                "[[individual.robot]]\nindex = {i}\nwheel_scale = [{}, {}]\nmotor_lag = {lag}\nlatency = {lat}\n",
+                "[[individual.robot]]\nindex = {i}\nwheel_scale = [{}, {}]\nmotor_lag = {lag}\nlatency = {lat}\n\
+                 sensor_gain = {g}\nsensor_offset = {o}\n",
                 s[0], s[1]
             )
         })
@@ -119,13 +160,31 @@ fn truth_toml(truth: &Truth) -> String {
 }
 
 fn check(truth: &Truth, seed: u64) {
-    let (sc, ticks) = record(&truth_toml(truth), 60.0, seed);
+    let (sc, ticks) = record(&truth_toml(truth), &stripes(4.0), 60.0, seed);
     let series = robot_series(&ticks, &sc).unwrap();
+    let (readings, white) = predict_readings(&ticks, &sc, &series).unwrap();
     let opts = FitOptions {
         wheel_base: sc.spec.robot.wheel_base as f64,
         ..FitOptions::default()
     };
-    for (i, (s, lag, lat)) in truth.iter().enumerate() {
+    for (i, (s, lag, lat, (gain, offset))) in truth.iter().enumerate() {
+        let sensor = fit_sensor(&readings[i], STEADY_FRACTION * white);
+        let (got_gain, gain_sd) = sensor.gain.clone().unwrap();
+        let (got_offset, offset_sd) = sensor.offset.clone().unwrap();
+        println!(
+            "seed {seed} robot {i}: sensor gain {got_gain:.4} +- {gain_sd:.5} (truth {gain}), offset \
+             {got_offset:.1} +- {offset_sd:.1} (truth {offset}); {} of {} readings, rms {:.1} counts",
+            sensor.used, sensor.readings, sensor.rms
+        );
+        assert!(
+            (got_gain - gain).abs() / gain < 0.1,
+            "robot {i} sensor gain {got_gain} vs {gain}"
+        );
+        // The offset's scale is the dark counts' (30) and the screen's black: within 100 counts.
+        assert!(
+            (got_offset - offset).abs() < 100.0,
+            "robot {i} sensor offset {got_offset} vs {offset}"
+        );
         let fit = fit_robot(i, &series[i].commands, &series[i].poses, &opts);
         let (scale, scale_sd) = fit.wheel_scale.clone().unwrap();
         let (got_lag, lag_sd) = fit.motor_lag.clone().unwrap();
@@ -163,9 +222,9 @@ fn check(truth: &Truth, seed: u64) {
 fn identifies_the_first_truth() {
     check(
         &[
-            ([1.0, 0.9], 0.05, 0.04),
-            ([0.85, 1.0], 0.08, 0.0),
-            ([1.1, 1.05], 0.03, 0.1),
+            ([1.0, 0.9], 0.05, 0.04, (0.8, 120.0)),
+            ([0.85, 1.0], 0.08, 0.0, (1.0, 0.0)),
+            ([1.1, 1.05], 0.03, 0.1, (1.25, -300.0)),
         ],
         1,
     );
@@ -175,9 +234,9 @@ fn identifies_the_first_truth() {
 fn identifies_the_second_truth() {
     check(
         &[
-            ([0.95, 0.95], 0.12, 0.02),
-            ([1.0, 0.8], 0.04, 0.06),
-            ([0.9, 1.1], 0.06, 0.08),
+            ([0.95, 0.95], 0.12, 0.02, (1.1, 50.0)),
+            ([1.0, 0.8], 0.04, 0.06, (0.7, 400.0)),
+            ([0.9, 1.1], 0.06, 0.08, (0.95, -100.0)),
         ],
         2,
     );
@@ -187,9 +246,9 @@ fn identifies_the_second_truth() {
 fn identifies_the_third_truth() {
     check(
         &[
-            ([1.2, 1.0], 0.1, 0.12),
-            ([0.7, 0.75], 0.02, 0.04),
-            ([1.0, 1.0], 0.05, 0.0),
+            ([1.2, 1.0], 0.1, 0.12, (1.4, 0.0)),
+            ([0.7, 0.75], 0.02, 0.04, (0.6, 200.0)),
+            ([1.0, 1.0], 0.05, 0.0, (0.9, 30.0)),
         ],
         3,
     );
@@ -197,7 +256,7 @@ fn identifies_the_third_truth() {
 
 #[test]
 fn too_little_data_names_what_cannot_be_identified() {
-    let (sc, ticks) = record("", 0.6, 4);
+    let (sc, ticks) = record("", &stripes(4.0), 0.6, 4);
     let series = robot_series(&ticks, &sc).unwrap();
     let fit = fit_robot(
         0,
@@ -213,7 +272,6 @@ fn too_little_data_names_what_cannot_be_identified() {
         let why = p.expect("no number from too little data");
         assert!(why.contains("too little data"), "{why}");
     }
-    // Driving straight on: the turning is seen but nothing changes, so the lag and latency cannot be.
     let mut still = ticks.clone();
     for t in &mut still {
         t.commands.clear();
@@ -232,4 +290,20 @@ fn too_little_data_names_what_cannot_be_identified() {
             .to_string()
             .contains("no ticks")
     );
+}
+
+#[test]
+fn a_robot_that_saw_one_colour_has_no_sensor_gain() {
+    // A black screen: every count is the dark counts, which a gain and an offset explain alike.
+    let (sc, ticks) = record("", "", 20.0, 5);
+    let series = robot_series(&ticks, &sc).unwrap();
+    let (readings, white) = predict_readings(&ticks, &sc, &series).unwrap();
+    for r in &readings {
+        assert!(r.len() > 100, "{} readings", r.len());
+        let why = fit_sensor(r, STEADY_FRACTION * white).gain.unwrap_err();
+        assert!(why.contains("too little contrast"), "{why}");
+    }
+    // Without telemetry, the sensor says so.
+    let why = fit_sensor(&[], 400.0).gain.unwrap_err();
+    assert!(why.contains("no telemetry"), "{why}");
 }

@@ -4,6 +4,7 @@
 //! curvature of the profile (latency, lag). A parameter the data cannot pin down is reported as
 //! unidentifiable with the reason, never as a number.
 use super::response::Response;
+use super::sensor::SensorFit;
 use super::windows::{Window, windows};
 use nalgebra::{Matrix2, Vector2};
 
@@ -25,6 +26,8 @@ pub struct RobotFit {
     pub outliers: usize,
     /// RMS residual of the heading turned (rad) and the distance driven (m) per window.
     pub rms: [f64; 2],
+    /// The colour sensor's gain and offset (from the telemetry; [`super::identify`] fills it in).
+    pub sensor: SensorFit,
 }
 
 /// What the fit searches over and needs.
@@ -89,6 +92,7 @@ pub fn fit_robot(
         windows: moving.len(),
         outliers: 0,
         rms: [f64::NAN; 2],
+        sensor: SensorFit::none("not fitted: identification was given no telemetry", 0),
     };
     let driven: f64 = moving.iter().map(|w| w.driven.abs()).sum();
     if moving.len() < opts.min_windows || driven < 0.05 {
