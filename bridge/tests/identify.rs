@@ -7,15 +7,18 @@
 //! (4 m) so that the robots, which no shield guards here, rarely touch a wall: on the rig the shield
 //! keeps them off. Bad input is refused with the reason.
 use colcos_bridge::colias::{CommandPacket, HostCommand, Telemetry, colour_from_sim};
+use colcos_bridge::identify::excite::check_room;
+use colcos_bridge::identify::overlay::overlay;
 use colcos_bridge::identify::readings::predict_readings;
 use colcos_bridge::identify::{
-    Excitation, FitOptions, STEADY_FRACTION, fit_robot, fit_sensor, robot_series,
+    Excitation, FitOptions, STEADY_FRACTION, fit_robot, fit_sensor, identify, robot_series,
 };
 use colcos_bridge::live::PoseIn;
 use colcos_bridge::live::replay::RecordedTick;
+use colcos_bridge::recorder::{Recorder, Topic};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Pose;
-use colcos_sim::scenario::Scenario;
+use colcos_sim::scenario::{IndividualFile, Scenario};
 use colcos_sim::world::World;
 
 const SCENARIO: &str = r#"
@@ -73,10 +76,17 @@ impl Noise {
 }
 
 /// `seconds` of excitation of a world with `truth` (inline `[individual]` entries) as the bridge's
-/// ticks: each tick the poses captured two ticks earlier, then the commands sent.
-/// Every tick also asks one robot (in turn) for its data, which answers in the next tick with the
-/// colour counts it read when asked. `screen`: what is printed on the screen (TOML).
-fn record(truth: &str, screen: &str, seconds: f64, seed: u64) -> (Scenario, Vec<RecordedTick>) {
+/// ticks, as the live loop makes them: every `pose_every` ticks the poses captured two ticks
+/// earlier; the commands that changed (and every 0.5 s the unchanged ones); every third tick a
+/// data request to one robot in turn, which answers in the next tick with the colour counts it read
+/// when asked. `screen`: what is printed on the screen (TOML).
+fn record(
+    truth: &str,
+    screen: &str,
+    seconds: f64,
+    seed: u64,
+    pose_every: u64,
+) -> (Scenario, Vec<RecordedTick>) {
     let host = Scenario::from_toml_str(&format!("{SCENARIO}\n{screen}"), ".").unwrap();
     let sc = Scenario::from_toml_str(&format!("{SCENARIO}\n{screen}\n{truth}"), ".").unwrap();
     let mut world = World::new(&sc).unwrap();
@@ -88,6 +98,7 @@ fn record(truth: &str, screen: &str, seconds: f64, seed: u64) -> (Scenario, Vec<
     let mut history: Vec<Vec<Pose>> = Vec::new();
     let mut ticks = Vec::new();
     let mut answer: Option<Telemetry> = None;
+    let mut sent = vec![(WheelCommand::STOP, f64::NEG_INFINITY); n];
     for k in 0..(seconds / dt).round() as u64 {
         let t = k as f64 * dt;
         history.push(world.poses().to_vec());
@@ -99,7 +110,7 @@ fn record(truth: &str, screen: &str, seconds: f64, seed: u64) -> (Scenario, Vec<
             telemetry: answer.take().into_iter().collect(),
             ..Default::default()
         };
-        if k >= 2 {
+        if k >= 2 && k % pose_every == 0 {
             let seen = &history[k as usize - 2];
             tick.poses = (0..n)
                 .map(|i| PoseIn {
@@ -116,6 +127,10 @@ fn record(truth: &str, screen: &str, seconds: f64, seed: u64) -> (Scenario, Vec<
         }
         let cmds: Vec<WheelCommand> = (0..n).map(|i| excite.command(i, t)).collect();
         for (i, c) in cmds.iter().enumerate() {
+            if *c == sent[i].0 && t - sent[i].1 < 0.5 {
+                continue;
+            }
+            sent[i] = (*c, t);
             let cmd = HostCommand::WheelSpeeds {
                 left: c.left,
                 right: c.right,
@@ -123,12 +138,12 @@ fn record(truth: &str, screen: &str, seconds: f64, seed: u64) -> (Scenario, Vec<
             let packet = CommandPacket::new(radio[i], (t * 1000.0) as u32, cmd);
             tick.commands.push(packet.to_frame());
         }
-        // The loop asks one robot a tick; it reads as it hears (the counts of the poses now).
-        let asked = k as usize % n;
-        let request = HostCommand::RequestTelemetry(1);
-        let packet = CommandPacket::new(radio[asked], (t * 1000.0) as u32, request);
-        tick.commands.push(packet.to_frame());
-        if k > 0 {
+        // A robot reads as it hears the request (the counts of the poses now).
+        let asked = (k / 3) as usize % n;
+        if k > 0 && k % 3 == 0 {
+            let request = HostCommand::RequestTelemetry(1);
+            let packet = CommandPacket::new(radio[asked], (t * 1000.0) as u32, request);
+            tick.commands.push(packet.to_frame());
             answer = Some(Telemetry {
                 id: radio[asked],
                 sys_t_ms: (t * 1000.0) as u32,
@@ -160,7 +175,7 @@ fn truth_toml(truth: &Truth) -> String {
 }
 
 fn check(truth: &Truth, seed: u64) {
-    let (sc, ticks) = record(&truth_toml(truth), &stripes(4.0), 60.0, seed);
+    let (sc, ticks) = record(&truth_toml(truth), &stripes(4.0), 60.0, seed, 1);
     let series = robot_series(&ticks, &sc).unwrap();
     let (readings, white) = predict_readings(&ticks, &sc, &series).unwrap();
     let opts = FitOptions {
@@ -256,7 +271,7 @@ fn identifies_the_third_truth() {
 
 #[test]
 fn too_little_data_names_what_cannot_be_identified() {
-    let (sc, ticks) = record("", &stripes(4.0), 0.6, 4);
+    let (sc, ticks) = record("", &stripes(4.0), 0.6, 4, 1);
     let series = robot_series(&ticks, &sc).unwrap();
     let fit = fit_robot(
         0,
@@ -295,7 +310,7 @@ fn too_little_data_names_what_cannot_be_identified() {
 #[test]
 fn a_robot_that_saw_one_colour_has_no_sensor_gain() {
     // A black screen: every count is the dark counts, which a gain and an offset explain alike.
-    let (sc, ticks) = record("", "", 20.0, 5);
+    let (sc, ticks) = record("", "", 20.0, 5, 1);
     let series = robot_series(&ticks, &sc).unwrap();
     let (readings, white) = predict_readings(&ticks, &sc, &series).unwrap();
     for r in &readings {
@@ -306,4 +321,152 @@ fn a_robot_that_saw_one_colour_has_no_sensor_gain() {
     // Without telemetry, the sensor says so.
     let why = fit_sensor(&[], 400.0).gain.unwrap_err();
     assert!(why.contains("no telemetry"), "{why}");
+}
+
+/// `ticks` as the rig log `colcos bridge` writes (the topics `colcos rig identify` reads), for a
+/// run of `sc` whose pose ages are exact (no tracker delivery left out).
+fn write_log(path: &std::path::Path, sc: &Scenario, ticks: &[RecordedTick]) {
+    let mut rec = Recorder::create(path).unwrap();
+    let meta = [
+        ("scenario", sc.spec.name.clone()),
+        ("robots", sc.robot_count().to_string()),
+        ("tracker_latency", "0".to_string()),
+    ];
+    rec.write_metadata("rig", meta.map(|(k, v)| (k.to_string(), v)).into())
+        .unwrap();
+    for tick in ticks {
+        let t_ns = (tick.t * 1e9) as u64;
+        if !tick.poses.is_empty() {
+            let poses: Vec<_> = (tick.poses.iter())
+                .map(|p| {
+                    serde_json::json!({"id": p.id, "x": p.pose.pos.x, "y": p.pose.pos.y,
+                        "heading": p.pose.heading, "age": p.age, "fresh": p.fresh})
+                })
+                .collect();
+            let json = serde_json::to_vec(&poses).unwrap();
+            rec.record(Topic::Poses, t_ns, &json).unwrap();
+        }
+        for tm in &tick.telemetry {
+            rec.record(Topic::Telemetry, t_ns, &tm.to_frame()).unwrap();
+        }
+        for c in &tick.commands {
+            rec.record(Topic::Commands, t_ns, c).unwrap();
+        }
+        let marker = serde_json::json!({"tick": tick.tick, "t": tick.t, "step": tick.step,
+            "stopped": [], "commands": tick.commands.len()});
+        rec.record(Topic::Ticks, t_ns, marker.to_string().as_bytes())
+            .unwrap();
+    }
+    rec.finish().unwrap();
+}
+
+/// The small log the Python tests identify (`bridge/tests/data/identify`): 10 s of three robots
+/// with a truth over the stripes. `COLCOS_WRITE_FIXTURES=1` writes it anew; the committed one and
+/// this run's must both identify to the truth.
+#[test]
+fn a_rig_log_identifies_end_to_end_and_bad_logs_are_refused() {
+    let truth: Truth = [
+        ([1.0, 0.9], 0.05, 0.04, (0.8, 120.0)),
+        ([0.85, 1.0], 0.08, 0.0, (1.0, 0.0)),
+        ([1.1, 1.05], 0.03, 0.1, (1.25, 60.0)),
+    ];
+    let screen = stripes(4.0);
+    let (sc, ticks) = record(&truth_toml(&truth), &screen, 10.0, 1, 1);
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("rig.mcap");
+    write_log(&log, &sc, &ticks);
+    let bytes = std::fs::read(&log).unwrap();
+    let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/identify");
+    let scenario_text = format!("{SCENARIO}\n{screen}");
+    let truth_text = truth_toml(&truth).replace("[[individual.robot]]", "[[robot]]");
+    if std::env::var_os("COLCOS_WRITE_FIXTURES").is_some() {
+        std::fs::create_dir_all(&fixture).unwrap();
+        std::fs::write(fixture.join("rig.mcap"), &bytes).unwrap();
+        std::fs::write(fixture.join("scenario.toml"), &scenario_text).unwrap();
+        std::fs::write(fixture.join("truth.toml"), &truth_text).unwrap();
+    }
+    let committed = std::fs::read(fixture.join("rig.mcap")).unwrap();
+    let on_file = std::fs::read_to_string(fixture.join("scenario.toml")).unwrap();
+    assert_eq!(on_file, scenario_text);
+    assert_eq!(
+        std::fs::read_to_string(fixture.join("truth.toml")).unwrap(),
+        truth_text
+    );
+
+    for log in [&committed, &bytes] {
+        check_log(log, &sc, &truth);
+    }
+    let found = identify(&bytes, &sc, &FitOptions::default()).unwrap();
+    let file = overlay(&found, "rig.mcap", &sc.spec.name);
+    let again = IndividualFile::parse(&file.to_toml()).unwrap();
+    assert_eq!(again.robot.len(), 3);
+    assert!(again.robot.iter().all(|r| r.sensor_gain.is_some()));
+
+    // Refused, naming why: another scenario, a log without commands, without poses, not a log.
+    let other =
+        Scenario::from_toml_str(&scenario_text.replace("\"identify\"", "\"other\""), ".").unwrap();
+    let err = identify(&bytes, &other, &FitOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("not \"other\""), "{err}");
+    let strip = |keep: &dyn Fn(&mut RecordedTick)| {
+        let mut t = ticks.clone();
+        t.iter_mut().for_each(keep);
+        let path = dir.path().join("stripped.mcap");
+        write_log(&path, &sc, &t);
+        let err = identify(&std::fs::read(&path).unwrap(), &sc, &FitOptions::default());
+        err.unwrap_err().to_string()
+    };
+    let err = strip(&|t| t.commands.clear());
+    assert!(err.contains("no wheel commands"), "{err}");
+    let err = strip(&|t| t.poses.clear());
+    assert!(err.contains("no poses"), "{err}");
+    let err = identify(b"not a log", &sc, &FitOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("no tick records"), "{err}");
+}
+
+/// `log` (of `sc`) identifies to `truth`: scales within 5 %, latency within 20 ms (a short log; 60 s
+/// give 5 ms), sensor gain within 10 %.
+fn check_log(log: &[u8], sc: &Scenario, truth: &Truth) {
+    let found = identify(log, sc, &FitOptions::default()).unwrap();
+    assert_eq!(found.pose_delay, 0.0);
+    for (f, (s, _, lat, (gain, _))) in found.robots.iter().zip(truth) {
+        let (scale, _) = f.wheel_scale.clone().unwrap();
+        let (got_lat, _) = f.latency.clone().unwrap();
+        let (got_gain, _) = f.sensor.gain.clone().unwrap();
+        println!(
+            "robot {}: scales {scale:.4?}, latency {got_lat:.4}, gain {got_gain:.4}",
+            f.index
+        );
+        assert!((0..2).all(|w| (scale[w] - s[w]).abs() / s[w] < 0.05));
+        assert!((got_lat - lat).abs() < 0.02, "{got_lat} vs {lat}");
+        assert!((got_gain - gain).abs() / gain < 0.1, "{got_gain} vs {gain}");
+    }
+}
+
+#[test]
+fn an_excitation_that_would_leave_the_arena_is_refused() {
+    let room = |extra: &str| {
+        let sc = Scenario::from_toml_str(&format!("{SCENARIO}\n{extra}"), ".").unwrap();
+        check_room(&sc, 0.14)
+    };
+    assert_eq!(room(""), Ok(()));
+    let why = room("[rig]\nshield = { margin = 0.01 }").unwrap_err();
+    assert!(
+        why.contains("shield.margin = 0.01") && why.contains("radius"),
+        "{why}"
+    );
+    let why = room("[rig]\nshield = { horizon = 0.0 }\n[robot]\nmotor_lag = 0.3").unwrap_err();
+    assert!(
+        why.contains("while it stops") && why.contains("--speed"),
+        "{why}"
+    );
+    let small = SCENARIO
+        .replace("size = [4.0, 4.0]", "size = [0.15, 0.15]")
+        .replace(
+            "poses = [[1.5, 1.5, 0.0], [2.5, 1.5, 90.0], [2.0, 2.5, 180.0]]",
+            "poses = [[0.05, 0.05, 0.0], [0.1, 0.05, 0.0], [0.05, 0.1, 0.0]]",
+        );
+    let sc = Scenario::from_toml_str(&small, ".").unwrap();
+    let why = check_room(&sc, 0.14).unwrap_err();
+    assert!(why.contains("inside the shield's walls"), "{why}");
+    assert!(check_room(&Scenario::from_toml_str(SCENARIO, ".").unwrap(), 0.0).is_err());
 }

@@ -47,6 +47,11 @@ pub struct FitOptions {
     /// its wheels reach at the step's end, half a step ahead of a continuous motor, so the latency
     /// written is the continuous one plus half a step (the simulator then reproduces the timing).
     pub step: f64,
+    /// How much older every pose is than its logged age says, s: the tracker's fastest delivery,
+    /// which the bridge takes for the tracker's clock offset and so leaves out of the ages. `None`:
+    /// the `tracker_latency` the log was recorded with (the scenario's `[tracker] latency`, as
+    /// `colcos calibrate latency` measures it). Left in, it would count as the robots' latency.
+    pub pose_delay: Option<f64>,
 }
 
 impl Default for FitOptions {
@@ -58,6 +63,7 @@ impl Default for FitOptions {
             span: 0.1,
             min_windows: 50,
             step: 0.02,
+            pose_delay: None,
         }
     }
 }

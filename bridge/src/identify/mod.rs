@@ -34,6 +34,11 @@ pub struct Identified {
     pub tracker_latency: Option<f64>,
     /// Seconds of log.
     pub duration: f64,
+    /// The tracker's delivery added to every pose's age ([`FitOptions::pose_delay`]), s.
+    pub pose_delay: f64,
+    /// Median time from a data request to its answer's arrival, s (the link both ways and the
+    /// loop's tick): none without telemetry.
+    pub round_trip: Option<f64>,
 }
 
 impl Identified {
@@ -77,10 +82,26 @@ pub fn identify(
     scenario: &Scenario,
     opts: &FitOptions,
 ) -> Result<Identified, IdentifyError> {
-    series::check_scenario(&read_metadata(bytes), scenario)?;
+    let metadata = read_metadata(bytes);
+    series::check_scenario(&metadata, scenario)?;
     let log = read_log(bytes);
     let ticks = replay::ticks_of(&log, scenario.robot_count())?;
-    let robots = robot_series(&ticks, scenario)?;
+    let mut robots = robot_series(&ticks, scenario)?;
+    let recorded = (metadata.iter().find(|(name, _)| name == "rig"))
+        .and_then(|(_, rig)| rig.get("tracker_latency")?.parse::<f64>().ok());
+    let pose_delay = (opts.pose_delay.or(recorded))
+        .unwrap_or(scenario.spec.tracker.latency as f64)
+        .clamp(0.0, 1.0);
+    for r in &mut robots {
+        for p in &mut r.poses {
+            p.0 -= pose_delay;
+        }
+    }
+    let mut trips: Vec<f64> = (robots.iter())
+        .flat_map(|r| r.answers.iter().map(|(sent, _, got)| got - sent))
+        .collect();
+    trips.sort_by(f64::total_cmp);
+    let round_trip = trips.get(trips.len() / 2).copied();
     let ages: Vec<f64> = ticks
         .iter()
         .flat_map(|t| t.poses.iter().filter(|p| p.fresh).map(|p| p.age))
@@ -112,5 +133,7 @@ pub fn identify(
         robots: fits,
         tracker_latency,
         duration,
+        pose_delay,
+        round_trip,
     })
 }

@@ -15,6 +15,16 @@ pub fn overlay(found: &Identified, log: &str, scenario: &str) -> IndividualFile 
         "duration_s".into(),
         toml::Value::Float(round(found.duration, 3)),
     );
+    notes.insert(
+        "pose_delay".into(),
+        toml::Value::Float(round(found.pose_delay, 4)),
+    );
+    if let Some(t) = found.round_trip {
+        notes.insert(
+            "telemetry_round_trip".into(),
+            toml::Value::Float(round(t, 4)),
+        );
+    }
     if let Some(t) = found.tracker_latency {
         notes.insert("tracker_latency".into(), toml::Value::Float(round(t, 4)));
     }

@@ -53,7 +53,11 @@ pub fn predict_readings(
     let screen = *world.screen();
     let mut core = LoopCore::new(scenario, LegacyDrive::default())?;
     let mut rng = rng::stream_of(scenario.spec.seed, 0, Stream::Telemetry(0));
-    let white = quiet.counts([255.0; 3], &mut rng).into_iter().max().unwrap_or(0) as f64;
+    let white = quiet
+        .counts([255.0; 3], &mut rng)
+        .into_iter()
+        .max()
+        .unwrap_or(0) as f64;
     // Every robot's readings in the order of their times, each predicted once the replay has
     // reached that time.
     let mut pending: Vec<(f64, usize, [[u16; 3]; 4])> = (series.iter().enumerate())

@@ -70,12 +70,19 @@ pub fn fit_sensor(readings: &[Reading], steady: f64) -> SensorFit {
     for _ in 0..4 {
         let used = distinct(&points);
         let contrast = sd(points.iter().map(|p| p.1));
-        if used < MIN_READINGS || !(contrast >= MIN_CONTRAST) {
+        if used < MIN_READINGS {
             let why = format!(
-                "unidentifiable: the robot saw too little contrast ({used} of {} readings steady, \
-                 predicted counts spread {contrast:.0} (sd); at least {MIN_READINGS} readings \
-                 and {MIN_CONTRAST} counts needed)",
+                "unidentifiable: only {used} of {} readings were usable (a tracked pose, a sensor \
+                 clear of the pattern's edges, counts inside 1..65534); at least {MIN_READINGS} \
+                 needed",
                 readings.len()
+            );
+            return SensorFit::none(&why, readings.len());
+        }
+        if !(contrast >= MIN_CONTRAST) {
+            let why = format!(
+                "unidentifiable: the robot saw too little contrast (predicted counts spread \
+                 {contrast:.0} (sd) over {used} steady readings; at least {MIN_CONTRAST} needed)"
             );
             return SensorFit::none(&why, readings.len());
         }

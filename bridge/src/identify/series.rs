@@ -91,7 +91,9 @@ pub fn robot_series(
                 let read = asked[i].unwrap_or(tick.t);
                 out[i].telemetry.push((read, colour_to_sim(tm.colour)));
                 if let Some(sent) = asked[i] {
-                    out[i].answers.push((sent, tm.sys_t_ms as f64 * 1e-3, tick.t));
+                    out[i]
+                        .answers
+                        .push((sent, tm.sys_t_ms as f64 * 1e-3, tick.t));
                 }
             }
         }
