@@ -208,7 +208,7 @@ pub fn identify(args: IdentifyArgs, text: &mut String) -> Result<()> {
         )?;
         let sensor = match (&f.sensor.gain, &f.sensor.offset) {
             (Ok((g, g_sd)), Ok((o, o_sd))) => format!(
-                "gain {g:.3} +- {g_sd:.3}, offset {o:.0} +- {o_sd:.0} counts ({} of {} readings, rms {:.0} counts)",
+                "gain {g:.4} +- {g_sd:.4}, offset {o:.0} +- {o_sd:.0} counts ({} of {} readings, rms {:.0} counts)",
                 f.sensor.used, f.sensor.readings, f.sensor.rms
             ),
             (Err(why), _) | (_, Err(why)) => why.clone(),

@@ -79,7 +79,7 @@ pub fn fit_sensor(readings: &[Reading], steady: f64) -> SensorFit {
             );
             return SensorFit::none(&why, readings.len());
         }
-        if !(contrast >= MIN_CONTRAST) {
+        if contrast.is_nan() || contrast < MIN_CONTRAST {
             let why = format!(
                 "unidentifiable: the robot saw too little contrast (predicted counts spread \
                  {contrast:.0} (sd) over {used} steady readings; at least {MIN_CONTRAST} needed)"
