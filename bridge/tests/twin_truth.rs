@@ -48,8 +48,10 @@ fn stripes() -> String {
     out
 }
 
-/// (wheel scales, motor lag, latency, (sensor gain, offset)) per robot.
-const TRUTH: [([f64; 2], f64, f64, (f64, f64)); 3] = [
+/// (wheel scales, motor lag, latency, (sensor gain, offset)) of one robot.
+type RobotTruth = ([f64; 2], f64, f64, (f64, f64));
+
+const TRUTH: [RobotTruth; 3] = [
     ([1.0, 0.9], 0.08, 0.04, (0.8, 100.0)),
     ([0.85, 1.0], 0.05, 0.0, (1.2, -200.0)),
     ([1.1, 1.0], 0.03, 0.1, (1.0, 0.0)),
