@@ -1,10 +1,12 @@
 //! `colcos rig excite` and `colcos rig identify`: drive a short, bounded excitation through the
-//! bridge (inside the shield) while it records the rig log, then fit each robot's wheel scales,
-//! motor lag and command latency from that log into a file of per-robot values that a scenario's
-//! `[individual] file` (and `colcos twin --truth`) reads.
+//! bridge (inside the shield, showing the scenario's screen) while it records the rig log, then fit
+//! each robot's wheel scales, motor lag, command latency and colour gain and offset from that log
+//! into a file of per-robot values that a scenario's `[individual] file` (and `colcos twin
+//! --truth`) reads.
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use colcos_bridge::calibrate::RigCalibration;
+use colcos_bridge::transport::FrameServer;
 use colcos_bridge::identify::{self, Excitation, FitOptions, Param};
 use colcos_bridge::rig::{LiveOptions, LiveSession};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
@@ -32,6 +34,16 @@ pub struct ExciteArgs {
     /// Largest wheel speed commanded, as a fraction of the shield's limit.
     #[arg(long, default_value_t = 0.4)]
     pub speed: f64,
+    /// Show the scenario's screen full screen on this monitor (the arena's LCD) during the
+    /// excitation: what the robots' colour sensors see, from which their gain is identified.
+    #[arg(long)]
+    pub display: Option<usize>,
+    /// With --display: a window instead of full screen.
+    #[arg(long)]
+    pub windowed: bool,
+    /// Serve the displayed frames on this address (e.g. 127.0.0.1:7700) for a twin or a viewer.
+    #[arg(long)]
+    pub frames: Option<std::net::SocketAddr>,
     /// Output directory: rig.mcap.
     #[arg(long, default_value = "runs/excite")]
     pub out: PathBuf,
@@ -47,6 +59,10 @@ pub struct IdentifyArgs {
     /// Where to write the robots' values (a file of `[[robot]]` entries for `[individual] file`).
     #[arg(long)]
     pub out: PathBuf,
+    /// How much older every pose is than the age the bridge logged, s: the tracker's fastest
+    /// delivery (default: the `[tracker] latency` the log was recorded with).
+    #[arg(long)]
+    pub pose_delay: Option<f64>,
 }
 
 /// `colcos rig excite`.
@@ -72,15 +88,11 @@ pub fn excite(args: ExciteArgs, text: &mut String) -> Result<()> {
         .min(sc.spec.robot.max_wheel_speed);
     // The excitation turns and drives in small circles; its commands go through the shield, which
     // keeps every robot inside the arena's virtual walls, and what the shield made of them is what
-    // the log records and identification fits.
-    if sc.spec.rig.shield.margin < sc.spec.robot.radius {
-        bail!(
-            "[rig] shield.margin = {} m is less than the robot's radius {} m: the excitation would \
-             drive bodies past the arena's edge; widen the margin",
-            sc.spec.rig.shield.margin,
-            sc.spec.robot.radius
-        );
-    }
+    // the log records and identification fits. An arena or shield that cannot hold it is refused
+    // before anything moves.
+    let max_speed = args.speed * limit as f64;
+    identify::excite::check_room(&sc, max_speed)
+        .map_err(|why| anyhow::anyhow!("refused: {why}"))?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating output directory {}", args.out.display()))?;
     let calibration = RigCalibration::load(&sc)?;
@@ -90,14 +102,32 @@ pub fn excite(args: ExciteArgs, text: &mut String) -> Result<()> {
     let link =
         open_robot_link(&args.robots).with_context(|| format!("--robots {}", args.robots))?;
     let log = args.out.join("rig.mcap");
+    let frames = match args.frames {
+        Some(addr) => Some(FrameServer::bind(addr).with_context(|| format!("--frames {addr}"))?),
+        None => None,
+    };
+    let display = match args.display {
+        Some(monitor) => Some(std::sync::Mutex::new(crate::rig::open_display(
+            &sc,
+            monitor,
+            args.windowed,
+            960,
+        )?)),
+        None => None,
+    };
     let live_opts = LiveOptions {
         duration: Some(args.seconds),
         log: Some(log.clone()),
+        display,
+        display_width: 960,
+        display_hz: 10.0,
+        stream_width: 960,
+        stream_hz: 25.0,
         ..LiveOptions::default()
     };
-    let excitation = Excitation::new(sc.spec.seed, (args.speed * limit as f64) as f32);
+    let excitation = Excitation::new(sc.spec.seed, max_speed as f32);
     let n = sc.robot_count();
-    let mut session = LiveSession::new(&sc, source, link, None, live_opts)?;
+    let mut session = LiveSession::new(&sc, source, link, frames, live_opts)?;
     let mut overrides: Vec<Option<WheelCommand>> = vec![None; n];
     while !session.is_over() {
         let t = session.elapsed();
@@ -130,7 +160,16 @@ pub fn identify(args: IdentifyArgs, text: &mut String) -> Result<()> {
     let sc = Scenario::from_file(&args.scenario)?;
     let bytes =
         std::fs::read(&args.log).with_context(|| format!("reading {}", args.log.display()))?;
-    let found = identify::identify(&bytes, &sc, &FitOptions::default())
+    if let Some(d) = args.pose_delay
+        && !(d.is_finite() && (0.0..=1.0).contains(&d))
+    {
+        bail!("--pose-delay {d}: must be in [0, 1] s");
+    }
+    let opts = FitOptions {
+        pose_delay: args.pose_delay,
+        ..FitOptions::default()
+    };
+    let found = identify::identify(&bytes, &sc, &opts)
         .with_context(|| format!("identifying from {}", args.log.display()))?;
     writeln!(
         text,
@@ -139,6 +178,14 @@ pub fn identify(args: IdentifyArgs, text: &mut String) -> Result<()> {
         found
             .tracker_latency
             .map_or("unknown".into(), |t| format!("{:.1} ms", 1e3 * t))
+    )?;
+    writeln!(
+        text,
+        "poses taken {:.1} ms older than their logged age (the tracker's delivery); telemetry round trip {}",
+        1e3 * found.pose_delay,
+        found
+            .round_trip
+            .map_or("none".into(), |t| format!("{:.1} ms", 1e3 * t))
     )?;
     if let Some((p, h)) = found.tracker_noise() {
         writeln!(
@@ -159,6 +206,14 @@ pub fn identify(args: IdentifyArgs, text: &mut String) -> Result<()> {
             f.windows,
             f.outliers
         )?;
+        let sensor = match (&f.sensor.gain, &f.sensor.offset) {
+            (Ok((g, g_sd)), Ok((o, o_sd))) => format!(
+                "gain {g:.4} +- {g_sd:.4}, offset {o:.0} +- {o_sd:.0} counts ({} of {} readings, rms {:.0} counts)",
+                f.sensor.used, f.sensor.readings, f.sensor.rms
+            ),
+            (Err(why), _) | (_, Err(why)) => why.clone(),
+        };
+        writeln!(text, "  colour sensor: {sensor}")?;
     }
     let file = identify::overlay::overlay(&found, &args.log.display().to_string(), &sc.spec.name);
     std::fs::write(&args.out, file.to_toml())

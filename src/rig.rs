@@ -124,7 +124,12 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
     };
     let log = args.out.join("rig.mcap");
     let display = match args.display {
-        Some(monitor) => Some(std::sync::Mutex::new(open_display(&sc, monitor, &args)?)),
+        Some(monitor) => Some(std::sync::Mutex::new(open_display(
+            &sc,
+            monitor,
+            args.windowed,
+            args.display_width,
+        )?)),
         None => None,
     };
     let live_opts = LiveOptions {
@@ -274,10 +279,11 @@ pub fn twin(args: TwinArgs, text: &mut String) -> Result<()> {
 
 /// The LCD's window: full screen on `monitor` (or windowed), showing each frame as it comes.
 #[cfg(feature = "display")]
-fn open_display(
+pub(crate) fn open_display(
     sc: &Scenario,
     monitor: usize,
-    args: &BridgeArgs,
+    windowed: bool,
+    width: u32,
 ) -> Result<Box<dyn colcos_bridge::rig::FrameSink>> {
     struct Window(colcos_display::Viewer);
     impl colcos_bridge::rig::FrameSink for Window {
@@ -289,12 +295,12 @@ fn open_display(
             self.0.show(rgba, size)
         }
     }
-    let w = args.display_width.clamp(16, 7680);
+    let w = width.clamp(16, 7680);
     let s = sc.spec.screen.size;
     let size = (w, ((w as f32) * s[1] / s[0]).round().max(1.0) as u32);
     let opts = colcos_display::DisplayOptions {
         title: "colcos bridge".into(),
-        fullscreen: !args.windowed,
+        fullscreen: !windowed,
         monitor: Some(monitor),
         // The loop paces the frames; the window must never hold it up.
         frame_period: std::time::Duration::from_millis(1),
@@ -306,10 +312,11 @@ fn open_display(
 }
 
 #[cfg(not(feature = "display"))]
-fn open_display(
+pub(crate) fn open_display(
     _: &Scenario,
     monitor: usize,
-    _: &BridgeArgs,
+    _: bool,
+    _: u32,
 ) -> Result<Box<dyn colcos_bridge::rig::FrameSink>> {
     bail!("--display {monitor}: this build has no display window (the `display` feature)")
 }

@@ -9,6 +9,7 @@ mod errors;
 mod limits;
 mod plant;
 mod registry;
+mod rig;
 mod spec;
 mod sweep;
 mod task_hooks;
@@ -26,6 +27,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     plant::register(m)?;
     baseline::register(m)?;
     registry::register(m)?;
+    rig::register(m)?;
     window::register(m)?;
     sweep::register(m)?;
     task_hooks::register(m)?;

@@ -3,8 +3,9 @@
 //! wheel speeds (revealing each wheel's scale through the turning and the driving), sometimes
 //! turning on the spot or standing still. Bounded: every wheel at most `max_speed`. Stateless in
 //! time: the command at `t` follows from the seed, the robot and `t` alone, so a replay or a test
-//! gets the same sequence.
+//! gets the same sequence. [`check_room`] refuses an excitation the arena and its shield cannot hold.
 use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::scenario::Scenario;
 
 #[derive(Clone, Copy, Debug)]
 pub struct Excitation {
@@ -57,6 +58,63 @@ impl Excitation {
         };
         WheelCommand { left, right }
     }
+}
+
+/// Why an excitation with wheels up to `max_speed` m/s would leave `scenario`'s arena, or `Ok`:
+/// every command goes through the shield, which stops a robot whose command would cross its virtual
+/// walls within its look-ahead; the robot must then stop before its body reaches the arena's edge,
+/// and there must be room between the walls to drive at all.
+pub fn check_room(scenario: &Scenario, max_speed: f64) -> Result<(), String> {
+    let shield = &scenario.spec.rig.shield;
+    let robot = &scenario.spec.robot;
+    let (margin, radius) = (shield.margin as f64, robot.radius as f64);
+    if !(max_speed.is_finite() && max_speed > 0.0) {
+        return Err(format!(
+            "the excitation's wheel speed {max_speed} m/s: must be above 0"
+        ));
+    }
+    if margin < radius {
+        return Err(format!(
+            "[rig] shield.margin = {} m is less than the robot's radius {} m: the excitation would \
+             drive bodies past the arena's edge; widen the margin",
+            shield.margin, robot.radius
+        ));
+    }
+    // Between the walls: a robot's width and its turning circle on the spot, twice.
+    let arena = scenario.arena_size();
+    let room = [arena.x as f64 - 2.0 * margin, arena.y as f64 - 2.0 * margin];
+    let need = 8.0 * radius;
+    if room[0] < need || room[1] < need {
+        return Err(format!(
+            "the arena inside the shield's walls is {:.3} x {:.3} m ({} x {} m less \
+             shield.margin = {} m on each side): the excitation needs at least {need:.3} m each \
+             way to drive and turn",
+            room[0].max(0.0),
+            room[1].max(0.0),
+            arena.x,
+            arena.y,
+            shield.margin
+        ));
+    }
+    // Stopping from `max_speed`: the motor's first-order lag covers `speed x lag`, and the stop
+    // goes out a tick or two late.
+    let (lag, dt) = (robot.motor_lag.max(0.0) as f64, scenario.spec.dt as f64);
+    let stopping = max_speed * (lag + 2.0 * dt);
+    let room_to_stop = max_speed * shield.horizon.max(0.0) as f64 + (margin - radius);
+    if stopping > room_to_stop {
+        return Err(format!(
+            "at {max_speed:.3} m/s a robot covers {stopping:.4} m while it stops (motor lag \
+             {} s and two ticks of {} s), more than the shield's look-ahead ({} s: {:.4} m) \
+             and the margin beyond its body ({:.4} m) leave: the excitation would carry robots \
+             past the arena's edge; lower --speed or raise [rig] shield.horizon or shield.margin",
+            robot.motor_lag,
+            scenario.spec.dt,
+            shield.horizon,
+            max_speed * shield.horizon.max(0.0) as f64,
+            margin - radius
+        ));
+    }
+    Ok(())
 }
 
 /// splitmix64 of the three numbers.

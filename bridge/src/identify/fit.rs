@@ -4,6 +4,7 @@
 //! curvature of the profile (latency, lag). A parameter the data cannot pin down is reported as
 //! unidentifiable with the reason, never as a number.
 use super::response::Response;
+use super::sensor::SensorFit;
 use super::windows::{Window, windows};
 use nalgebra::{Matrix2, Vector2};
 
@@ -25,6 +26,8 @@ pub struct RobotFit {
     pub outliers: usize,
     /// RMS residual of the heading turned (rad) and the distance driven (m) per window.
     pub rms: [f64; 2],
+    /// The colour sensor's gain and offset (from the telemetry; [`super::identify`] fills it in).
+    pub sensor: SensorFit,
 }
 
 /// What the fit searches over and needs.
@@ -44,6 +47,11 @@ pub struct FitOptions {
     /// its wheels reach at the step's end, half a step ahead of a continuous motor, so the latency
     /// written is the continuous one plus half a step (the simulator then reproduces the timing).
     pub step: f64,
+    /// How much older every pose is than its logged age says, s: the tracker's fastest delivery,
+    /// which the bridge takes for the tracker's clock offset and so leaves out of the ages. `None`:
+    /// the `tracker_latency` the log was recorded with (the scenario's `[tracker] latency`, as
+    /// `colcos calibrate latency` measures it). Left in, it would count as the robots' latency.
+    pub pose_delay: Option<f64>,
 }
 
 impl Default for FitOptions {
@@ -55,6 +63,7 @@ impl Default for FitOptions {
             span: 0.1,
             min_windows: 50,
             step: 0.02,
+            pose_delay: None,
         }
     }
 }
@@ -89,6 +98,7 @@ pub fn fit_robot(
         windows: moving.len(),
         outliers: 0,
         rms: [f64::NAN; 2],
+        sensor: SensorFit::none("not fitted: identification was given no telemetry", 0),
     };
     let driven: f64 = moving.iter().map(|w| w.driven.abs()).sum();
     if moving.len() < opts.min_windows || driven < 0.05 {

@@ -1,7 +1,8 @@
 //! Identification's result as a file of per-robot values (`[[robot]]` entries with their `*_sd`
 //! uncertainties), the format `[individual] file` and `colcos twin --truth` read. A parameter that
 //! could not be identified is left out of its robot's entry (the robot keeps the nominal value) and
-//! its reason goes into the `[identified]` notes.
+//! its reason goes into the `[identified]` notes. The sensor's gain and offset go together: one
+//! without the other would misplace every count.
 use super::Identified;
 use colcos_sim::scenario::{IndividualFile, RobotIndividual};
 
@@ -14,6 +15,16 @@ pub fn overlay(found: &Identified, log: &str, scenario: &str) -> IndividualFile 
         "duration_s".into(),
         toml::Value::Float(round(found.duration, 3)),
     );
+    notes.insert(
+        "pose_delay".into(),
+        toml::Value::Float(round(found.pose_delay, 4)),
+    );
+    if let Some(t) = found.round_trip {
+        notes.insert(
+            "telemetry_round_trip".into(),
+            toml::Value::Float(round(t, 4)),
+        );
+    }
     if let Some(t) = found.tracker_latency {
         notes.insert("tracker_latency".into(), toml::Value::Float(round(t, 4)));
     }
@@ -58,6 +69,15 @@ pub fn overlay(found: &Identified, log: &str, scenario: &str) -> IndividualFile 
                     e.latency_sd = Some(round(*sd, 4) as f32);
                 }
                 Err(r) => why.push(format!("latency: {r}")),
+            }
+            match (&f.sensor.gain, &f.sensor.offset) {
+                (Ok((g, g_sd)), Ok((o, o_sd))) => {
+                    e.sensor_gain = Some(round(*g, 4) as f32);
+                    e.sensor_gain_sd = Some(round(*g_sd, 4) as f32);
+                    e.sensor_offset = Some(round(*o, 1) as f32);
+                    e.sensor_offset_sd = Some(round(*o_sd, 1) as f32);
+                }
+                (Err(r), _) | (_, Err(r)) => why.push(format!("sensor_gain: {r}")),
             }
             if !why.is_empty() {
                 unidentified.insert(

@@ -1,8 +1,8 @@
 //! A rig log as each robot's two time series: the wheel commands the bridge sent (decoded from the
 //! command frames on the wire) and the poses the tracker delivered, stamped with their capture time
 //! (the tick's time less the pose's age), so that the tracker's latency is not mistaken for the
-//! robot's.
-use crate::protocol::colias::{CommandDecoder, CommandPacket, HostCommand};
+//! robot's; and the colour counts each robot reported, stamped with the time it was asked for them.
+use crate::protocol::colias::{CommandDecoder, CommandPacket, HostCommand, colour_to_sim};
 use crate::rig::replay::RecordedTick;
 use colcos_sim::scenario::{BROADCAST_ID, Scenario};
 
@@ -14,6 +14,12 @@ pub struct RobotSeries {
     pub commands: Vec<(f64, [f64; 2])>,
     /// Capture time, s since the run's start, and (x m, y m, heading rad): fresh detections only.
     pub poses: Vec<(f64, [f64; 3])>,
+    /// Telemetry colour counts in the simulator's sensor order, stamped with the time the bridge
+    /// asked for them (a robot reads as it hears the request; the answer's arrival is later by the
+    /// link's round trip), or with the arrival where no request was logged.
+    pub telemetry: Vec<(f64, [[u16; 3]; 4])>,
+    /// Time of every answer to a data request: (request sent, robot clock s, answer received).
+    pub answers: Vec<(f64, f64, f64)>,
 }
 
 /// Why a log cannot be fitted.
@@ -76,12 +82,31 @@ pub fn robot_series(
     let mut out = vec![RobotSeries::default(); n];
     let mut decoder = CommandDecoder::new();
     let (mut any_command, mut any_pose) = (false, false);
+    // Per robot, when it was last asked for data (in an earlier tick: an answer comes a tick later
+    // at the earliest, as the loop reads telemetry before it sends).
+    let mut asked: Vec<Option<f64>> = vec![None; n];
     for tick in ticks {
+        for tm in &tick.telemetry {
+            if let Some(i) = radio.iter().position(|r| *r == tm.id) {
+                let read = asked[i].unwrap_or(tick.t);
+                out[i].telemetry.push((read, colour_to_sim(tm.colour)));
+                if let Some(sent) = asked[i] {
+                    out[i]
+                        .answers
+                        .push((sent, tm.sys_t_ms as f64 * 1e-3, tick.t));
+                }
+            }
+        }
         for frame in &tick.commands {
             for payload in decoder.feed(frame) {
                 let Ok(packet) = CommandPacket::decode(&payload) else {
                     continue;
                 };
+                if let HostCommand::RequestTelemetry(_) = packet.command
+                    && let Some(i) = radio.iter().position(|r| *r == packet.id)
+                {
+                    asked[i] = Some(tick.t);
+                }
                 let Some(wheels) = wheels_of(&packet.command) else {
                     continue;
                 };

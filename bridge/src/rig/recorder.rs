@@ -62,7 +62,7 @@ impl Topic {
 }
 
 #[derive(Debug, thiserror::Error)]
-pub(crate) enum RecorderError {
+pub enum RecorderError {
     #[error("rig log {path}: {source}")]
     Io {
         path: String,
@@ -72,7 +72,7 @@ pub(crate) enum RecorderError {
     Mcap(#[from] mcap::McapError),
 }
 
-pub(crate) struct Recorder {
+pub struct Recorder {
     writer: mcap::Writer<BufWriter<File>>,
     channels: [u16; 7],
     sequence: u32,
@@ -80,7 +80,7 @@ pub(crate) struct Recorder {
 
 impl Recorder {
     /// A new log at `path` (replacing any file there).
-    pub(crate) fn create(path: &Path) -> Result<Recorder, RecorderError> {
+    pub fn create(path: &Path) -> Result<Recorder, RecorderError> {
         let file = File::create(path).map_err(|source| RecorderError::Io {
             path: path.display().to_string(),
             source,
@@ -102,7 +102,7 @@ impl Recorder {
     }
 
     /// Records `data` on `topic` at `t_ns` ns since the Unix epoch.
-    pub(crate) fn record(
+    pub fn record(
         &mut self,
         topic: Topic,
         t_ns: u64,
@@ -121,7 +121,7 @@ impl Recorder {
     }
 
     /// Writes a metadata record `name` of key-value strings (what the run ran with).
-    pub(crate) fn write_metadata(
+    pub fn write_metadata(
         &mut self,
         name: &str,
         values: BTreeMap<String, String>,
@@ -134,13 +134,13 @@ impl Recorder {
     }
 
     /// Pushes everything recorded so far to the file.
-    pub(crate) fn flush(&mut self) -> Result<(), RecorderError> {
+    pub fn flush(&mut self) -> Result<(), RecorderError> {
         self.writer.flush()?;
         Ok(())
     }
 
     /// Writes the summary and closes the log.
-    pub(crate) fn finish(mut self) -> Result<(), RecorderError> {
+    pub fn finish(mut self) -> Result<(), RecorderError> {
         self.writer.finish()?;
         Ok(())
     }

@@ -33,7 +33,7 @@ from __future__ import annotations
 # gymnasium); the SB3 and TorchRL adapters import their libraries and stay opt-in. `colcos.tasks()`
 # lists the tasks, `colcos.tasks.aggregation_v0` etc. make them, and importing `colcos.tasks`
 # registers the Gymnasium ids `colcos/<task>-v<version>`.
-from colcos import _core, gymnasium_vector, sweep, tasks, vector
+from colcos import _core, gymnasium_vector, rig, sweep, tasks, vector
 from colcos import preflight as preflight  # noqa: E402  (after pettingzoo_env, which it imports)
 from colcos._core import (
     ActionError,
@@ -85,6 +85,7 @@ __all__ = [
     "parallel_env",
     "preflight",
     "raw_env",
+    "rig",
     "sweep",
     "task_policies",
     "tasks",

@@ -66,22 +66,28 @@ def core_kwargs(
     return kw
 
 
-def twin_kwargs(twin_scenario: Any) -> dict[str, Any]:
-    """`colcos._core.Plant`'s keyword for a twin's own scenario: a file, TOML text or overrides."""
+def twin_kwargs(twin_scenario: Any, truth: Any = None) -> dict[str, Any]:
+    """`colcos._core.Plant`'s keywords for a twin's own scenario (a file, TOML text or overrides) and
+    its robots' hidden per-robot values (`truth`: a file of `[[robot]]` entries)."""
+    out: dict[str, Any] = {}
+    if truth is not None:
+        if not isinstance(truth, (str, os.PathLike)):
+            raise ArgumentTypeError(f"truth must be a path (str or os.PathLike), got {type(truth).__name__}")
+        out["truth"] = os.fspath(truth)
     if twin_scenario is None:
-        return {}
+        return out
     if isinstance(twin_scenario, dict):
         for k in twin_scenario:
             if not isinstance(k, str):
                 raise ArgumentTypeError(f"twin_scenario keys must be key paths (str), got {k!r}")
         sets = {k: _checks.plain(v, f"twin_scenario.{k}") for k, v in twin_scenario.items()}
-        return {"twin_overrides_json": json.dumps(sets)}
+        return {**out, "twin_overrides_json": json.dumps(sets)}
     text = os.fspath(twin_scenario) if isinstance(twin_scenario, os.PathLike) else twin_scenario
     if not isinstance(text, str):
         raise ArgumentTypeError(
             f"twin_scenario must be a path, TOML text or a dict of key paths, got {type(twin_scenario).__name__}"
         )
-    return {"twin_scenario_text": text} if "\n" in text else {"twin_scenario": text}
+    return {**out, "twin_scenario_text": text} if "\n" in text else {**out, "twin_scenario": text}
 
 
 def make_space(d: dict[str, Any]) -> spaces.Space:

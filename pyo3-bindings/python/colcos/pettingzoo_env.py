@@ -77,6 +77,10 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             (`{"tracker.latency": 0.15, "sensor.gain": 0.8}`). Its robots, arena, screen and tick
             must be this scenario's. The robots' own sensors are read only with `[rig] sensors =
             "robot"` in this scenario. See docs/bridge.md ("Sim-to-real").
+        truth: `"twin"` started here: its robots' hidden per-robot values (a file of `[[robot]]`
+            entries: wheel scales, motor lag, command latency, sensor gain and offset, as
+            `colcos twin --truth` and `colcos.rig.identify`'s `out`) while this scenario assumes its
+            own; `colcos.rig.identify` on the `log` recovers them (docs/identify.md).
         **params: task parameters (see the task's docs); unknown ones raise `colcos.TaskError`.
 
     Actions (`step`): a dict with an action for every agent in `agents`; see docs/python.md
@@ -111,13 +115,14 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         goto: bool = True,
         goto_timeout: float = 30.0,
         twin_scenario: str | os.PathLike[str] | dict[str, Any] | None = None,
+        truth: str | os.PathLike[str] | None = None,
         **params: Any,
     ) -> None:
         self._init_kwargs = dict(
             task=task, scenario=scenario, max_cycles=max_cycles, render_mode=render_mode, continuous=continuous,
             global_state=global_state, patch=patch, patch_side=patch_side, seed=seed, backend=backend,
             physics=physics, plant=plant, tracker=tracker, robots=robots, log=log, goto=goto, goto_timeout=goto_timeout,
-            twin_scenario=twin_scenario, **params,
+            twin_scenario=twin_scenario, truth=truth, **params,
         )
         _checks.choice(render_mode, "render_mode", [None, "human", "rgb_array"])
         _checks.choice(plant, "plant", list(PLANTS))
@@ -126,7 +131,9 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
         self.plant = plant
         self._core: _core.VecEnv | _core.Plant
         if plant == "sim":
-            for name, value in (("tracker", tracker), ("robots", robots), ("log", log), ("twin_scenario", twin_scenario)):
+            for name, value in (
+                ("tracker", tracker), ("robots", robots), ("log", log), ("twin_scenario", twin_scenario), ("truth", truth)
+            ):
                 if value is not None:
                     raise TaskError(f"{name}={value!r} is for plant='twin', 'rig' or 'replay', not 'sim'")
             self._core = _core.VecEnv(
@@ -136,7 +143,7 @@ class ColcosParallelEnv(BackendInfo, ParallelEnv):
             self._core = _core.Plant(
                 plant=plant, tracker=tracker, robots=robots, log=None if log is None else os.fspath(log),
                 goto=_checks.flag(goto, "goto"), goto_timeout=goto_timeout, seed=_checks.seed(seed),
-                **twin_kwargs(twin_scenario), **kw,
+                **twin_kwargs(twin_scenario, truth), **kw,
             )
         log_backend(self._core, backend)
         spec = self._core.spec()

@@ -68,6 +68,10 @@ pub struct RobotIndividual {
     pub motor_lag_sd: Option<f32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub latency_sd: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor_gain_sd: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor_offset_sd: Option<f32>,
 }
 
 /// A file of per-robot values (`[[robot]]` entries): what `[individual] file`, `colcos twin --truth`

@@ -1,0 +1,81 @@
+//! `colcos rig excite` refuses, before anything moves and with the reason, an excitation the arena
+//! and its shield cannot hold; `colcos rig identify` refuses a log of another scenario.
+use std::process::Command;
+
+fn colcos(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_colcos"))
+        .args(args)
+        .output()
+        .unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    (out.status.success(), text)
+}
+
+#[test]
+fn an_excitation_that_would_leave_the_arena_is_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = "name = \"lab\"\nduration = 10.0\n[[robots]]\ncount = 2\nbehaviour = \"wander\"\n";
+    // No tracker or radio is there: the refusal must come before either is opened.
+    let excite = |name: &str, extra: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, format!("{base}{extra}")).unwrap();
+        let out = dir.path().join("out");
+        colcos(&[
+            "rig",
+            "excite",
+            path.to_str().unwrap(),
+            "--tracker",
+            "swarmcon://127.0.0.1:9",
+            "--robots",
+            "udp://127.0.0.1:9",
+            "--seconds",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let (ok, text) = excite("margin.toml", "[rig]\nshield = { margin = 0.01 }\n");
+    assert!(
+        !ok && text
+            .contains("refused: [rig] shield.margin = 0.01 m is less than the robot's radius"),
+        "{text}"
+    );
+    let (ok, text) = excite(
+        "stop.toml",
+        "[robot]\nmotor_lag = 0.4\n[rig]\nshield = { horizon = 0.0 }\n",
+    );
+    assert!(!ok && text.contains("while it stops"), "{text}");
+    let (ok, text) = excite(
+        "small.toml",
+        "[screen]\nresolution = [100, 100]\nsize = [0.15, 0.15]\n",
+    );
+    assert!(!ok && text.contains("inside the shield's walls"), "{text}");
+    assert!(!dir.path().join("out").join("rig.mcap").exists());
+
+    // A log of the identify fixture's scenario, identified against another one.
+    let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/bridge/tests/data/identify");
+    let scenario = std::fs::read_to_string(format!("{fixture}/scenario.toml")).unwrap();
+    let other = dir.path().join("other.toml");
+    std::fs::write(
+        &other,
+        scenario.replace("name = \"identify\"", "name = \"other\""),
+    )
+    .unwrap();
+    let fit = dir.path().join("fit.toml");
+    let (ok, text) = colcos(&[
+        "rig",
+        "identify",
+        &format!("{fixture}/rig.mcap"),
+        "--scenario",
+        other.to_str().unwrap(),
+        "--out",
+        fit.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && text
+            .contains("the rig log is of scenario \"identify\" with 3 robots, not \"other\""),
+        "{text}"
+    );
+    assert!(!fit.exists());
+}
