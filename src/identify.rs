@@ -6,9 +6,9 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use colcos_bridge::calibrate::RigCalibration;
-use colcos_bridge::transport::FrameServer;
 use colcos_bridge::identify::{self, Excitation, FitOptions, Param};
 use colcos_bridge::rig::{LiveOptions, LiveSession};
+use colcos_bridge::transport::FrameServer;
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;

@@ -6,16 +6,16 @@
 //! within 5 ms, every motor lag within 20 % and every sensor gain within 10 %. The arena is large
 //! (4 m) so that the robots, which no shield guards here, rarely touch a wall: on the rig the shield
 //! keeps them off. Bad input is refused with the reason.
-use colcos_bridge::protocol::colias::{CommandPacket, HostCommand, Telemetry, colour_from_sim};
 use colcos_bridge::identify::excite::check_room;
 use colcos_bridge::identify::overlay::overlay;
 use colcos_bridge::identify::readings::predict_readings;
 use colcos_bridge::identify::{
     Excitation, FitOptions, STEADY_FRACTION, fit_robot, fit_sensor, identify, robot_series,
 };
+use colcos_bridge::protocol::colias::{CommandPacket, HostCommand, Telemetry, colour_from_sim};
 use colcos_bridge::rig::PoseIn;
-use colcos_bridge::rig::replay::RecordedTick;
 use colcos_bridge::rig::recorder::{Recorder, Topic};
+use colcos_bridge::rig::replay::RecordedTick;
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::{IndividualFile, Scenario};

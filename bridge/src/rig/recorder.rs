@@ -102,12 +102,7 @@ impl Recorder {
     }
 
     /// Records `data` on `topic` at `t_ns` ns since the Unix epoch.
-    pub fn record(
-        &mut self,
-        topic: Topic,
-        t_ns: u64,
-        data: &[u8],
-    ) -> Result<(), RecorderError> {
+    pub fn record(&mut self, topic: Topic, t_ns: u64, data: &[u8]) -> Result<(), RecorderError> {
         let channel_id = self.channels[Topic::ALL.iter().position(|t| *t == topic).unwrap_or(0)];
         self.sequence = self.sequence.wrapping_add(1);
         let header = mcap::records::MessageHeader {
