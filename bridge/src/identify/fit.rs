@@ -174,10 +174,16 @@ pub fn fit_robot(
     let dl = 0.002;
     let curv_l = (chi(lat + dl, tau) + chi(lat - dl, tau) - 2.0 * c0) / (dl * dl);
     let sd_l = (2.0 / curv_l).sqrt();
-    fit.latency = if lat >= opts.max_latency - 0.002 || lat <= -opts.step + 0.001 {
+    fit.latency = if lat >= opts.max_latency - 0.002 {
         Err(format!(
             "unidentifiable: the best latency is at the searched limit {} s",
             opts.max_latency
+        ))
+    } else if lat <= -opts.step + 0.001 {
+        Err(format!(
+            "unidentifiable: the poses move {} s or more before the commands that drive them \
+             (is the tracker's latency, --pose-delay, too large?)",
+            opts.step
         ))
     } else if !(sd_l.is_finite() && sd_l < 0.02) {
         Err("unidentifiable: the commands changed too little to time their effect".into())
