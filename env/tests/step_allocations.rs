@@ -4,9 +4,10 @@
 //! in a step with contacts.
 use colcos_env::{Actions, EnvConfig, VecEnv};
 use colcos_sim::robot::PhysicsBackend;
-#[path = "../../sim/tests/support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
+use colcos_testkit::alloc::{Counting, allocations};
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
 
 /// Allocations per world and step over 100 steps of 64 worlds, after 100 steps to warm up; episodes
 /// are longer than the 200 steps, so no world is rebuilt.

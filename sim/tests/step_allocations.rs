@@ -3,9 +3,10 @@
 //! few small blocks in each step with contacts (its solver's stage sync, its lists of modified bodies).
 use colcos_sim::prelude::*;
 use colcos_sim::robot::PhysicsBackend;
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
+use colcos_testkit::alloc::{Counting, allocations};
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
 
 const SCENARIOS: [&str; 6] = [
     "three_trails.toml",

@@ -1,9 +1,18 @@
-//! The test binary's global allocator: the system's, counting allocations and reallocations made by
-//! every thread, for the tests that a running step allocates nothing.
+//! A global allocator that counts: the system's, counting the allocations and reallocations every
+//! thread makes, for the tests that a running step allocates nothing. A test binary installs it with
+//!
+//! ```ignore
+//! #[global_allocator]
+//! static ALLOCATOR: colcos_testkit::alloc::Counting = colcos_testkit::alloc::Counting;
+//! ```
+//!
+//! (a type rather than a `#[global_allocator]` here, so that only the binaries that ask for it count).
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 
-struct Counting;
+/// The system allocator, counting allocations and reallocations into one process-wide counter.
+pub struct Counting;
+
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
 
 unsafe impl GlobalAlloc for Counting {
@@ -20,10 +29,8 @@ unsafe impl GlobalAlloc for Counting {
     }
 }
 
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
-
-/// Allocations and reallocations so far, on every thread.
+/// Allocations and reallocations so far, on every thread (0 forever unless [`Counting`] is the
+/// binary's global allocator).
 pub fn allocations() -> usize {
     ALLOCATIONS.load(Relaxed)
 }
