@@ -100,7 +100,10 @@ fn large_swarm() {
     let scenario = dir.path().join("large.toml");
     std::fs::write(
         &scenario,
-        colcos_testkit::scenarios::large_swarm().to_toml(),
+        colcos_testkit::scenarios::large_swarm()
+            .build()
+            .unwrap()
+            .to_toml(),
     )
     .unwrap();
     let out = dir.path().join("out");

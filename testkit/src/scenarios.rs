@@ -108,37 +108,35 @@ fn follower(count: usize, channel: &str) -> RobotGroupSpec {
 /// Enough robots and deposits on a fine grid (3 mm, 2.4 x 1.35 m) that every parallel path of a run
 /// is taken (robots, banded deposits, field rows): 200 robots follow a static blue trail laying red,
 /// 150 avoid each other laying blue; 0.4 s with a GIF frame every 0.2 s. `tests/golden.rs` pins
-/// every file its run writes.
-pub fn large_swarm() -> Scenario {
-    valid(
-        ScenarioBuilder::new()
-            .duration(0.4)
-            .seed(7)
-            .screen([3840, 2160], [2.4, 1.35])
-            .cell(0.003)
-            .gif_interval(0.2)
-            .pheromone(
-                PheromoneSpec::grid("red", [255.0, 0.0, 0.0])
-                    .with_evaporation(5.0)
-                    .with_diffusion(1e-5),
-            )
-            .pheromone(
-                PheromoneSpec::grid("blue", [0.0, 0.0, 255.0])
-                    .with_evaporation(5.0)
-                    .with_diffusion(1e-6)
-                    .with_map(MapSpec::polyline(vec![[0.2, 0.2], [2.2, 1.1]], 0.05, 0.2)),
-            )
-            .robots(
-                RobotGroupSpec::new(200, "follow")
-                    .with_param("channel", "b")
-                    .with_deposit("red", Kernel::Cone { radius: 0.01 }, 5.0),
-            )
-            .robots(RobotGroupSpec::new(150, "avoid").with_deposit(
-                "blue",
-                Kernel::Disc { radius: 0.01 },
-                5.0,
-            )),
-    )
+/// every file its run writes; `tests/determinism.rs` runs it longer on 1, 2 and 4 threads.
+pub fn large_swarm() -> ScenarioBuilder {
+    ScenarioBuilder::new()
+        .duration(0.4)
+        .seed(7)
+        .screen([3840, 2160], [2.4, 1.35])
+        .cell(0.003)
+        .gif_interval(0.2)
+        .pheromone(
+            PheromoneSpec::grid("red", [255.0, 0.0, 0.0])
+                .with_evaporation(5.0)
+                .with_diffusion(1e-5),
+        )
+        .pheromone(
+            PheromoneSpec::grid("blue", [0.0, 0.0, 255.0])
+                .with_evaporation(5.0)
+                .with_diffusion(1e-6)
+                .with_map(MapSpec::polyline(vec![[0.2, 0.2], [2.2, 1.1]], 0.05, 0.2)),
+        )
+        .robots(
+            RobotGroupSpec::new(200, "follow")
+                .with_param("channel", "b")
+                .with_deposit("red", Kernel::Cone { radius: 0.01 }, 5.0),
+        )
+        .robots(RobotGroupSpec::new(150, "avoid").with_deposit(
+            "blue",
+            Kernel::Disc { radius: 0.01 },
+            5.0,
+        ))
 }
 
 /// The live loop's benchmark load: 100 robots on the 65-inch panel following a static blue trail and
