@@ -4,7 +4,7 @@
 //! in a step with contacts.
 use colcos_env::{Actions, EnvConfig, VecEnv};
 use colcos_sim::robot::PhysicsBackend;
-use colcos_testkit::alloc::{Counting, allocations};
+use colcos_testkit::alloc::{Counting, allocations, assert_installed};
 
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
@@ -38,6 +38,7 @@ fn allocations_per_world_step(task: &str, physics: PhysicsBackend) -> f64 {
 /// and step, rapier 0.4-1.3.
 #[test]
 fn a_batched_step_allocates_nothing_of_its_own() {
+    assert_installed();
     for task in ["aggregation", "foraging", "trail"] {
         let discs = allocations_per_world_step(task, PhysicsBackend::Discs);
         assert!(

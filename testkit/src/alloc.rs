@@ -34,3 +34,24 @@ unsafe impl GlobalAlloc for Counting {
 pub fn allocations() -> usize {
     ALLOCATIONS.load(Relaxed)
 }
+
+/// Panics unless [`Counting`] is this binary's global allocator: without it [`allocations`] stays 0
+/// and a test that something allocates nothing would pass whatever it does.
+pub fn assert_installed() {
+    let before = allocations();
+    std::hint::black_box(Box::new(0u64));
+    assert!(
+        allocations() > before,
+        "colcos_testkit::alloc::Counting is not this binary's global allocator"
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    /// This test binary keeps the system allocator: the check says so.
+    #[test]
+    #[should_panic(expected = "not this binary's global allocator")]
+    fn the_check_fails_without_the_counting_allocator() {
+        super::assert_installed();
+    }
+}
