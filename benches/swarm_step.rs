@@ -6,11 +6,9 @@
 //! cargo bench --bench swarm_step
 use colcos::sim::prelude::*;
 use colcos::sim::robot::PhysicsBackend::{Discs, Rapier};
-#[path = "common/swarm_scenario.rs"]
-mod swarm_scenario;
+use colcos_testkit::swarm::scenario;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
-use swarm_scenario::scenario;
 
 const ARGOS_10K_REAL_TIME_FACTOR: f64 = 1.4;
 

@@ -5,9 +5,8 @@ use colcos::sim::field::Kernel;
 use colcos::sim::prelude::*;
 use colcos::sim::robot::PhysicsBackend::{self, Discs, Rapier};
 use colcos::sim::scenario::{PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
+use colcos_testkit::swarm;
 use std::time::Instant;
-#[path = "../benches/common/swarm_scenario.rs"]
-mod swarm_scenario;
 
 fn time(label: &str, scenario: ScenarioBuilder) {
     time_scenario(label, || scenario.build().unwrap());
@@ -92,13 +91,13 @@ fn case(
 fn main() {
     // Exactly what `cargo bench --bench swarm_step` steps.
     time_scenario("bench: 10,000 robots, discs", || {
-        swarm_scenario::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Discs)
+        swarm::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Discs)
     });
     time_scenario("bench: 10,000 robots, rapier", || {
-        swarm_scenario::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Rapier)
+        swarm::scenario(10_000, [14.4, 8.1], [38_400, 21_600], 0.01, Rapier)
     });
     time_scenario("bench: 100 robots, 65-inch, 5 mm, rapier", || {
-        swarm_scenario::scenario(100, [1.439, 0.809], [3840, 2160], 0.005, Rapier)
+        swarm::scenario(100, [1.439, 0.809], [3840, 2160], 0.005, Rapier)
     });
     time(
         "full (follow, 3 fields, deposits, discs)",

@@ -6,6 +6,7 @@ pub use colcos_sim as sim;
 
 pub mod backend;
 pub mod calibrate;
+pub mod cli;
 pub mod display;
 pub mod experiment;
 pub mod identify;

@@ -1,81 +1,13 @@
 //! The `colcos` command line.
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand};
+use clap::Parser;
+use colcos::cli::{Cli, Command};
 use colcos::report::print_report;
 use colcos::run::{RunOptions, run};
 use colcos::sim::prelude::*;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
-
-// `pub(crate)`: the command-line fuzz target (fuzz/) compiles this file as a module and parses with it.
-#[derive(Parser)]
-#[command(
-    name = "colcos",
-    version,
-    about = "Multi-pheromone swarm robotics simulator (ColCOSPhi)"
-)]
-pub(crate) struct Cli {
-    #[command(subcommand)]
-    command: Command,
-}
-
-#[derive(Subcommand)]
-enum Command {
-    /// Run a scenario: writes trajectory.csv, screen.png, run.gif, fields/*.npy and summary.json.
-    Run {
-        /// Scenario file (TOML).
-        scenario: PathBuf,
-        /// Output directory [default: runs/<scenario file name without .toml>].
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override the scenario's seed.
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Override the scenario's duration, s.
-        #[arg(long)]
-        duration: Option<f32>,
-        /// Worker threads, 1 to 1024 (default: all cores). Results do not depend on it.
-        // 0 would silently mean "all cores"; beyond 1024 each thread's stack only costs memory.
-        #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
-        threads: Option<usize>,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-        /// Field backend: cpu, gpu or auto (overrides the scenario's `field.backend`).
-        #[arg(long)]
-        backend: Option<colcos::sim::field::BackendChoice>,
-    },
-    /// Show a scenario's screen image in a window (full screen on a chosen monitor, or windowed), or
-    /// render it headless to PNG.
-    Display(colcos::display::DisplayArgs),
-    /// Reproduce the paper's case studies (all trials in parallel): figures, CSVs, summary.json/.md.
-    Experiment(colcos::experiment::ExperimentArgs),
-    /// Drive real robots with a scenario's behaviours: poses from the tracker, pheromone injected and
-    /// the field stepped by the simulator, commands over the radio link, safety stops by a watchdog.
-    Bridge(colcos::rig::BridgeArgs),
-    /// The digital twin: the simulator serving the rig's wire formats (SwarmCon over TCP, the robots'
-    /// serial protocol over a pseudo-terminal or UDP) for `colcos bridge` to drive.
-    Twin(colcos::rig::TwinArgs),
-    /// Calibrate the rig over its own wires (screen <-> camera, latency, colour sensors); each writes
-    /// a file the scenario's `[rig]` section names.
-    Calibrate(colcos::calibrate::CalibrateArgs),
-    /// Put a rig log (`rig.mcap`) through the live loop again and check that the same inputs give
-    /// the same command bytes.
-    Replay(colcos::replay::ReplayArgs),
-    /// The rig's pre-flight: `colcos rig check SCENARIO` runs the behaviours on a digital twin first.
-    Rig {
-        #[command(subcommand)]
-        command: colcos::preflight::RigCommand,
-    },
-    /// Run a batch of scenarios over axes of parameters and seeds (a sweep file), in parallel and
-    /// resumable: results.csv, plots/ and summary.md (docs/sweeps.md).
-    Sweep(colcos::sweep::SweepArgs),
-    /// Check a scenario file and print what it sets up, without running it.
-    Check { scenario: PathBuf },
-    /// List the behaviours a scenario can name.
-    Behaviours,
-}
 
 fn main() -> ExitCode {
     colcos::run::quiet_wayland_probe();

@@ -1,38 +1,13 @@
 //! Same scenario and seed give byte-identical logs, whatever the number of threads.
 use colcos::run::{RunOptions, run};
-use colcos::sim::field::Kernel;
 use colcos::sim::prelude::*;
-use colcos::sim::scenario::{MapSpec, PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
+use colcos_testkit::scenarios::large_swarm;
 
 /// Enough robots and a large enough grid that the parallel paths (robots and field rows) are taken.
 fn scenario() -> Scenario {
-    ScenarioBuilder::new()
+    large_swarm()
         .duration(0.6)
-        .seed(7)
-        .screen([3840, 2160], [2.4, 1.35])
-        .cell(0.003)
         .gif_interval(0.0)
-        .pheromone(
-            PheromoneSpec::grid("red", [255.0, 0.0, 0.0])
-                .with_evaporation(5.0)
-                .with_diffusion(1e-5),
-        )
-        .pheromone(
-            PheromoneSpec::grid("blue", [0.0, 0.0, 255.0])
-                .with_evaporation(5.0)
-                .with_diffusion(1e-6)
-                .with_map(MapSpec::polyline(vec![[0.2, 0.2], [2.2, 1.1]], 0.05, 0.2)),
-        )
-        .robots(
-            RobotGroupSpec::new(200, "follow")
-                .with_param("channel", "b")
-                .with_deposit("red", Kernel::Cone { radius: 0.01 }, 5.0),
-        )
-        .robots(RobotGroupSpec::new(150, "avoid").with_deposit(
-            "blue",
-            Kernel::Disc { radius: 0.01 },
-            5.0,
-        ))
         .build()
         .unwrap()
 }

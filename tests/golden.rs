@@ -92,44 +92,20 @@ fn case_studies_as_scenarios() {
     }
 }
 
-/// Enough robots and deposits that every parallel path is taken (robots, banded deposits, field rows).
-const LARGE_SWARM: &str = r#"
-duration = 0.4
-seed = 7
-[screen]
-resolution = [3840, 2160]
-size = [2.4, 1.35]
-[field]
-cell = 0.003
-[output]
-gif_interval = 0.2
-[[pheromones]]
-name = "red"
-colour = [255, 0, 0]
-evaporation = 5.0
-diffusion = 1e-5
-[[pheromones]]
-name = "blue"
-colour = [0, 0, 255]
-evaporation = 5.0
-diffusion = 1e-6
-maps = [{ polyline = [[0.2, 0.2], [2.2, 1.1]], width = 0.05, rate = 0.2 }]
-[[robots]]
-count = 200
-behaviour = "follow"
-params = { channel = "b" }
-deposits = [{ pheromone = "red", kernel = { shape = "cone", radius = 0.01 }, rate = 5.0 }]
-[[robots]]
-count = 150
-behaviour = "avoid"
-deposits = [{ pheromone = "blue", kernel = { shape = "disc", radius = 0.01 }, rate = 5.0 }]
-"#;
-
 #[test]
 fn large_swarm() {
     let dir = tempfile::tempdir().unwrap();
+    // Enough robots and deposits that every parallel path is taken (robots, banded deposits, field
+    // rows), written out as a scenario file.
     let scenario = dir.path().join("large.toml");
-    std::fs::write(&scenario, LARGE_SWARM).unwrap();
+    std::fs::write(
+        &scenario,
+        colcos_testkit::scenarios::large_swarm()
+            .build()
+            .unwrap()
+            .to_toml(),
+    )
+    .unwrap();
     let out = dir.path().join("out");
     let got = colcos(&["run", scenario.to_str().unwrap(), "--quiet"], &out);
     check("large swarm", got, LARGE);

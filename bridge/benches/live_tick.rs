@@ -17,40 +17,15 @@ use colcos_bridge::rig::HostWorld;
 use colcos_bridge::transport::frame_to_poses;
 use colcos_sim::Vec2;
 use colcos_sim::field::{FieldModel, Pheromone};
-use colcos_sim::scenario::{Scenario, SensorSource};
+use colcos_sim::scenario::SensorSource;
 use colcos_sim::screen::{ScreenRenderer, ScreenSpec, to_level};
+use colcos_testkit::scenarios::three_grids_panel;
 use std::hint::black_box;
 use std::time::Instant;
 
 /// The tick's budget and the bar for pose block in to 4K frame out, ms.
 const TICK_MS: f64 = 20.0;
 const BAR_MS: f64 = 5.0;
-
-const SCENARIO: &str = r#"
-duration = 10.0
-[field]
-cell = 0.005
-[[pheromones]]
-name = "red"
-colour = [255, 0, 0]
-evaporation = 20.0
-diffusion = 1e-6
-[[pheromones]]
-name = "green"
-colour = [0, 255, 0]
-evaporation = 20.0
-diffusion = 1e-6
-[[pheromones]]
-name = "blue"
-colour = [0, 0, 255]
-evaporation = 60.0
-maps = [{ polyline = [[0.2, 0.2], [1.2, 0.6]], width = 0.03, rate = 0.05 }]
-[[robots]]
-count = 100
-behaviour = "follow"
-params = { channel = "b" }
-deposits = [{ pheromone = "red", kernel = { shape = "disc", radius = 0.01 }, rate = 5.0 }]
-"#;
 
 fn median(mut xs: Vec<f64>) -> f64 {
     xs.sort_by(f64::total_cmp);
@@ -127,7 +102,7 @@ fn threads() -> usize {
 }
 
 fn main() {
-    let sc = Scenario::from_toml_str(SCENARIO, ".").expect("scenario");
+    let sc = three_grids_panel();
     let mut host = HostWorld::new(&sc, SensorSource::Virtual).expect("host");
     let transform = FrameTransform::new(sc.arena_size().y as f64);
     let start = colcos_sim::world::World::new(&sc)

@@ -3,36 +3,21 @@
 //! own sensors' counts in telemetry; `colcos calibrate colour` on that twin (ramps shown through the
 //! frame stream, raw counts read over the radio link) gives the file's models back, reproduces counts
 //! at colours it never saw, and its inverse gives the screen levels back.
-mod calibrate_common;
-
-use calibrate_common::{TwinRun, scenario};
 use colcos_bridge::calibrate::RigCalibration;
 use colcos_bridge::calibrate::{ColourRunOptions, calibrate_colour};
 use colcos_bridge::twin::TwinArena;
 use colcos_sim::rng::{Stream, stream_of};
-use colcos_sim::scenario::Scenario;
-use colcos_sim::sensors::{ColourCalibration, ColourSensor, RobotColour, SensorFit};
+use colcos_sim::scenario::{Scenario, ScenarioBuilder};
+use colcos_sim::sensors::{ColourCalibration, ColourSensor, RobotColour};
+use colcos_testkit::scenarios::parked;
+use colcos_testkit::sensors::{bright_crosstalk, dim_red, fit};
+use colcos_testkit::twin::TwinRun;
 use image::RgbImage;
-
-fn fit(gamma: f64, gain: f64, crosstalk: [[f64; 3]; 3], dark: [f64; 3]) -> SensorFit {
-    SensorFit::from_parts(gamma, gain, crosstalk, dark, 24.0)
-}
 
 /// Three robots: a dim red-leaning one; a bright one with strong green-blue crosstalk whose front
 /// sensor differs from its other three; a third with a high dark level.
 fn file_models() -> ColourCalibration {
-    let a = fit(
-        2.4,
-        900.0,
-        [[1.2, 0.02, 0.0], [0.03, 0.8, 0.05], [0.01, 0.04, 0.7]],
-        [20.0, 35.0, 50.0],
-    );
-    let b = fit(
-        1.9,
-        2100.0,
-        [[0.9, 0.15, 0.05], [0.1, 1.05, 0.3], [0.05, 0.35, 1.1]],
-        [60.0, 10.0, 25.0],
-    );
+    let (a, b) = (dim_red(), bright_crosstalk());
     let b_front = fit(
         2.1,
         1800.0,
@@ -58,15 +43,20 @@ fn file_models() -> ColourCalibration {
     )
 }
 
+/// Robots parked at `poses` on the panel whose rig's colour calibration is the file `path`.
+fn reading_through(poses: &[[f32; 3]], path: &str) -> ScenarioBuilder {
+    parked(poses).with(|s| s.rig.colour_calibration = Some(path.to_string()))
+}
+
 /// The twin of three robots reading through `file` (saved in `dir`).
 fn twin_scenario(file: &ColourCalibration, dir: &std::path::Path) -> Scenario {
     let path = dir.join("colour.json");
     file.save(&path).unwrap();
-    let rig = format!(
-        "colour_calibration = \"{}\"\n[sensor]\nper_robot = true",
-        path.display()
-    );
-    scenario(&[(0.3, 0.3, 0.0), (0.7, 0.4, 45.0), (1.1, 0.5, 90.0)], &rig)
+    let robots = [[0.3, 0.3, 0.0], [0.7, 0.4, 45.0], [1.1, 0.5, 90.0]];
+    reading_through(&robots, &path.display().to_string())
+        .with(|s| s.sensor.per_robot = true)
+        .build()
+        .unwrap()
 }
 
 /// What the twin's robots report for one uniform colour: each sensor's own model, within noise.
@@ -189,8 +179,10 @@ fn calibration_files_load_and_bad_ones_are_refused() {
     file_models().save(&path).unwrap();
     let back = ColourCalibration::load(&path).unwrap();
     assert_eq!(back.robots.len(), 3);
-    let rig_text = format!("colour_calibration = \"{}\"", path.display());
-    let loaded = RigCalibration::load(&scenario(&[(0.3, 0.3, 0.0)], &rig_text)).unwrap();
+    let sc = reading_through(&[[0.3, 0.3, 0.0]], &path.display().to_string())
+        .build()
+        .unwrap();
+    let loaded = RigCalibration::load(&sc).unwrap();
     assert!(loaded.colour.is_some() && loaded.screen.is_none());
     let text = std::fs::read_to_string(&path).unwrap();
     let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -205,10 +197,9 @@ fn calibration_files_load_and_bad_ones_are_refused() {
 /// starts, naming the file.
 #[test]
 fn the_live_loop_refuses_a_missing_calibration_file() {
-    let sc = scenario(
-        &[(0.3, 0.3, 0.0)],
-        "colour_calibration = \"/nonexistent/colour.json\"",
-    );
+    let sc = reading_through(&[[0.3, 0.3, 0.0]], "/nonexistent/colour.json")
+        .build()
+        .unwrap();
     let err = colcos_bridge::rig::LoopCore::new(&sc, Default::default())
         .err()
         .expect("refused")

@@ -1,9 +1,6 @@
 //! Latency calibration on the twin, whose tracker holds its blocks back 40 ms +- 10 ms: each stage
 //! measured over the wires, and the measured latency's compensation shown to bring the injection
 //! point nearer the robot's true position.
-mod calibrate_common;
-
-use calibrate_common::{TwinRun, scenario, wanderers};
 use colcos_bridge::calibrate::{LatencyRunOptions, calibrate_latency};
 use colcos_bridge::protocol::swarmcon::FrameTransform;
 use colcos_bridge::rig::HostWorld;
@@ -11,22 +8,27 @@ use colcos_bridge::transport::ClockOffset;
 use colcos_bridge::twin::{Noise, TwinArena};
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::{Scenario, SensorSource};
+use colcos_testkit::scenarios::{parked, wanderers};
+use colcos_testkit::twin::TwinRun;
 use std::collections::VecDeque;
 
-/// The scenario with a tracker that sees every 20 ms step and has no delay of its own: the twin's
-/// delay line adds it.
-fn with_tracker(sc: Scenario) -> Scenario {
-    let mut spec = sc.spec.clone();
-    spec.tracker.rate_hz = 50.0;
-    spec.tracker.latency = 0.0;
-    spec.tracker.dropout = 0.0;
-    Scenario::from_spec(spec, ".").unwrap()
+/// Two parked robots, tracked every 20 ms step without a delay of the tracker model's own: the
+/// twin's delay line adds it.
+fn scenario() -> Scenario {
+    parked(&[[0.72, 0.40, 0.0], [0.4, 0.3, 90.0]])
+        .with(|s| {
+            s.tracker.rate_hz = 50.0;
+            s.tracker.latency = 0.0;
+            s.tracker.dropout = 0.0;
+        })
+        .build()
+        .unwrap()
 }
 
 #[test]
 fn a_40_ms_tracker_is_measured_within_5_ms_and_compensating_it_brings_the_injection_point_to_the_robot()
  {
-    let sc = with_tracker(scenario(&[(0.72, 0.40, 0.0), (0.4, 0.3, 90.0)], ""));
+    let sc = scenario();
     let mut run = TwinRun::start(&sc, None, 0.040, 0.010, 30.0);
     let transform = FrameTransform::new(sc.arena_size().y as f64);
     let opts = LatencyRunOptions {

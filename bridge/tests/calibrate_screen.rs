@@ -1,20 +1,18 @@
 //! Screen <-> camera calibration on the twin, whose camera is known: fiducials shown through the
 //! frame stream are read back over SwarmCon, the homography and heading are fitted, and the robots'
 //! poses through the calibration land within a millimetre of where they truly are.
-mod calibrate_common;
-
-use calibrate_common::{TwinRun, scenario};
 use colcos_bridge::calibrate::{RigCalibration, ScreenCalibration};
 use colcos_bridge::calibrate::{ScreenRunOptions, calibrate_screen};
 use colcos_bridge::twin::{CameraModel, Noise};
 use colcos_bridge::{SourceOptions, open_pose_source};
+use colcos_testkit::scenarios::parked;
+use colcos_testkit::twin::TwinRun;
 
 #[test]
 fn the_screen_calibration_recovers_the_camera_within_a_millimetre() {
-    let sc = scenario(
-        &[(0.72, 0.40, 20.0), (0.3, 0.25, 0.0), (1.1, 0.6, 90.0)],
-        "",
-    );
+    let sc = parked(&[[0.72, 0.40, 20.0], [0.3, 0.25, 0.0], [1.1, 0.6, 90.0]])
+        .build()
+        .unwrap();
     let size = [sc.spec.screen.size[0] as f64, sc.spec.screen.size[1] as f64];
     let camera = CameraModel::lab(size);
     let mut run = TwinRun::start(&sc, Some(camera), 0.0, 0.0, 30.0);
@@ -94,8 +92,13 @@ fn the_screen_calibration_recovers_the_camera_within_a_millimetre() {
     );
     let (a, b) = (a.unwrap(), b.unwrap());
     assert!((a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12 && (a.2 - b.2).abs() < 1e-12);
-    let rig_text = format!("screen_calibration = \"{}\"", path.display());
-    let calibrated = scenario(&[(0.72, 0.40, 20.0)], &rig_text);
+    let through_file = |s: &mut colcos_sim::scenario::ScenarioSpec| {
+        s.rig.screen_calibration = Some(path.display().to_string())
+    };
+    let calibrated = parked(&[[0.72, 0.40, 20.0]])
+        .with(through_file)
+        .build()
+        .unwrap();
     let loaded = RigCalibration::load(&calibrated).unwrap();
     let opts = SourceOptions::new(loaded.frame_transform(&calibrated));
     let mut source = open_pose_source(&format!("swarmcon://{}", run.tracker_addr), &opts).unwrap();
@@ -111,7 +114,11 @@ fn the_screen_calibration_recovers_the_camera_within_a_millimetre() {
     }
 
     // A calibration of another panel is refused, naming both resolutions.
-    let other = calibrate_common::scenario_with_screen(&rig_text, [1920, 1080]);
+    let other = parked(&[[0.72, 0.4, 0.0]])
+        .with(through_file)
+        .with(|s| s.screen.resolution = [1920, 1080])
+        .build()
+        .unwrap();
     let err = RigCalibration::load(&other).unwrap_err().to_string();
     assert!(
         err.contains("3840x2160") && err.contains("1920x1080"),

@@ -2,15 +2,11 @@
 //! robots' serial protocol over UDP and over a pseudo-terminal, the displayed frames over the frame
 //! stream; and the safety stops, measured from the twin's own record of what it received.
 use colcos_bridge::protocol::colias::{BROADCAST_ID, HostCommand};
-use colcos_bridge::protocol::swarmcon::{FrameTransform, HeaderForm};
 use colcos_bridge::rig::recorder::{Topic, read_log};
 use colcos_bridge::rig::{self, LiveOptions, LiveReport, LoopCore, replay};
-use colcos_bridge::transport::FrameServer;
-use colcos_bridge::twin::{
-    ByteChannel, PtyChannel, RobotFaults, TrackerFaults, TrackerServer, Twin, UdpChannel,
-};
-use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
+use colcos_bridge::twin::{ByteChannel, PtyChannel, RobotFaults, TrackerFaults};
 use colcos_sim::scenario::Scenario;
+use colcos_testkit::twin::{LoopbackTwin, RunningTwin, one_at_a_time, udp_channel};
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -21,7 +17,7 @@ fn scenario() -> Scenario {
 }
 
 struct Rig {
-    twin: std::thread::JoinHandle<Twin>,
+    twin: RunningTwin,
     faults: Arc<Mutex<TrackerFaults>>,
     report: LiveReport,
     log: Vec<colcos_bridge::rig::recorder::Recorded>,
@@ -36,26 +32,15 @@ fn run_rig(
     seconds: f64,
     during: impl FnOnce(&Arc<Mutex<TrackerFaults>>, &Arc<Mutex<RobotFaults>>),
 ) -> Rig {
-    // One rig at a time: the timing bounds hold for a loop that has a core, not for four at once.
-    static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let _turn = one_at_a_time();
     let sc = scenario();
-    let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
-    let tracker_addr = tracker.local_addr();
-    let frames = FrameServer::bind("127.0.0.1:0").unwrap();
-    let frames_addr = frames.local_addr();
-    let mut twin = Twin::new(&sc, tracker, channel, Some(frames_addr)).unwrap();
-    let faults = twin.tracker().faults();
-    let robot_faults = twin.robots().faults.clone();
-    let twin_stop = Arc::new(AtomicBool::new(false));
-    let ts = twin_stop.clone();
-    let twin = std::thread::spawn(move || {
-        twin.run(Some(seconds + 1.0), &ts);
-        twin
-    });
-    let opts = SourceOptions::new(FrameTransform::new(sc.arena_size().y as f64));
-    let source = open_pose_source(&format!("swarmcon://{tracker_addr}"), &opts).unwrap();
-    let link = open_robot_link(&link_url).unwrap();
+    let mut twin = LoopbackTwin::over(&sc, channel, link_url, true);
+    let faults = twin.twin.tracker().faults();
+    let robot_faults = twin.twin.robots().faults.clone();
+    let mut twin = twin.spawn(seconds + 1.0);
+    let source = twin.pose_source(&sc);
+    let link = twin.robot_link();
+    let frames = twin.frames.take();
     let dir = tempfile::tempdir().unwrap();
     let log_path = dir.path().join("rig.mcap");
     let live_opts = LiveOptions {
@@ -71,9 +56,7 @@ fn run_rig(
     let bridge = {
         let sc = sc.clone();
         let stop = stop.clone();
-        std::thread::spawn(move || {
-            rig::run(&sc, source, link, Some(frames), live_opts, stop).unwrap()
-        })
+        std::thread::spawn(move || rig::run(&sc, source, link, frames, live_opts, stop).unwrap())
     };
     during(&faults, &robot_faults);
     let report = bridge.join().unwrap();
@@ -144,14 +127,13 @@ fn wheel_speeds(p: &HostCommand) -> Option<(f32, f32)> {
 /// keeps its 20 ms.
 #[test]
 fn case_two_drives_the_twin_over_udp() {
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let (channel, url) = udp_channel();
     let start_poses: Vec<_> = {
         let sc = scenario();
         colcos_sim::world::World::new(&sc).unwrap().poses().to_vec()
     };
-    let rig = run_rig(Box::new(channel), url, 4.0, |_, _| {});
-    let twin = rig.twin.join().unwrap();
+    let rig = run_rig(channel, url, 4.0, |_, _| {});
+    let twin = rig.twin.join();
     let r = &rig.report;
     assert!(r.ticks >= 150, "{r:?}");
     assert!(r.pose_blocks >= 60, "{r:?}");
@@ -249,7 +231,7 @@ fn the_serial_link_drives_the_twin_over_a_pty() {
     let channel = PtyChannel::open().unwrap();
     let url = format!("serial://{}?baud=115200", channel.peer_path());
     let rig = run_rig(Box::new(channel), url, 2.0, |_, _| {});
-    let twin = rig.twin.join().unwrap();
+    let twin = rig.twin.join();
     let driven = twin
         .received()
         .iter()
@@ -268,16 +250,15 @@ fn the_serial_link_drives_the_twin_over_a_pty() {
 /// limit plus 50 ms, measured on the twin's receipt times.
 #[test]
 fn tracker_silence_stops_every_robot_in_time() {
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let (channel, url) = udp_channel();
     let silent_at = Arc::new(Mutex::new(None));
     let s = silent_at.clone();
-    let rig = run_rig(Box::new(channel), url, 3.0, move |faults, _| {
+    let rig = run_rig(channel, url, 3.0, move |faults, _| {
         std::thread::sleep(Duration::from_millis(1500));
         faults.lock().unwrap().silent = true;
         *s.lock().unwrap() = Some(Instant::now());
     });
-    let twin = rig.twin.join().unwrap();
+    let twin = rig.twin.join();
     let silent_at = silent_at.lock().unwrap().unwrap();
     let stop = twin
         .received()
@@ -314,16 +295,15 @@ fn tracker_silence_stops_every_robot_in_time() {
 /// clock an hour ahead: the bridge still takes every pose, drives every robot and sends no stop.
 #[test]
 fn stream_faults_do_not_stop_the_loop() {
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let url = format!("udp://{}", channel.local_addr().unwrap());
-    let rig = run_rig(Box::new(channel), url, 3.0, |faults, _| {
+    let (channel, url) = udp_channel();
+    let rig = run_rig(channel, url, 3.0, |faults, _| {
         let mut f = faults.lock().unwrap();
         f.split = 7;
         f.merge = 2;
         f.garbage = true;
         f.clock_offset_us = 3_600_000_000;
     });
-    let twin = rig.twin.join().unwrap();
+    let twin = rig.twin.join();
     let r = &rig.report;
     assert!(r.stops.is_empty(), "{r:?}");
     assert!(r.pose_blocks >= 30, "{r:?}");
@@ -358,16 +338,15 @@ fn stream_faults_do_not_stop_the_loop() {
 /// limit plus 50 ms; the others keep driving.
 #[test]
 fn a_lost_robot_alone_is_stopped_in_time() {
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let (channel, url) = udp_channel();
     let hidden_at = Arc::new(Mutex::new(None));
     let h = hidden_at.clone();
-    let rig = run_rig(Box::new(channel), url, 3.0, move |faults, _| {
+    let rig = run_rig(channel, url, 3.0, move |faults, _| {
         std::thread::sleep(Duration::from_millis(1500));
         faults.lock().unwrap().hidden = vec![2];
         *h.lock().unwrap() = Some(Instant::now());
     });
-    let twin = rig.twin.join().unwrap();
+    let twin = rig.twin.join();
     let hidden_at = hidden_at.lock().unwrap().unwrap();
     // Tracker ID 2 is the third robot, radio address 3.
     let stop = twin
@@ -424,13 +403,12 @@ fn events_of(log: &[colcos_bridge::rig::recorder::Recorded]) -> Vec<String> {
 /// second of unanswered data requests, says so, and sends it nothing but stops from then on.
 #[test]
 fn a_robot_that_stops_answering_is_reported() {
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let url = format!("udp://{}", channel.local_addr().unwrap());
-    let rig = run_rig(Box::new(channel), url, 3.0, |_, robots| {
+    let (channel, url) = udp_channel();
+    let rig = run_rig(channel, url, 3.0, |_, robots| {
         std::thread::sleep(Duration::from_millis(1000));
         robots.lock().unwrap().deaf = vec![4];
     });
-    let _twin = rig.twin.join().unwrap();
+    let _twin = rig.twin.join();
     assert_eq!(rig.report.silent_robots, vec![4], "{:?}", rig.report);
     let events = events_of(&rig.log);
     assert!(
@@ -443,13 +421,12 @@ fn a_robot_that_stops_answering_is_reported() {
 /// about a second after it was first asked.
 #[test]
 fn a_robot_that_never_answers_is_reported() {
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let url = format!("udp://{}", channel.local_addr().unwrap());
+    let (channel, url) = udp_channel();
     // The last robot is asked last: deaf before the loop's first request reaches it.
-    let rig = run_rig(Box::new(channel), url, 2.5, |_, robots| {
+    let rig = run_rig(channel, url, 2.5, |_, robots| {
         robots.lock().unwrap().deaf = vec![5];
     });
-    let _twin = rig.twin.join().unwrap();
+    let _twin = rig.twin.join();
     assert_eq!(rig.report.silent_robots, vec![5], "{:?}", rig.report);
     let events = events_of(&rig.log);
     assert!(

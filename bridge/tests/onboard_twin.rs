@@ -7,66 +7,31 @@ use colcos_bridge::protocol::colias::colour_from_sim;
 use colcos_bridge::protocol::colias::{
     CommandPacket, FrameDecoder, HostCommand, PolicyMode, TELEMETRY_LEN, Telemetry,
 };
-use colcos_bridge::protocol::swarmcon::{FrameTransform, HeaderForm};
 use colcos_bridge::rig::recorder::read_log;
 use colcos_bridge::rig::{self, LiveOptions, LoopCore, replay};
-use colcos_bridge::transport::FrameServer;
-use colcos_bridge::twin::{FIRMWARE_TIMEOUT, TrackerServer, Twin, UdpChannel};
-use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
+use colcos_bridge::twin::{FIRMWARE_TIMEOUT, Twin};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::sensors::{ColourCalibration, RobotColour, SensorFit};
+use colcos_testkit::scenarios::{onboard, onboard_policy};
+use colcos_testkit::twin::{LoopbackTwin, one_at_a_time};
 use std::net::UdpSocket;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-fn fixture() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/onboard/policy.json")
-}
-
 /// Three robots well inside the arena, heading along x; the rig's shield caps the wheels at 0.2 m/s,
 /// so the robots' parameter block must say 0.2 (the export says 0.35).
-fn scenario(onboard: &Path) -> Scenario {
-    scenario_at(onboard, 0.3)
-}
-
-fn scenario_at(onboard: &Path, x: f32) -> Scenario {
-    let text = format!(
-        r#"
-name = "onboard"
-duration = 60.0
-dt = 0.02
-seed = 3
-[screen]
-resolution = [960, 540]
-size = [1.439, 0.809]
-[[robots]]
-count = 3
-behaviour = "wander"
-placement = "explicit"
-poses = [[{x}, 0.2, 0.0], [{x}, 0.4, 0.0], [{x}, 0.6, 0.0]]
-[rig]
-onboard = {onboard:?}
-[rig.shield]
-max_wheel_speed = 0.2
-"#
-    );
-    Scenario::from_toml_str(&text, ".").unwrap()
+fn scenario(policy: &Path) -> Scenario {
+    onboard(policy, 0.3)
 }
 
 fn manifest() -> OnboardManifest {
-    OnboardManifest::load(&fixture()).unwrap()
+    OnboardManifest::load(&onboard_policy()).unwrap()
 }
 
 /// The bridge's live loop and the twin over loopback for `seconds`; `host` is the bridge's scenario
-/// (it may name another policy than the twin's robots carry).
-/// The real-time runs one at a time: their bounds hold for a loop that has a core to itself.
-fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
-    static TURN: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    TURN.lock().unwrap_or_else(|e| e.into_inner())
-}
-
+/// (it may name another policy than the twin's robots carry). One run at a time.
 fn run(
     host: &Scenario,
     seconds: f64,
@@ -76,32 +41,7 @@ fn run(
     Vec<colcos_bridge::rig::recorder::Recorded>,
 ) {
     let _turn = one_at_a_time();
-    let twin_sc = scenario(&fixture());
-    let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
-    let tracker_addr = tracker.local_addr();
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let url = format!("udp://{}", channel.local_addr().unwrap());
-    let frames = FrameServer::bind("127.0.0.1:0").unwrap();
-    let mut twin = Twin::new(
-        &twin_sc,
-        tracker,
-        Box::new(channel),
-        Some(frames.local_addr()),
-    )
-    .unwrap();
-    let stop = Arc::new(AtomicBool::new(false));
-    let twin = {
-        let stop = stop.clone();
-        std::thread::spawn(move || {
-            twin.run(Some(seconds + 0.5), &stop);
-            twin
-        })
-    };
-    let source = open_pose_source(
-        &format!("swarmcon://{tracker_addr}"),
-        &SourceOptions::new(FrameTransform::new(host.arena_size().y as f64)),
-    )
-    .unwrap();
+    let mut twin = LoopbackTwin::udp(&scenario(&onboard_policy()), true).spawn(seconds + 0.5);
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("rig.mcap");
     let opts = LiveOptions {
@@ -112,14 +52,14 @@ fn run(
     };
     let report = rig::run(
         host,
-        source,
-        open_robot_link(&url).unwrap(),
-        Some(frames),
+        twin.pose_source(host),
+        twin.robot_link(),
+        twin.frames.take(),
         opts,
         Arc::new(AtomicBool::new(false)),
     )
     .unwrap();
-    let twin = twin.join().unwrap();
+    let twin = twin.join();
     (twin, report, read_log(&std::fs::read(&log).unwrap()))
 }
 
@@ -137,7 +77,7 @@ fn commands_to(twin: &Twin, radio: u8) -> Vec<HostCommand> {
 #[test]
 fn the_twins_robots_run_the_exported_policy_on_board() {
     let m = manifest();
-    let host = scenario(&fixture());
+    let host = scenario(&onboard_policy());
     let start: Vec<_> = colcos_sim::world::World::new(&host)
         .unwrap()
         .poses()
@@ -218,7 +158,7 @@ fn the_twins_robots_run_the_exported_policy_on_board() {
 #[test]
 fn robots_flashed_with_another_policy_are_held() {
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(fixture()).unwrap();
+    let text = std::fs::read_to_string(onboard_policy()).unwrap();
     let other_hash = manifest().hash ^ 1;
     let json = text.replace(
         &format!("\"hash\": {}", manifest().hash),
@@ -258,12 +198,11 @@ struct Bench {
 
 impl Bench {
     fn new() -> Bench {
-        let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
-        let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-        let addr = channel.local_addr().unwrap();
-        let twin = Twin::new(&scenario(&fixture()), tracker, Box::new(channel), None).unwrap();
+        let twin = LoopbackTwin::udp(&scenario(&onboard_policy()), false);
         let host = UdpSocket::bind("127.0.0.1:0").unwrap();
-        host.connect(addr).unwrap();
+        host.connect(twin.link_url.strip_prefix("udp://").unwrap())
+            .unwrap();
+        let twin = twin.twin;
         host.set_read_timeout(Some(std::time::Duration::from_millis(500)))
             .unwrap();
         Bench {
@@ -372,7 +311,7 @@ fn the_robots_firmware_obeys_stops_and_silence() {
 #[test]
 fn bad_manifests_are_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(fixture()).unwrap();
+    let text = std::fs::read_to_string(onboard_policy()).unwrap();
     for (from, to, says) in [
         (
             "colcos-onboard-policy/1",
@@ -408,9 +347,7 @@ fn bad_manifests_are_refused_by_name() {
     // The C missing beside a good manifest: the twin says so.
     std::fs::write(dir.path().join("policy.json"), &text).unwrap();
     let sc = scenario(&dir.path().join("policy.json"));
-    let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let err = Twin::new(&sc, tracker, Box::new(channel), None)
+    let err = LoopbackTwin::try_udp(&sc, false)
         .err()
         .expect("no C source")
         .to_string();

@@ -4,6 +4,7 @@
 //! motions and lay bits lays at the full rate; bad declarations and actions are refused by name.
 use colcos_env::{ActionKind, Actions, EnvConfig, ScenarioSource, VecEnv};
 use colcos_sim::field::FieldModel;
+use colcos_sim::scenario::{EmitSpec, PheromoneSpec, Scenario};
 
 const TRAIL: &str = include_str!("../scenarios/trail.toml");
 const SCRIPTED: &str = r#"deposits = [{ pheromone = "red", kernel = { shape = "disc", radius = 0.008 }, rate = 3.0 }]"#;
@@ -194,10 +195,14 @@ fn bad_deposit_actions_are_refused_by_name() {
 /// A gaussian `alarm` pheromone each agent switches on and off (`when = "action"`), after its red
 /// trail: actions `[left, right, red rate, alarm switch]`.
 fn with_alarm_switch() -> String {
-    let alarm = "[[pheromones]]\nname = \"alarm\"\nmodel = \"gaussian\"\ncolour = [0, 255, 0]\n\
-                 evaporation = 1.0\n\n[[robots]]";
-    let emits = r#"emits = [{ pheromone = "alarm", k = 0.01, sigma = [0.03, 0.03], evaporation = 1.0, when = "action" }]"#;
-    trail_with(&format!("{}\n{emits}", action_line(3.0))).replacen("[[robots]]", alarm, 1)
+    let mut sc = Scenario::from_toml_str(&trail_with(&action_line(3.0)), ".").unwrap();
+    sc.spec
+        .pheromones
+        .push(PheromoneSpec::gaussian("alarm", [0.0, 255.0, 0.0]).with_evaporation(1.0));
+    sc.spec.robots[0]
+        .emits
+        .push(EmitSpec::follow("alarm", 0.01, [0.03, 0.03], 1.0).when_action());
+    sc.to_toml()
 }
 
 /// Worlds whose agents' alarm sources have been switched on.

@@ -4,9 +4,10 @@
 //! in a step with contacts.
 use colcos_env::{Actions, EnvConfig, VecEnv};
 use colcos_sim::robot::PhysicsBackend;
-#[path = "../../sim/tests/support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
+use colcos_testkit::alloc::{Counting, allocations, assert_installed};
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
 
 /// Allocations per world and step over 100 steps of 64 worlds, after 100 steps to warm up; episodes
 /// are longer than the 200 steps, so no world is rebuilt.
@@ -37,6 +38,7 @@ fn allocations_per_world_step(task: &str, physics: PhysicsBackend) -> f64 {
 /// and step, rapier 0.4-1.3.
 #[test]
 fn a_batched_step_allocates_nothing_of_its_own() {
+    assert_installed();
     for task in ["aggregation", "foraging", "trail"] {
         let discs = allocations_per_world_step(task, PhysicsBackend::Discs);
         assert!(

@@ -1,5 +1,6 @@
 //! Screen images, sensor readings and whole worlds: GPU against CPU on the paper's two case studies
-//! (case I: static pheromone maps on the grid; case II: Gaussian sources that follow or are refreshed).
+//! (case I: static pheromone maps on the grid; case II: Gaussian sources that follow or are refreshed),
+//! shortened to 4 s (`colcos_testkit::scenarios::case_i_like`, `case_ii_like`).
 mod common;
 use colcos_gpu::GpuGrids;
 use colcos_gpu::screen::{GpuScreen, ScreenScene, SensorQuery, mean_levels};
@@ -7,90 +8,8 @@ use colcos_sim::field::{BackendChoice, FieldModel, GridField};
 use colcos_sim::prelude::*;
 use colcos_sim::screen;
 use colcos_sim::sensors::{SENSOR_RADIUS, sensor_positions};
+use colcos_testkit::scenarios::{case_i_like, case_ii_like};
 use common::{compare, ctx};
-
-/// Case I of the paper: static maps of three pheromones drawn on the grid (d = 0, steady state e J),
-/// robots following them and laying a trail.
-const CASE_I: &str = r#"
-name = "case_i_like"
-duration = 4.0
-seed = 3
-[screen]
-resolution = [3840, 2160]
-size = [1.439, 0.809]
-[field]
-cell = 0.005
-[[pheromones]]
-name = "red"
-colour = [255, 0, 0]
-evaporation = 5.0
-[[pheromones.maps]]
-polyline = [[0.2, 0.2], [1.2, 0.2], [1.2, 0.6]]
-width = 0.03
-rate = 0.2
-[[pheromones]]
-name = "green"
-colour = [0, 255, 0]
-evaporation = 8.0
-diffusion = 1e-6
-[[pheromones.maps]]
-polyline = [[0.2, 0.6], [0.7, 0.4], [1.2, 0.6]]
-width = 0.05
-rate = 0.15
-[[pheromones]]
-name = "blue"
-colour = [40, 0, 255]
-evaporation = 3.0
-[[robots]]
-count = 6
-behaviour = "follow"
-params = { channel = "r", speed = 0.1, sensitivity = 0.5, threshold = 0.05 }
-deposits = [{ pheromone = "blue", kernel = { shape = "cone", radius = 0.012 }, rate = 5.0 }]
-"#;
-
-/// Case II of the paper: a leader followed by an attractive Gaussian pheromone (AGP) and robots that
-/// refresh a Gaussian source when near the leader (ALP), with a grid trail besides.
-const CASE_II: &str = r#"
-name = "case_ii_like"
-duration = 4.0
-seed = 5
-[screen]
-resolution = [3840, 2160]
-size = [1.439, 0.809]
-[field]
-cell = 0.005
-[[pheromones]]
-name = "agp"
-colour = [0, 255, 0]
-model = "gaussian"
-evaporation = 5.0
-[[pheromones]]
-name = "alp"
-colour = [255, 0, 0]
-model = "gaussian"
-evaporation = 2.0
-[[pheromones]]
-name = "trail"
-colour = [0, 0, 255]
-evaporation = 10.0
-diffusion = 2e-6
-[[robots]]
-count = 1
-role = "leader"
-behaviour = "wander"
-emits = [{ pheromone = "agp", k = 0.4, sigma = [0.06, 0.04], rho = 0.3, evaporation = 5.0 }]
-deposits = [{ pheromone = "trail", kernel = { shape = "gaussian", sigma = 0.006 }, rate = 4.0 }]
-[[robots]]
-count = 5
-role = "follower"
-behaviour = "follow"
-params = { channel = "g", speed = 0.1, sensitivity = 0.5, threshold = 0.05 }
-emits = [{ pheromone = "alp", k = 0.2, sigma = [0.03, 0.03], evaporation = 2.0, when = { near = { role = "leader", distance = 0.3 } } }]
-"#;
-
-fn scenario(text: &str) -> Scenario {
-    Scenario::from_toml_str(text, ".").expect("scenario")
-}
 
 /// Uploads a world's grid pheromones into a batch and its layers into a one-world scene.
 fn upload(
@@ -112,9 +31,8 @@ fn upload(
     (grids, scene)
 }
 
-fn check_screen_and_sensors(name: &str, text: &str, steps: usize, sizes: &[(u32, u32)]) {
+fn check_screen_and_sensors(name: &str, sc: Scenario, steps: usize, sizes: &[(u32, u32)]) {
     let Some(ctx) = ctx() else { return };
-    let sc = scenario(text);
     let mut world = World::new(&sc).unwrap();
     for _ in 0..steps {
         world.step();
@@ -216,7 +134,7 @@ fn check_screen_and_sensors(name: &str, text: &str, steps: usize, sizes: &[(u32,
 fn case_i_screen_and_sensors_match() {
     check_screen_and_sensors(
         "case I",
-        CASE_I,
+        case_i_like(),
         150,
         &[(3840, 2160), (480, 270), (333, 199)],
     );
@@ -224,14 +142,13 @@ fn case_i_screen_and_sensors_match() {
 
 #[test]
 fn case_ii_screen_and_sensors_match() {
-    check_screen_and_sensors("case II", CASE_II, 150, &[(3840, 2160), (480, 270)]);
+    check_screen_and_sensors("case II", case_ii_like(), 150, &[(3840, 2160), (480, 270)]);
 }
 
 /// Two worlds from one scenario, one with the GPU backend installed: the fields stay within 1e-5 and
 /// (the GPU reproducing the CPU's arithmetic) the robots' observations and trajectories agree.
-fn check_world(name: &str, text: &str, steps: usize) {
+fn check_world(name: &str, sc: Scenario, steps: usize) {
     let Some(_ctx) = ctx() else { return };
-    let sc = scenario(text);
     let mut cpu = World::new(&sc).unwrap();
     let mut gpu = World::new(&sc).unwrap();
     let sel = colcos_gpu::install(&mut gpu, BackendChoice::Gpu).unwrap();
@@ -268,17 +185,17 @@ fn check_world(name: &str, text: &str, steps: usize) {
 
 #[test]
 fn case_i_world_on_gpu_matches_cpu() {
-    check_world("case I world", CASE_I, 200);
+    check_world("case I world", case_i_like(), 200);
 }
 
 #[test]
 fn case_ii_world_on_gpu_matches_cpu() {
-    check_world("case II world", CASE_II, 200);
+    check_world("case II world", case_ii_like(), 200);
 }
 
 #[test]
 fn backend_choice_cpu_and_auto() {
-    let sc = scenario(CASE_I);
+    let sc = case_i_like();
     let mut w = World::new(&sc).unwrap();
     let sel = colcos_gpu::install(&mut w, BackendChoice::Cpu).unwrap();
     assert!(matches!(sel, colcos_gpu::BackendSelection::Cpu { .. }));

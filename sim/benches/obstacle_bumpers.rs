@@ -5,68 +5,92 @@
 //! the median whole step. Target: the bumper pass at most 20 % of the step.
 //!
 //! cargo bench -p colcos-sim --bench obstacle_bumpers
-use colcos_sim::arena::Obstacles;
+use colcos_sim::arena::{ObstacleKind, ObstacleShape, ObstacleSpec, Obstacles};
+use colcos_sim::robot::PhysicsBackend;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::sensors::{BumperParams, BumperRays, NeighbourIndex};
 use colcos_sim::world::World;
+use colcos_testkit::scenarios::trail_followers;
 use glam::Vec2;
 use rayon::prelude::*;
-use std::fmt::Write;
 use std::time::Instant;
 
 const ROBOTS: usize = 1_000;
 /// Ten times the 65-inch screen's area: 100 robots per screen, as in the paper's densest runs.
 const ARENA: [f32; 2] = [4.55, 2.56];
 
-/// 200 obstacles on a jittered 20 x 10 grid, cycling through boxes, discs, walls and concave polygons.
-fn scenario(physics: &str) -> Scenario {
-    let mut t = String::new();
-    let (w, h) = (ARENA[0], ARENA[1]);
-    writeln!(
-        t,
-        "duration = 10.0\nphysics = \"{physics}\"\n[screen]\nsize = [{w}, {h}]\nresolution = [4550, 2560]\n\
-         [field]\ncell = 0.01\n[output]\ngif_interval = 0.0\n\
-         [[pheromones]]\nname = \"trail\"\ncolour = [0, 0, 255]\nevaporation = 20.0\n\
-         [[robots]]\ncount = {ROBOTS}\nbehaviour = \"follow\"\nparams = {{ channel = \"b\", speed = 0.1 }}\n\
-         deposits = [{{ pheromone = \"trail\", kernel = {{ shape = \"disc\", radius = 0.01 }}, rate = 3.0 }}]"
-    )
-    .unwrap();
-    for k in 0..200 {
-        let (i, j) = (k % 20, k / 20);
-        let jitter = ((k * 37 % 11) as f32 - 5.0) * 0.006;
-        let c = Vec2::new(
-            (i as f32 + 0.5) * w / 20.0 + jitter,
-            (j as f32 + 0.5) * h / 10.0 - jitter,
-        );
-        match k % 4 {
-            0 => writeln!(
-                t,
-                "[[obstacles]]\nshape = \"box\"\ncentre = [{}, {}]\nsize = [0.08, 0.05]\nangle = {}",
-                c.x,
-                c.y,
-                k * 17 % 90
-            ),
-            1 => writeln!(t, "[[obstacles]]\nshape = \"disc\"\ncentre = [{}, {}]\nradius = 0.04", c.x, c.y),
-            2 => writeln!(
-                t,
-                "[[obstacles]]\nshape = \"wall\"\npoints = [[{}, {}], [{}, {}], [{}, {}]]\nthickness = 0.01",
-                c.x - 0.06,
-                c.y,
-                c.x + 0.06,
-                c.y,
-                c.x + 0.06,
-                c.y + 0.06
-            ),
-            _ => writeln!(
-                t,
-                "[[obstacles]]\nshape = \"polygon\"\npoints = [[{}, {}], [{}, {}], [{}, {}], [{}, {}], [{}, {}], [{}, {}]]",
-                c.x - 0.05, c.y - 0.05, c.x + 0.05, c.y - 0.05, c.x + 0.05, c.y - 0.02,
-                c.x - 0.02, c.y - 0.02, c.x - 0.02, c.y + 0.05, c.x - 0.05, c.y + 0.05
-            ),
-        }
-        .unwrap();
+/// An obstacle of `shape` with none of its keys set yet.
+fn obstacle(shape: ObstacleShape) -> ObstacleSpec {
+    ObstacleSpec {
+        shape,
+        kind: ObstacleKind::Physical,
+        colour: None,
+        centre: None,
+        size: None,
+        angle: None,
+        radius: None,
+        points: None,
+        thickness: None,
+        image: None,
+        channel: None,
+        threshold: None,
+        pixels: None,
     }
-    Scenario::from_toml_str(&t, ".").expect("bench scenario is valid")
+}
+
+/// 200 obstacles on a jittered 20 x 10 grid, cycling through boxes, discs, walls and concave polygons.
+fn scenario(physics: PhysicsBackend) -> Scenario {
+    let (w, h) = (ARENA[0], ARENA[1]);
+    let obstacles = (0..200)
+        .map(|k| {
+            let (i, j) = (k % 20, k / 20);
+            let jitter = ((k * 37 % 11) as f32 - 5.0) * 0.006;
+            let c = Vec2::new(
+                (i as f32 + 0.5) * w / 20.0 + jitter,
+                (j as f32 + 0.5) * h / 10.0 - jitter,
+            );
+            match k % 4 {
+                0 => ObstacleSpec {
+                    centre: Some([c.x, c.y]),
+                    size: Some([0.08, 0.05]),
+                    angle: Some((k * 17 % 90) as f32),
+                    ..obstacle(ObstacleShape::Box)
+                },
+                1 => ObstacleSpec {
+                    centre: Some([c.x, c.y]),
+                    radius: Some(0.04),
+                    ..obstacle(ObstacleShape::Disc)
+                },
+                2 => ObstacleSpec {
+                    points: Some(vec![
+                        [c.x - 0.06, c.y],
+                        [c.x + 0.06, c.y],
+                        [c.x + 0.06, c.y + 0.06],
+                    ]),
+                    thickness: Some(0.01),
+                    ..obstacle(ObstacleShape::Wall)
+                },
+                _ => ObstacleSpec {
+                    points: Some(vec![
+                        [c.x - 0.05, c.y - 0.05],
+                        [c.x + 0.05, c.y - 0.05],
+                        [c.x + 0.05, c.y - 0.02],
+                        [c.x - 0.02, c.y - 0.02],
+                        [c.x - 0.02, c.y + 0.05],
+                        [c.x - 0.05, c.y + 0.05],
+                    ]),
+                    ..obstacle(ObstacleShape::Polygon)
+                },
+            }
+        })
+        .collect();
+    trail_followers(ROBOTS)
+        .physics(physics)
+        .screen([4550, 2560], ARENA)
+        .cell(0.01)
+        .with(|s| s.obstacles = obstacles)
+        .build()
+        .expect("bench scenario is valid")
 }
 
 fn median(mut xs: Vec<f64>) -> f64 {
@@ -99,13 +123,20 @@ fn bumper_pass(
 fn main() {
     println!(
         "{ROBOTS} robots, 200 obstacles ({} parry2d parts), arena {} x {} m, {} threads",
-        scenario("discs").obstacles().unwrap().parts().len(),
+        scenario(PhysicsBackend::Discs)
+            .obstacles()
+            .unwrap()
+            .parts()
+            .len(),
         ARENA[0],
         ARENA[1],
         rayon::current_num_threads()
     );
-    for physics in ["rapier", "discs"] {
-        let mut world = World::new(&scenario(physics)).unwrap();
+    for (physics, backend) in [
+        ("rapier", PhysicsBackend::Rapier),
+        ("discs", PhysicsBackend::Discs),
+    ] {
+        let mut world = World::new(&scenario(backend)).unwrap();
         for _ in 0..20 {
             world.step();
         }

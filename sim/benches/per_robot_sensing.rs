@@ -14,6 +14,7 @@ use colcos_sim::sensors::{
     ColourCalibration, RobotColour, SENSOR_RADIUS, SensorFit, sensor_positions,
 };
 use colcos_sim::world::World;
+use colcos_testkit::scenarios::{SMALL_SCREEN, orange_glow, trail_followers};
 use glam::Vec2;
 use std::hint::black_box;
 use std::time::Instant;
@@ -48,38 +49,19 @@ fn calibration() -> ColourCalibration {
     ColourCalibration::new("2026-11-24T00:00:00Z".into(), 24.0, robots, 6.0)
 }
 
+/// The trail followers on the small screen, with an orange glow besides, reading through `file`
+/// (every robot through its own models when `per_robot`).
 fn scenario(file: &str, per_robot: bool) -> Scenario {
-    let text = format!(
-        r#"
-duration = 10.0
-seed = 4
-[screen]
-size = [1.44, 0.8]
-resolution = [720, 400]
-[output]
-gif_interval = 0.0
-[sensor]
-per_robot = {per_robot}
-[[pheromones]]
-name = "trail"
-colour = [0, 0, 255]
-evaporation = 20.0
-[[pheromones]]
-name = "glow"
-colour = [200, 120, 60]
-model = "gaussian"
-evaporation = 1e6
-sources = [{{ k = 2.0, sigma = [0.2, 0.15], evaporation = 1e6, centre = [0.72, 0.4] }}]
-[[robots]]
-count = {ROBOTS}
-behaviour = "follow"
-params = {{ channel = "b", speed = 0.1 }}
-deposits = [{{ pheromone = "trail", kernel = {{ shape = "disc", radius = 0.01 }}, rate = 3.0 }}]
-[rig]
-colour_calibration = "{file}"
-"#
-    );
-    Scenario::from_toml_str(&text, ".").expect("bench scenario is valid")
+    trail_followers(ROBOTS)
+        .seed(4)
+        .screen(SMALL_SCREEN.0, SMALL_SCREEN.1)
+        .pheromone(orange_glow(2.0, [0.2, 0.15]))
+        .with(|s| {
+            s.sensor.per_robot = per_robot;
+            s.rig.colour_calibration = Some(file.to_string());
+        })
+        .build()
+        .expect("bench scenario is valid")
 }
 
 fn median(mut xs: Vec<f64>) -> f64 {

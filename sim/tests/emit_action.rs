@@ -3,23 +3,18 @@
 //! stays where it was switched off and evaporates, exactly as eq. (5) says.
 use colcos_sim::field::FieldModel;
 use colcos_sim::prelude::*;
+use colcos_sim::scenario::{EmitSpec, PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
 
-const SCENARIO: &str = r#"
-duration = 10.0
-[[pheromones]]
-name = "alarm"
-model = "gaussian"
-evaporation = 2.0
-colour = [255, 0, 0]
-[[robots]]
-count = 1
-behaviour = "wander"
-emits = [{ pheromone = "alarm", k = 1.0, sigma = [0.05, 0.05], evaporation = 2.0, when = "action" }]
-[[robots]]
-count = 1
-behaviour = "wander"
-emits = [{ pheromone = "alarm", k = 1.0, sigma = [0.05, 0.05], evaporation = 2.0 }]
-"#;
+/// A robot whose alarm emitter its agent switches, and one whose alarm follows it; 10 s.
+fn scenario() -> Scenario {
+    let alarm = || EmitSpec::follow("alarm", 1.0, [0.05, 0.05], 2.0);
+    ScenarioBuilder::new()
+        .pheromone(PheromoneSpec::gaussian("alarm", [255.0, 0.0, 0.0]).with_evaporation(2.0))
+        .robots(RobotGroupSpec::new(1, "wander").with_emit(alarm().when_action()))
+        .robots(RobotGroupSpec::new(1, "wander").with_emit(alarm()))
+        .build()
+        .unwrap()
+}
 
 /// The switched source's (centre, start) and the field's value at the first robot.
 fn source(world: &World) -> (glam::Vec2, f32, f32) {
@@ -33,7 +28,7 @@ fn source(world: &World) -> (glam::Vec2, f32, f32) {
 
 #[test]
 fn an_emitter_switched_by_action_emits_only_while_on() {
-    let sc = Scenario::from_toml_str(SCENARIO, ".").unwrap();
+    let sc = scenario();
     assert_eq!(sc.spec.robots[0].action_count(), 1);
     assert_eq!(sc.spec.robots[1].action_count(), 0);
     let mut world = World::new(&sc).unwrap();

@@ -3,39 +3,24 @@
 //! different gains, crosstalk, dark counts and transfer curves read the same colour as the file's
 //! models predict; `[randomize]` goes on top; a file that cannot serve the scenario is refused by key.
 use colcos_sim::scenario::Scenario;
-use colcos_sim::sensors::{ColourCalibration, RobotColour, SensorFit};
+use colcos_sim::sensors::{ColourCalibration, RobotColour};
 use colcos_sim::world::World;
-
-/// A fitted sensor: `gain` counts per unit light per ms at 24 ms, `crosstalk`, `dark` per channel.
-fn fit(gamma: f64, gain: f64, crosstalk: [[f64; 3]; 3], dark: [f64; 3]) -> SensorFit {
-    SensorFit::from_parts(gamma, gain, crosstalk, dark, 24.0)
-}
+use colcos_testkit::scenarios::glow_pair;
+use colcos_testkit::sensors::{bright_crosstalk, dim_red};
 
 /// Radio 1: a dim, red-leaning sensor; radio 2: a bright one with strong green-blue crosstalk.
 fn calibration() -> ColourCalibration {
-    let a = fit(
-        2.4,
-        900.0,
-        [[1.2, 0.02, 0.0], [0.03, 0.8, 0.05], [0.01, 0.04, 0.7]],
-        [20.0, 35.0, 50.0],
-    );
-    let b = fit(
-        1.9,
-        2100.0,
-        [[0.9, 0.15, 0.05], [0.1, 1.05, 0.3], [0.05, 0.35, 1.1]],
-        [60.0, 10.0, 25.0],
-    );
     ColourCalibration::new(
         "2026-11-24T00:00:00Z".into(),
         24.0,
         vec![
             RobotColour {
                 radio_id: 1,
-                sensors: [a; 4],
+                sensors: [dim_red(); 4],
             },
             RobotColour {
                 radio_id: 2,
-                sensors: [b; 4],
+                sensors: [bright_crosstalk(); 4],
             },
         ],
         6.0,
@@ -43,35 +28,13 @@ fn calibration() -> ColourCalibration {
 }
 
 /// Two robots near the centre of a screen that one wide, fixed Gaussian source paints an almost
-/// uniform orange; no sensor noise. `sensor` and `extra` go into the `[sensor]` section and after it.
-fn scenario(file: &str, sensor: &str, extra: &str) -> Scenario {
-    let text = format!(
-        r#"
-duration = 1.0
-seed = 3
-[screen]
-resolution = [720, 400]
-size = [1.44, 0.8]
-[sensor]
-noise = 0.0
-{sensor}
-[[pheromones]]
-name = "glow"
-colour = [200, 120, 60]
-model = "gaussian"
-evaporation = 1e6
-sources = [{{ k = 3.77, sigma = [1.0, 1.0], evaporation = 1e6, centre = [0.72, 0.4] }}]
-[[robots]]
-count = 2
-behaviour = "wander"
-placement = "explicit"
-poses = [[0.62, 0.4, 0.0], [0.82, 0.4, 0.0]]
-[rig]
-colour_calibration = "{file}"
-{extra}
-"#
-    );
-    Scenario::from_toml_str(&text, ".").unwrap()
+/// uniform orange, reading it through `file`; no sensor noise. `per_robot`: each robot through its
+/// own fitted sensors.
+fn scenario(file: &str, per_robot: bool) -> Scenario {
+    glow_pair(file)
+        .with(|s| s.sensor.per_robot = per_robot)
+        .build()
+        .unwrap()
 }
 
 fn saved(cal: &ColourCalibration) -> (tempfile::TempDir, String) {
@@ -86,8 +49,8 @@ fn each_robot_reads_the_screen_through_its_own_fitted_model() {
     let cal = calibration();
     let (_dir, file) = saved(&cal);
     // The screen levels under every sensor, from the nominal sensor's exact inverse (no noise).
-    let nominal = World::new(&scenario(&file, "", "")).unwrap();
-    let own = World::new(&scenario(&file, "per_robot = true", "")).unwrap();
+    let nominal = World::new(&scenario(&file, false)).unwrap();
+    let own = World::new(&scenario(&file, true)).unwrap();
     let mut red = [0.0f64; 2];
     for (r, red) in red.iter_mut().enumerate() {
         let fitted = &cal.robots[r].sensors[0];
@@ -121,13 +84,15 @@ fn each_robot_reads_the_screen_through_its_own_fitted_model() {
 #[test]
 fn randomised_gain_goes_on_top_of_the_fitted_sensors() {
     let (_dir, file) = saved(&calibration());
-    let plain = World::new(&scenario(&file, "per_robot = true", "")).unwrap();
-    let doubled = World::new(&scenario(
-        &file,
-        "per_robot = true",
-        "[randomize]\nsensor_gain = [2.0, 2.0]",
-    ))
-    .unwrap();
+    let plain = World::new(&scenario(&file, true)).unwrap();
+    let doubled = glow_pair(&file)
+        .with(|s| {
+            s.sensor.per_robot = true;
+            s.randomize.sensor_gain = Some([2.0, 2.0]);
+        })
+        .build()
+        .unwrap();
+    let doubled = World::new(&doubled).unwrap();
     let dark = calibration().robots[0].sensors[0].dark;
     let (a, b) = (
         plain.observations()[0].counts[1],
@@ -154,7 +119,7 @@ fn a_file_that_cannot_serve_the_scenario_is_refused_by_key() {
     let mut one = calibration();
     one.robots.truncate(1);
     let (_dir, file) = saved(&one);
-    let err = World::new(&scenario(&file, "per_robot = true", ""))
+    let err = World::new(&scenario(&file, true))
         .err()
         .expect("refused")
         .to_string();
@@ -169,7 +134,7 @@ fn a_file_that_cannot_serve_the_scenario_is_refused_by_key() {
     let mut singular = calibration();
     singular.robots[1].sensors[2].matrix = [[1.0; 3]; 3];
     let (_dir2, file) = saved(&singular);
-    let err = World::new(&scenario(&file, "per_robot = true", ""))
+    let err = World::new(&scenario(&file, true))
         .err()
         .expect("refused")
         .to_string();
@@ -183,7 +148,7 @@ fn a_file_that_cannot_serve_the_scenario_is_refused_by_key() {
     let path = dir.path().join("screen.json");
     std::fs::write(&path, "{\"homography\": [1, 0, 0]}").unwrap();
     let file = path.display().to_string();
-    let err = World::new(&scenario(&file, "per_robot = true", ""))
+    let err = World::new(&scenario(&file, true))
         .err()
         .expect("refused")
         .to_string();
@@ -193,14 +158,10 @@ fn a_file_that_cannot_serve_the_scenario_is_refused_by_key() {
     );
 
     // A missing file, named.
-    let err = World::new(&scenario(
-        "/nonexistent/colour.json",
-        "per_robot = true",
-        "",
-    ))
-    .err()
-    .expect("refused")
-    .to_string();
+    let err = World::new(&scenario("/nonexistent/colour.json", true))
+        .err()
+        .expect("refused")
+        .to_string();
     assert!(err.contains("/nonexistent/colour.json"), "{err}");
 
     // The switch without a file is refused when the scenario is read.

@@ -3,9 +3,10 @@
 //! few small blocks in each step with contacts (its solver's stage sync, its lists of modified bodies).
 use colcos_sim::prelude::*;
 use colcos_sim::robot::PhysicsBackend;
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
+use colcos_testkit::alloc::{Counting, allocations, assert_installed};
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
 
 const SCENARIOS: [&str; 6] = [
     "three_trails.toml",
@@ -47,6 +48,7 @@ fn allocations_per_step(file: &str, physics: PhysicsBackend) -> f64 {
 /// robots. One test, as the counter counts every thread's allocations.
 #[test]
 fn a_running_world_steps_without_allocating() {
+    assert_installed();
     for file in SCENARIOS {
         let per_step = allocations_per_step(file, PhysicsBackend::Discs);
         assert!(

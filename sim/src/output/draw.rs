@@ -273,26 +273,22 @@ pub fn path(img: &mut RgbImage, screen: &ScreenSpec, points: &[Vec2], c: Rgb<u8>
 mod tests {
     use super::*;
     use crate::output::gif::frame_image;
-    use crate::scenario::Scenario;
+    use crate::scenario::{PheromoneSpec, RobotGroupSpec, Scenario, ScenarioBuilder};
 
-    const TWO_GROUPS: &str = r#"
-duration = 1.0
-[[pheromones]]
-name = "trail"
-colour = [0, 0, 255]
-evaporation = 10.0
-[[robots]]
-count = 2
-role = "scout"
-behaviour = "avoid"
-placement = "explicit"
-poses = [[0.4, 0.4, 0.0], [0.6, 0.4, 0.0]]
-[[robots]]
-count = 1
-behaviour = "wander"
-placement = "explicit"
-poses = [[1.0, 0.4, 90.0]]
-"#;
+    /// A trail pheromone, two scouts avoiding and one robot wandering, all parked; 1 s.
+    fn two_groups() -> Scenario {
+        ScenarioBuilder::new()
+            .duration(1.0)
+            .pheromone(PheromoneSpec::grid("trail", [0.0, 0.0, 255.0]).with_evaporation(10.0))
+            .robots(
+                RobotGroupSpec::new(2, "avoid")
+                    .with_role("scout")
+                    .at_poses(vec![[0.4, 0.4, 0.0], [0.6, 0.4, 0.0]]),
+            )
+            .robots(RobotGroupSpec::new(1, "wander").at_poses(vec![[1.0, 0.4, 90.0]]))
+            .build()
+            .unwrap()
+    }
 
     fn count(img: &RgbImage, c: Rgb<u8>, x0: u32, x1: u32, y0: u32, y1: u32) -> usize {
         (y0..y1)
@@ -303,7 +299,7 @@ poses = [[1.0, 0.4, 90.0]]
 
     #[test]
     fn each_group_has_its_colour_and_a_legend_line() {
-        let world = World::new(&Scenario::from_toml_str(TWO_GROUPS, ".").unwrap()).unwrap();
+        let world = World::new(&two_groups()).unwrap();
         assert_eq!(
             robot_colours(&world),
             [group_colour(0), group_colour(0), group_colour(1)]

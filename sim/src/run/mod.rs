@@ -346,12 +346,23 @@ mod tests {
         image::RgbImage::from_pixel(8, 6, image::Rgb([0, 0, 200]))
             .save(src.path().join("maps/loop.png"))
             .unwrap();
-        let text = "duration = 0.04\n[output]\ngif_interval = 0\n[[pheromones]]\nname = \"trail\"\n\
-                    colour = [0, 0, 255]\nevaporation = 10.0\n\
-                    maps = [{ image = \"maps/loop.png\", channel = \"b\", rate = 1.0 }]\n\
-                    [[robots]]\ncount = 2\nbehaviour = \"avoid\"\n";
-        std::fs::write(src.path().join("s.toml"), text).unwrap();
-        let sc = Scenario::from_file(src.path().join("s.toml")).unwrap();
+        // A relative image path, resolved against the scenario's directory.
+        let sc = crate::scenario::ScenarioBuilder::new()
+            .duration(0.04)
+            .gif_interval(0.0)
+            .base_dir(src.path())
+            .pheromone(
+                crate::scenario::PheromoneSpec::grid("trail", [0.0, 0.0, 255.0])
+                    .with_evaporation(10.0)
+                    .with_map(crate::scenario::MapSpec::Image {
+                        image: "maps/loop.png".into(),
+                        channel: Some(crate::channel::ImageChannel::B),
+                        rate: 1.0,
+                    }),
+            )
+            .robots(crate::scenario::RobotGroupSpec::new(2, "avoid"))
+            .build()
+            .unwrap();
         let out = tempfile::tempdir().unwrap();
         run(&sc, out.path(), RunOptions::default()).unwrap();
         let saved = Scenario::from_file(out.path().join("scenario.toml")).expect("the saved copy");

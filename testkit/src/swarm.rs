@@ -1,11 +1,12 @@
-//! The scenario of `cargo bench --bench swarm_step`, shared with `examples/profile_swarm.rs` (which
-//! includes this file) so that a profile looks at exactly what the bench times: robots in three equal
-//! groups, each laying one of three diffusing pheromones and following another.
-use colcos::sim::field::Kernel;
-use colcos::sim::prelude::*;
-use colcos::sim::robot::PhysicsBackend;
-use colcos::sim::scenario::{PheromoneSpec, RobotGroupSpec, ScenarioBuilder};
+//! The scenario of `cargo bench --bench swarm_step`, shared with `examples/profile_swarm.rs` so that a
+//! profile looks at exactly what the bench times: robots in three equal groups, each laying one of
+//! three diffusing pheromones and following another.
+use colcos_sim::field::Kernel;
+use colcos_sim::robot::PhysicsBackend;
+use colcos_sim::scenario::{PheromoneSpec, RobotGroupSpec, Scenario, ScenarioBuilder};
 
+/// `robots` robots on a screen of `size` m shown at `resolution`, on a grid of `cell` m, their
+/// contacts solved by `physics`; 10 s, no GIF.
 pub fn scenario(
     robots: usize,
     size: [f32; 2],
