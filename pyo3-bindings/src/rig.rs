@@ -39,9 +39,7 @@ fn rig_identify(
         };
         let found = py
             .detach(|| identify::identify(&bytes, &sc, &opts))
-            .map_err(|e| {
-                Kind::Colcos.err(format!("identifying from {}: {e}", log.display()))
-            })?;
+            .map_err(|e| Kind::Colcos.err(format!("identifying from {}: {e}", log.display())))?;
         let file = identify::overlay::overlay(&found, &log.display().to_string(), &sc.spec.name);
         let text = file.to_toml();
         if let Some(out) = &out {
