@@ -10,9 +10,8 @@ fn allocations_and_reallocations_are_counted() {
     assert_installed();
     let before = allocations();
     let mut v: Vec<u64> = Vec::with_capacity(1);
-    v.push(1);
-    // The second push outgrows the first block: a reallocation.
-    v.push(2);
+    // Two elements outgrow the first block: a reallocation.
+    v.extend([1, 2]);
     std::hint::black_box(&v);
     assert!(
         allocations() >= before + 2,
