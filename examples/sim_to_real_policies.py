@@ -57,8 +57,8 @@ def load(path: str, d: int, c: int) -> ActorCritic:
     return model
 
 
-def on_sim(act, scenario: str, worlds: int, steps: int, seed: int) -> float:
-    """Mean return per follower over `worlds` seeded episodes on the simulator."""
+def sim_returns(act, scenario: str, worlds: int, steps: int, seed: int) -> list[float]:
+    """Each world's mean return per follower over `worlds` seeded episodes on the simulator."""
     v = VecEnv("aggregation", num_envs=worlds, max_cycles=steps, scenario=scenario)
     policy = act(v)
     obs, _ = v.reset(seed=seed)
@@ -66,23 +66,40 @@ def on_sim(act, scenario: str, worlds: int, steps: int, seed: int) -> float:
     for _ in range(steps):
         obs, rew, _, _, _ = v.step(policy(obs))
         total += rew
-    return float(total.mean())
+    return total.mean(axis=1).tolist()
 
 
-def on_twin(act, scenario: str, twin: dict, episodes: int, steps: int, seed: int) -> float:
+def on_sim(act, scenario: str, worlds: int, steps: int, seed: int) -> float:
+    """Mean return per follower over `worlds` seeded episodes on the simulator."""
+    return float(np.mean(sim_returns(act, scenario, worlds, steps, seed)))
+
+
+def twin_episode(env, make, seed: int) -> float:
+    """One episode on a twin `parallel_env`: the mean return per follower. `make(env)`, called once
+    per episode (a behaviour keeps state), gives `act(env, obs)`: the PettingZoo action dict."""
+    obs, _ = env.reset(seed=seed)
+    act = make(env)
+    total = 0.0
+    while env.agents:
+        obs, rew, _, _, _ = env.step(act(env, obs))
+        total += float(np.mean(list(rew.values()))) if rew else 0.0
+    return total
+
+
+def stacked(act):
+    """A policy on stacked observations (agents, obs) as a `make(env)` for twin_episode."""
+
+    def run(env, obs):
+        acts = act(np.stack([obs[a] for a in env.agents]))
+        return {a: acts[i] for i, a in enumerate(env.agents)}
+
+    return lambda _env: run
+
+
+def on_twin(act, scenario: str, twin, episodes: int, steps: int, seed: int) -> float:
     """Mean return per follower over `episodes` real-time episodes on the twin started here."""
-    returns = []
     with colcos.parallel_env(task="aggregation", scenario=scenario, plant="twin", twin_scenario=twin, max_cycles=steps) as env:
-        for k in range(episodes):
-            obs, _ = env.reset(seed=seed + k)
-            total = 0.0
-            while env.agents:
-                o = np.stack([obs[a] for a in env.agents])
-                acts = act(o)
-                obs, rew, _, _, _ = env.step({a: acts[i] for i, a in enumerate(env.agents)})
-                total += float(np.mean(list(rew.values()))) if rew else 0.0
-            returns.append(total)
-    return float(np.mean(returns))
+        return float(np.mean([twin_episode(env, stacked(act), seed + k) for k in range(episodes)]))
 
 
 def main() -> None:
