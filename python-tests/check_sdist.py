@@ -32,7 +32,7 @@ REQUIRED = [
     "env/scenarios/aggregation.toml",
     "sim/src/output/DejaVuSans-subset.ttf",
     "gpu/src/field.wgsl",
-    "gpu/src/screen.wgsl",
+    "gpu/src/screen/screen.wgsl",
 ]
 
 
