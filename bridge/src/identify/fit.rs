@@ -3,13 +3,11 @@
 //! linearly), then refined; uncertainties from the least-squares covariance (scales) and the
 //! curvature of the profile (latency, lag). A parameter the data cannot pin down is reported as
 //! unidentifiable with the reason, never as a number.
+use super::param::Param;
 use super::response::Response;
 use super::sensor::SensorFit;
 use super::windows::{Window, windows};
 use nalgebra::{Matrix2, Vector2};
-
-/// A fitted value with its uncertainty (one standard deviation), or why there is none.
-pub type Param<T> = Result<(T, T), String>;
 
 /// What one robot's fit found.
 #[derive(Clone, Debug)]

@@ -11,6 +11,7 @@
 pub mod excite;
 pub mod fit;
 pub mod overlay;
+pub mod param;
 pub mod readings;
 pub mod response;
 pub mod sensor;
@@ -18,7 +19,8 @@ pub mod series;
 pub mod windows;
 
 pub use excite::Excitation;
-pub use fit::{FitOptions, Param, RobotFit, fit_robot};
+pub use fit::{FitOptions, RobotFit, fit_robot};
+pub use param::Param;
 pub use sensor::{SensorFit, fit_sensor};
 pub use series::{RobotSeries, SeriesError, robot_series};
 

@@ -4,7 +4,7 @@
 //! the line (a pattern's edge the pose was wrong about, another robot's shadow) left out; the
 //! uncertainty treats each reading's twelve channels as one draw (their errors share its pose).
 //! Without enough contrast (a robot that saw one colour) the two cannot be told apart: unidentifiable.
-use super::fit::Param;
+use super::param::Param;
 use super::readings::Reading;
 
 /// Fewest steady readings and the least spread of predicted counts (sd, counts) a fit needs.
