@@ -11,6 +11,13 @@ use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+/// These tests time a real-time loop against a real-time twin: run side by side on a 2-core machine
+/// they starve each other's tracker streams ("tracker_silent"), so they take turns.
+fn one_rig_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+    static RIG: Mutex<()> = Mutex::new(());
+    RIG.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn scenario() -> Scenario {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/case2_alarm.toml");
     Scenario::from_file(path).unwrap()
@@ -127,6 +134,7 @@ fn wheel_speeds(p: &HostCommand) -> Option<(f32, f32)> {
 /// keeps its 20 ms.
 #[test]
 fn case_two_drives_the_twin_over_udp() {
+    let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
     let start_poses: Vec<_> = {
         let sc = scenario();
@@ -228,6 +236,7 @@ fn case_two_drives_the_twin_over_udp() {
 /// The same loop over a real pseudo-terminal, through the bridge's serial code.
 #[test]
 fn the_serial_link_drives_the_twin_over_a_pty() {
+    let _alone = one_rig_at_a_time();
     let channel = PtyChannel::open().unwrap();
     let url = format!("serial://{}?baud=115200", channel.peer_path());
     let rig = run_rig(Box::new(channel), url, 2.0, |_, _| {});
@@ -250,6 +259,7 @@ fn the_serial_link_drives_the_twin_over_a_pty() {
 /// limit plus 50 ms, measured on the twin's receipt times.
 #[test]
 fn tracker_silence_stops_every_robot_in_time() {
+    let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
     let silent_at = Arc::new(Mutex::new(None));
     let s = silent_at.clone();
@@ -295,6 +305,7 @@ fn tracker_silence_stops_every_robot_in_time() {
 /// clock an hour ahead: the bridge still takes every pose, drives every robot and sends no stop.
 #[test]
 fn stream_faults_do_not_stop_the_loop() {
+    let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
     let rig = run_rig(channel, url, 3.0, |faults, _| {
         let mut f = faults.lock().unwrap();
@@ -338,6 +349,7 @@ fn stream_faults_do_not_stop_the_loop() {
 /// limit plus 50 ms; the others keep driving.
 #[test]
 fn a_lost_robot_alone_is_stopped_in_time() {
+    let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
     let hidden_at = Arc::new(Mutex::new(None));
     let h = hidden_at.clone();
@@ -403,6 +415,7 @@ fn events_of(log: &[colcos_bridge::rig::recorder::Recorded]) -> Vec<String> {
 /// second of unanswered data requests, says so, and sends it nothing but stops from then on.
 #[test]
 fn a_robot_that_stops_answering_is_reported() {
+    let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
     let rig = run_rig(channel, url, 3.0, |_, robots| {
         std::thread::sleep(Duration::from_millis(1000));
@@ -421,6 +434,7 @@ fn a_robot_that_stops_answering_is_reported() {
 /// about a second after it was first asked.
 #[test]
 fn a_robot_that_never_answers_is_reported() {
+    let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
     // The last robot is asked last: deaf before the loop's first request reaches it.
     let rig = run_rig(channel, url, 2.5, |_, robots| {
