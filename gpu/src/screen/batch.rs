@@ -3,7 +3,7 @@
 //! them (`offset + centre`, the f32 sums of the CPU's `ColourSensor::sample_points`), composes the
 //! screen at the points from the grid fields and sums the levels. Sets of offsets are shared by every
 //! sensor with the same footprint (a scenario's sensors, unless randomised).
-use super::{GpuScreen, LayerRec, POINTS_PER_SENSOR, Uni, groups};
+use super::{GpuScreen, LayerRec, POINTS_PER_SENSOR, Uni, entry, groups};
 use crate::{GpuContext, GpuGrids, Result, check_size, storage};
 use colcos_sim::screen::ScreenSpec;
 use glam::Vec2;
@@ -212,12 +212,6 @@ impl GpuScreen {
                 .as_ref()
                 .is_none_or(|(_, g)| *g != footprints.generation)
             {
-                fn e(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-                    wgpu::BindGroupEntry {
-                        binding,
-                        resource: b.as_entire_binding(),
-                    }
-                }
                 let bind = self
                     .ctx
                     .device
@@ -225,14 +219,14 @@ impl GpuScreen {
                         label: Some("colcos batch sensing"),
                         layout: &self.layout,
                         entries: &[
-                            e(0, grids.values_buffer()),
-                            e(1, &batch.layers),
-                            e(2, &self.dummy),
-                            e(3, &batch.uniform),
-                            e(4, &batch.out),
-                            e(5, &batch.centres),
-                            e(6, &batch.sets),
-                            e(7, &footprints.buffer),
+                            entry(0, grids.values_buffer()),
+                            entry(1, &batch.layers),
+                            entry(2, &self.dummy),
+                            entry(3, &batch.uniform),
+                            entry(4, &batch.out),
+                            entry(5, &batch.centres),
+                            entry(6, &batch.sets),
+                            entry(7, &footprints.buffer),
                         ],
                     });
                 batch.bind = Some((bind, footprints.generation));

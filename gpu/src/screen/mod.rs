@@ -426,12 +426,6 @@ impl GpuScreen {
             .queue
             .write_buffer(&ub, 0, bytemuck::bytes_of(&uni));
         let vals = grids.map_or(&self.dummy, |g| g.values_buffer());
-        fn e(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: b.as_entire_binding(),
-            }
-        }
         let bind = self
             .ctx
             .device
@@ -439,14 +433,14 @@ impl GpuScreen {
                 label: Some("colcos screen bind group"),
                 layout: &self.layout,
                 entries: &[
-                    e(0, vals),
-                    e(1, &lb),
-                    e(2, &sb),
-                    e(3, &ub),
-                    e(4, out),
-                    e(5, &pb),
-                    e(6, &qb),
-                    e(7, &self.dummy),
+                    entry(0, vals),
+                    entry(1, &lb),
+                    entry(2, &sb),
+                    entry(3, &ub),
+                    entry(4, out),
+                    entry(5, &pb),
+                    entry(6, &qb),
+                    entry(7, &self.dummy),
                 ],
             });
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
@@ -533,5 +527,13 @@ impl GpuScreen {
             o.copy_from_slice(&i[..3]);
         }
         Ok(img)
+    }
+}
+
+/// A bind group entry for a whole buffer (the screen's and the batch's bind groups).
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
     }
 }
