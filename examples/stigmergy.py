@@ -1,10 +1,10 @@
 """Does laying pheromone help agents that learn? PPO on `colony`, `coverage` and `alarm`, with and without
 pheromone actions.
 
-For each task and seed the same PPO (parameter sharing, the actor and critic of
-`examples/train_aggregation.py`) trains twice with the same budget of agent-steps (a whole number of
-updates, so the machine's load changes only the wall time): once with its deposit outputs sent to the
-env ("with"), once with them forced to 0 before every step ("without": the ablation; the policy is the
+For each task and seed the same PPO (parameter sharing; the actor, critic and trainer of
+`examples/ppo.py`, 4 epochs x 4 minibatches) trains twice with the same budget of agent-steps (a whole
+number of updates, so the machine's load changes only the wall time): once with its deposit outputs
+sent to the env ("with"), once with them forced to 0 before every step ("without": the ablation; the policy is the
 same network, its deposit outputs simply never lay anything). Then learned-with, learned-without, the
 task's hand-written policy (`colcos.task_policies()`) and uniform random actions run on the same seeded
 evaluation episodes (every world's first episode after `reset(seed=--eval-seed)`); the learned-with
@@ -32,37 +32,26 @@ Needs torch. The rewards are the tasks' own (docs/tasks.md); nothing is added he
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import math
 import os
 import pathlib
+import sys
 import time
 import tomllib
 
+import colcos
 import numpy as np
 import torch
-import torch.nn as nn
-
-import colcos
 from colcos.baselines import Baseline, RandomPolicy
 from colcos.vector import VecEnv
+from torch import nn
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ppo
 
 TASKS = ("colony", "coverage", "alarm")
 MODES = ("with", "without")
-
-
-def _ppo_parts():
-    """`examples/train_aggregation.py` as a module: its ActorCritic, RunningNorm and critic_input."""
-    path = pathlib.Path(__file__).resolve().parent / "train_aggregation.py"
-    spec = importlib.util.spec_from_file_location("train_aggregation", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-PPO = _ppo_parts()
 
 
 def to_env(a: np.ndarray, lay: bool) -> np.ndarray:
@@ -90,94 +79,25 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
     """PPO on `task` for the budget's updates; the model and its log: the learning curve (per update:
     agent-steps, mean reward per agent-step of the rollout; per finished batch of training episodes:
     agent-steps, their mean return), the updates, agent-steps and wall time."""
-    torch.manual_seed(seed)
     env = VecEnv(task, num_envs=args.num_envs, seed=seed, max_cycles=episode_steps(task, args), num_threads=args.threads)
-    e, n, d = env.num_envs, env.num_agents, env.single_observation_space.shape[0]
-    w = env.single_action_space.shape[0]
-    c = d + env.state_space.shape[0] + n
-    b = e * n
-    model = PPO.ActorCritic(d, c, act_dim=w)
-    opt = torch.optim.Adam(model.parameters(), lr=args.lr, eps=1e-5)
-    gamma, lam, clip, epochs, minibatches = 0.98, 0.95, 0.2, 4, 4
-    T = args.horizon
-    bufs = {k: torch.zeros(T, b, *s) for k, s in (("obs", (d,)), ("cri", (c,)), ("act", (w,)))}
-    logp_buf, rew_buf, done_buf, valid_buf = (torch.zeros(T, b) for _ in range(4))
-    val_buf = torch.zeros(T + 1, b)
-    ret_norm, disc_ret = PPO.RunningNorm(1), np.zeros(b)
-    obs, infos = env.reset(seed=seed)
-    state = infos["state"]
-    prev_done = np.zeros(b, dtype=bool)
-    ep_return = np.zeros(b)
+    cfg = ppo.Config(horizon=args.horizon, epochs=4, minibatches=4, lr=args.lr)
+    trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
-    steps, updates, start = 0, updates_for(args, n), time.time()
+    updates, start = updates_for(args, env.num_agents), time.time()
     for update in range(updates):
-        rollout_reward, rollout_count = 0.0, 0
-        for t in range(T):
-            o = torch.from_numpy(obs.reshape(b, d).copy())
-            ci = PPO.critic_input(obs, state)
-            with torch.no_grad():
-                dist = model.dist(o)
-                a = dist.sample()
-                bufs["obs"][t], bufs["cri"][t], bufs["act"][t] = o, ci, a
-                logp_buf[t], val_buf[t] = dist.log_prob(a).sum(-1), model.value(ci)
-            obs, rew, term, trunc, infos = env.step(to_env(a.numpy().reshape(e, n, w), lay))
-            state = infos["state"]
-            r = rew.reshape(b).astype(np.float64)
-            done = (term | trunc).reshape(b)
-            # The step after a done one only resets the world: no transition of the policy's.
-            valid_buf[t] = torch.from_numpy((~prev_done).astype(np.float32))
-            disc_ret = disc_ret * gamma * (~prev_done) + r
-            ret_norm.update(torch.from_numpy(disc_ret[~prev_done].astype(np.float32))[:, None])
-            rew_buf[t] = torch.from_numpy(r.astype(np.float32))
-            done_buf[t] = torch.from_numpy(done.astype(np.float32))
-            rollout_reward += float(r[~prev_done].sum())
-            rollout_count += int((~prev_done).sum())
-            ep_return += r
-            if done.any():
-                episode_curve.append((steps + b, float(ep_return[done].mean())))
-                ep_return[done] = 0.0
-            prev_done = done.copy()
-            steps += b
-        rate_curve.append((steps, rollout_reward / max(1, rollout_count)))
-        with torch.no_grad():
-            val_buf[T] = model.value(PPO.critic_input(obs, state))
-        scale = float(torch.sqrt(ret_norm.var[0] + 1e-8))
-        adv, last = torch.zeros(T, b), torch.zeros(b)
-        for t in reversed(range(T)):
-            nonterminal = 1.0 - done_buf[t]
-            delta = rew_buf[t] / scale + gamma * val_buf[t + 1] * nonterminal - val_buf[t]
-            last = delta + gamma * lam * nonterminal * last
-            adv[t] = last
-        ret = adv + val_buf[:T]
-        keep = valid_buf.reshape(-1) > 0
-        fo, fc, fa = (x.reshape(T * b, -1)[keep] for x in (bufs["obs"], bufs["cri"], bufs["act"]))
-        fl, fadv, fret = (x.reshape(-1)[keep] for x in (logp_buf, adv, ret))
-        model.obs_norm.update(fo)
-        model.critic_norm.update(fc)
-        fadv = (fadv - fadv.mean()) / (fadv.std() + 1e-8)
-        m = fo.shape[0]
-        size = max(1, m // minibatches)
-        for _ in range(epochs):
-            perm = torch.randperm(m)
-            for k in range(0, m, size):
-                idx = perm[k : k + size]
-                dist = model.dist(fo[idx])
-                ratio = (dist.log_prob(fa[idx]).sum(-1) - fl[idx]).exp()
-                pg = -torch.min(ratio * fadv[idx], ratio.clamp(1 - clip, 1 + clip) * fadv[idx]).mean()
-                vloss = 0.5 * (model.value(fc[idx]) - fret[idx]).pow(2).mean()
-                opt.zero_grad()
-                (pg + 0.5 * vloss).backward()
-                nn.utils.clip_grad_norm_(model.parameters(), 0.5)
-                opt.step()
+        ended = len(trainer.finished)
+        rate_curve.append((trainer.agent_steps + cfg.horizon * trainer.b, trainer.iterate()))
+        if len(trainer.finished) > ended:
+            episode_curve.append((trainer.agent_steps, float(np.mean(trainer.finished[ended:]))))
         if args.verbose and (update + 1) % args.verbose == 0:
             print(f"  {task} {'with' if lay else 'without'} seed {seed}: update {update + 1}/{updates}, "
-                  f"{steps:,} agent-steps, reward/agent-step {rate_curve[-1][1]:.5f}, "
+                  f"{trainer.agent_steps:,} agent-steps, reward/agent-step {rate_curve[-1][1]:.5f}, "
                   f"last episodes {episode_curve[-1][1] if episode_curve else float('nan'):.2f}, "
                   f"{time.time() - start:.0f} s", flush=True)
-    log = {"updates": updates, "agent_steps": steps, "train_seconds": round(time.time() - start, 1),
+    log = {"updates": updates, "agent_steps": trainer.agent_steps, "train_seconds": round(time.time() - start, 1),
            "rate_curve": rate_curve, "episode_curve": episode_curve}
-    return model, log
+    return trainer.model, log
 
 
 def evaluate(task: str, act, args: argparse.Namespace) -> list[float]:
@@ -257,7 +177,7 @@ def twin(task: str, seed: int, args: argparse.Namespace) -> dict:
     probe = VecEnv(task, num_envs=1, max_cycles=episode_steps(task, args), num_threads=args.threads)
     d, w = probe.single_observation_space.shape[0], probe.single_action_space.shape[0]
     n = probe.num_agents
-    model = PPO.ActorCritic(d, d + probe.state_space.shape[0] + n, act_dim=w)
+    model = ppo.ActorCritic(d, d + probe.state_space.shape[0] + n, act_dim=w)
     model.load_state_dict(torch.load(folder / f"with_seed{seed}.pt"))
     out: dict = {"seed": seed, "episodes": args.twin_episodes, "episode_steps": args.twin_steps or episode_steps(task, args)}
     for plant in ("sim", "twin"):

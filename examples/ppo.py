@@ -1,0 +1,253 @@
+"""PPO with parameter sharing over colcos's batched `VecEnv`: the trainer the examples share.
+
+All agents of all worlds share one policy; each (world, agent) pair is one sample stream. The actor sees
+only the agent's own observation (running z-score); the critic, used only in training, also sees the
+global state (`infos["state"]`) and a one-hot agent id. One `Trainer.iterate()` collects a rollout of
+`horizon` steps of every stream and runs `epochs` x `minibatches` clipped-PPO steps on it; a budget is
+a whole number of those updates, so a loaded machine changes the time a run takes, not its result.
+
+Used by `train_aggregation.py` (the quick start), `stigmergy.py` and, through the former, `transfer.py`
+and `onboard_export.py`. Needs torch.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable
+
+import numpy as np
+import torch
+from colcos.vector import VecEnv
+from torch import nn
+
+
+LOG_2PI = float(np.log(2 * np.pi))
+
+
+class RunningNorm(nn.Module):
+    """Running mean / variance of the inputs (Chan et al. parallel update), applied as a z-score."""
+
+    def __init__(self, dim: int) -> None:
+        super().__init__()
+        self.register_buffer("mean", torch.zeros(dim))
+        self.register_buffer("var", torch.ones(dim))
+        self.register_buffer("count", torch.tensor(1e-4))
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return ((x - self.mean) / torch.sqrt(self.var + 1e-8)).clamp(-10, 10)
+
+    @torch.no_grad()
+    def update(self, x: torch.Tensor) -> None:
+        if x.shape[0] == 0:
+            return
+        m, v, n = x.mean(0), x.var(0, unbiased=False), x.shape[0]
+        delta, tot = m - self.mean, self.count + n
+        self.mean += delta * n / tot
+        self.var = (self.var * self.count + v * n + delta**2 * self.count * n / tot) / tot
+        self.count = tot
+
+
+def mlp(i: int, o: int, hidden: int) -> nn.Sequential:
+    return nn.Sequential(nn.Linear(i, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh(), nn.Linear(hidden, o))
+
+
+class ActorCritic(nn.Module):
+    """Gaussian actor on the agent's own observation; critic on observation + global state + agent id.
+
+    `pi`, `obs_norm` and `log_std` are what a robot runs (`onboard_export.py` reads them by name)."""
+
+    def __init__(self, obs_dim: int, critic_dim: int, act_dim: int = 2, hidden: int = 64) -> None:
+        super().__init__()
+        self.pi = mlp(obs_dim, act_dim, hidden)
+        self.v = mlp(critic_dim, 1, hidden)
+        self.log_std = nn.Parameter(torch.full((act_dim,), -0.5))
+        self.obs_norm = RunningNorm(obs_dim)
+        self.critic_norm = RunningNorm(critic_dim)
+        with torch.no_grad():  # small initial actions: the policy starts near "stand still", not saturated
+            self.pi[-1].weight.mul_(0.01)
+            self.pi[-1].bias.zero_()
+
+    def dist(self, obs: torch.Tensor) -> torch.distributions.Normal:
+        return torch.distributions.Normal(self.pi(self.obs_norm(obs)), self.log_std.exp())
+
+    def log_prob(self, obs: torch.Tensor, act: torch.Tensor) -> torch.Tensor:
+        """log pi(act | obs) summed over the action's entries: `dist(obs).log_prob(act).sum(-1)` in
+        fewer tensor operations (the update's hot path on small batches)."""
+        z = (act - self.pi(self.obs_norm(obs))) * torch.exp(-self.log_std)
+        return -0.5 * (z * z).sum(-1) - self.log_std.sum() - 0.5 * LOG_2PI * act.shape[-1]
+
+    def value(self, critic_in: torch.Tensor) -> torch.Tensor:
+        return self.v(self.critic_norm(critic_in)).squeeze(-1)
+
+    @torch.no_grad()
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        """Deterministic action (the mean, clipped to [-1, 1]) for observations of shape (..., obs_dim)."""
+        o = torch.from_numpy(np.array(obs, dtype=np.float32).reshape(-1, obs.shape[-1]))
+        a = self.pi(self.obs_norm(o)).clamp(-1, 1)
+        return a.numpy().reshape(*obs.shape[:-1], -1).astype(np.float32)
+
+
+def critic_input(obs: np.ndarray, state: np.ndarray) -> np.ndarray:
+    """(E, N, obs) and (E, S) -> (E * N, obs + S + N): own observation, global state, one-hot agent id."""
+    e, n, _ = obs.shape
+    s = np.broadcast_to(state[:, None, :], (e, n, state.shape[-1]))
+    ids = np.broadcast_to(np.eye(n, dtype=np.float32)[None], (e, n, n))
+    return np.concatenate([obs, s, ids], axis=-1, dtype=np.float32).reshape(e * n, -1)
+
+
+@dataclasses.dataclass
+class Config:
+    """PPO's settings; the defaults are the quick start's (see docs/python.md, "Training")."""
+
+    horizon: int = 64  # steps of every stream per rollout
+    epochs: int = 4
+    minibatches: int = 4
+    lr: float = 1e-3
+    gamma: float = 0.98
+    lam: float = 0.95
+    clip: float = 0.2
+    ent_coef: float = 0.0
+    hidden: int = 64
+    anneal: int = 0  # with N > 0, the learning rate falls linearly to 0 over N updates (the budget)
+
+
+def clip_wheels(a: np.ndarray) -> np.ndarray:
+    """A policy's raw Gaussian sample as the env's wheel commands, clipped to [-1, 1]."""
+    return np.clip(a, -1.0, 1.0).astype(np.float32)
+
+
+class Trainer:
+    """PPO on one `VecEnv`: `iterate()` is one rollout and one update; `model` is the policy.
+
+    `to_env` maps the policy's raw (E, N, act_dim) sample to the env's action (clipping, or forcing
+    some outputs to 0 for an ablation); the loss uses the raw sample."""
+
+    def __init__(self, env: VecEnv, cfg: Config, seed: int,
+                 to_env: Callable[[np.ndarray], np.ndarray] = clip_wheels) -> None:  # fmt: skip
+        torch.manual_seed(seed)
+        self.env, self.cfg, self.to_env = env, cfg, to_env
+        e, n, d = env.num_envs, env.num_agents, env.single_observation_space.shape[0]
+        self.e, self.n, self.d, self.b = e, n, d, e * n
+        self.w = env.single_action_space.shape[0]
+        self.c = d + env.state_space.shape[0] + n
+        self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden)
+        self.opt = torch.optim.Adam(self.model.parameters(), lr=cfg.lr, eps=1e-5)
+        # Rewards are divided by a running std of the discounted return, so that the critic's targets
+        # stay O(1) whatever the reward's scale.
+        self.ret_norm = RunningNorm(1)
+        self.disc_ret = np.zeros(self.b)
+        obs, infos = env.reset(seed=seed)
+        self.obs, self.state = obs, infos["state"]
+        self.prev_done = np.zeros(self.b, dtype=bool)
+        self.ep_return = np.zeros(self.b)
+        self.finished: list[float] = []  # returns of the training episodes, in the order they ended
+        self.updates = 0
+        self.agent_steps = 0
+        self.seconds = {"env": 0.0, "act": 0.0, "learn": 0.0}  # wall time of each phase
+        self.cpu_seconds = {"env": 0.0, "act": 0.0, "learn": 0.0}  # this process's CPU time of each
+
+    def iterate(self) -> float:
+        """One rollout and one PPO update; returns the rollout's mean reward per agent-step."""
+        cfg, e, n, d, b, T = self.cfg, self.e, self.n, self.d, self.b, self.cfg.horizon
+        obs_buf = np.zeros((T, b, d), np.float32)
+        cri_buf = np.zeros((T + 1, b, self.c), np.float32)
+        act_buf = torch.zeros(T, b, self.w)
+        logp_buf = torch.zeros(T, b)
+        rew_buf = np.zeros((T, b), np.float32)
+        done_buf = np.zeros((T, b), np.float32)
+        valid_buf = np.zeros((T, b), bool)
+        model = self.model
+        for t in range(T):
+            t0, c0 = time.perf_counter(), time.process_time()
+            obs_buf[t] = self.obs.reshape(b, d)
+            cri_buf[t] = critic_input(self.obs, self.state)
+            with torch.no_grad():
+                noise = torch.randn(b, self.w)
+                act_buf[t] = model.pi(model.obs_norm(torch.from_numpy(obs_buf[t]))) + noise * model.log_std.exp()
+                logp_buf[t] = -0.5 * (noise * noise).sum(-1) - model.log_std.sum() - 0.5 * LOG_2PI * self.w
+            action = self.to_env(act_buf[t].numpy().reshape(e, n, self.w))
+            t1, c1 = time.perf_counter(), time.process_time()
+            self.obs, rew, term, trunc, infos = self.env.step(action)
+            self.seconds["env"] += time.perf_counter() - t1
+            self.cpu_seconds["env"] += time.process_time() - c1
+            self.seconds["act"] += t1 - t0
+            self.cpu_seconds["act"] += c1 - c0
+            self.state = infos["state"]
+            r = rew.reshape(b).astype(np.float64)
+            done = (term | trunc).reshape(b)
+            # Next-step autoreset: the step after a done one only resets the world (actions ignored,
+            # reward 0); it is no transition of the policy's, so it is masked out of the loss.
+            valid_buf[t] = ~self.prev_done
+            self.disc_ret = self.disc_ret * cfg.gamma * (~self.prev_done) + r
+            self.ret_norm.update(torch.from_numpy(self.disc_ret[~self.prev_done].astype(np.float32))[:, None])
+            rew_buf[t], done_buf[t] = r, done
+            self.ep_return += r
+            if done.any():
+                self.finished.extend(self.ep_return[done].tolist())
+                self.ep_return[done] = 0.0
+            self.prev_done = done
+            self.agent_steps += b
+        t0, c0 = time.perf_counter(), time.process_time()
+        cri_buf[T] = critic_input(self.obs, self.state)
+        self._learn(obs_buf, cri_buf, act_buf, logp_buf, rew_buf, done_buf, valid_buf)
+        self.seconds["learn"] += time.perf_counter() - t0
+        self.cpu_seconds["learn"] += time.process_time() - c0
+        self.updates += 1
+        return float(rew_buf[valid_buf].mean()) if valid_buf.any() else 0.0
+
+    def _learn(self, obs_buf, cri_buf, act_buf, logp_buf, rew_buf, done_buf, valid_buf) -> None:
+        cfg, model, T, b = self.cfg, self.model, self.cfg.horizon, self.b
+        cri = torch.from_numpy(cri_buf)
+        with torch.no_grad():  # every value of the rollout in one batched forward pass
+            values = model.value(cri.reshape((T + 1) * b, -1)).reshape(T + 1, b).numpy()
+        scale = float(torch.sqrt(self.ret_norm.var[0] + 1e-8))
+        adv = np.zeros((T, b), np.float32)
+        last = np.zeros(b, np.float32)
+        for t in reversed(range(T)):
+            nonterminal = 1.0 - done_buf[t]
+            delta = rew_buf[t] / scale + cfg.gamma * values[t + 1] * nonterminal - values[t]
+            last = delta + cfg.gamma * cfg.lam * nonterminal * last
+            adv[t] = last
+        ret = adv + values[:T]
+        keep = torch.from_numpy(valid_buf.reshape(-1))
+        fo = torch.from_numpy(obs_buf.reshape(T * b, -1))[keep]
+        fc = cri[:T].reshape(T * b, -1)[keep]
+        fa, fl = act_buf.reshape(T * b, -1)[keep], logp_buf.reshape(-1)[keep]
+        fadv = torch.from_numpy(adv.reshape(-1))[keep]
+        fret = torch.from_numpy(ret.reshape(-1))[keep]
+        model.obs_norm.update(fo)
+        model.critic_norm.update(fc)
+        fadv = (fadv - fadv.mean()) / (fadv.std() + 1e-8)
+        m = fo.shape[0]
+        size = max(1, -(-m // cfg.minibatches))
+        if cfg.anneal:
+            for group in self.opt.param_groups:
+                group["lr"] = cfg.lr * max(0.0, 1.0 - self.updates / cfg.anneal)
+        for _ in range(cfg.epochs):
+            perm = torch.randperm(m)
+            for k in range(0, m, size):
+                idx = perm[k : k + size]
+                ratio = (model.log_prob(fo[idx], fa[idx]) - fl[idx]).exp()
+                pg = -torch.min(ratio * fadv[idx], ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * fadv[idx]).mean()
+                vloss = 0.5 * (model.value(fc[idx]) - fret[idx]).pow(2).mean()
+                # The Gaussian's entropy is sum(log_std) + const: the same for every sample.
+                loss = pg + 0.5 * vloss - cfg.ent_coef * model.log_std.sum()
+                self.opt.zero_grad()
+                loss.backward()
+                nn.utils.clip_grad_norm_(model.parameters(), 0.5)
+                self.opt.step()
+
+
+def evaluate(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict, worlds: int,
+             steps: int, seed: int) -> float:  # fmt: skip
+    """Mean undiscounted return per agent over `worlds` seeded episodes of `steps` steps; `policy(env)`
+    gives the function from observations to actions (a `Baseline` needs the env it acts in)."""
+    v = VecEnv(num_envs=worlds, max_cycles=steps, **env_kwargs)
+    act = policy(v)
+    obs, _ = v.reset(seed=seed)
+    total = np.zeros((worlds, v.num_agents))
+    for _ in range(steps):
+        obs, rew, _, _, _ = v.step(act(obs))
+        total += rew
+    return float(total.mean())

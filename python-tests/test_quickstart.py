@@ -1,0 +1,77 @@
+"""`examples/train_aggregation.py` (the quick start) end to end on a tiny budget, and the shared PPO of
+`examples/ppo.py`: its log-probability against torch's Normal, and its update budget."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+
+
+def load_ppo():
+    spec = importlib.util.spec_from_file_location("ppo", REPO / "examples" / "ppo.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["ppo"] = module  # its dataclass looks its module up while the class is made
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_log_prob_is_the_gaussian_log_density():
+    torch = pytest.importorskip("torch")
+    ppo = load_ppo()
+    torch.manual_seed(3)
+    model = ppo.ActorCritic(17, 20, act_dim=3)
+    with torch.no_grad():
+        model.log_std.copy_(torch.tensor([-0.3, 0.2, -1.0]))
+        model.pi[-1].weight.normal_()
+    obs, act = torch.randn(50, 17), torch.randn(50, 3)
+    want = model.dist(obs).log_prob(act).sum(-1)
+    assert torch.allclose(model.log_prob(obs, act), want, atol=1e-5)
+
+
+def test_trainer_counts_updates_and_samples():
+    pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=20, num_threads=1)
+    trainer = ppo.Trainer(env, ppo.Config(horizon=8, epochs=1, minibatches=2), seed=0)
+    before = [p.detach().clone() for p in trainer.model.pi.parameters()]
+    for _ in range(3):
+        trainer.iterate()
+    assert trainer.updates == 3
+    assert trainer.agent_steps == 3 * 8 * 2 * env.num_agents
+    assert trainer.finished, "episodes of 20 steps end within 24 steps"
+    assert any(not np.array_equal(a.numpy(), p.detach().numpy()) for a, p in zip(before, trainer.model.pi.parameters()))
+
+
+def test_quickstart_runs_and_reports(tmp_path):
+    pytest.importorskip("torch")
+    args = ["--updates", "4", "--eval-every", "2", "--seeds", "0", "1", "--num-envs", "2", "--horizon", "8",
+            "--episode", "20", "--eval-worlds", "2", "--threads", "1", "--out", str(tmp_path)]
+    out = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), *args],
+                         capture_output=True, text=True, timeout=600, check=True).stdout
+    assert "| median |" in out
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert [r["seed"] for r in result["runs"]] == [0, 1]
+    for run in result["runs"]:
+        assert run["updates"] == 4
+        assert [c[1] for c in run["curve"]] == [0, 2, 4]  # evaluated before training and every 2 updates
+        assert (tmp_path / f"seed{run['seed']}" / "policy.pt").exists()
+    assert (tmp_path / "policy.pt").exists()
+    assert set(result["references"]) == {"paper_follower", "random", "standing_still"}
+
+
+def test_quickstart_refuses_a_bad_param(tmp_path):
+    pytest.importorskip("torch")
+    res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), "--param", "progress_weight",
+                          "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2
+    assert "--param 'progress_weight': expected KEY=VALUE" in res.stderr
