@@ -5,6 +5,7 @@
 //! simulated worlds or a plant's arena (a twin, the rig), so a hand-written behaviour is evaluated
 //! where a learned policy is.
 use crate::encoding::command_to_action;
+use crate::episode::Episode;
 use crate::error::{EnvError, Result};
 use crate::outputs::Outputs;
 use crate::policy::{self, AgentPolicy};
@@ -23,10 +24,8 @@ pub trait Arenas {
     fn scenario(&self) -> &colcos_sim::scenario::Scenario;
     /// Arena `w` (`w < spec().num_envs`).
     fn arena(&self, w: usize) -> &dyn ArenaView;
-    /// Number of arena `w`'s current episode.
-    fn episode(&self, w: usize) -> u64;
-    /// Steps taken in arena `w`'s current episode.
-    fn episode_steps(&self, w: usize) -> u64;
+    /// Arena `w`'s current episode (its number and steps taken).
+    fn episode(&self, w: usize) -> &Episode;
     fn outputs(&self) -> &Outputs;
     /// Entries of an agent's continuous action (the wheels and the deposit actions).
     fn action_width(&self) -> usize;
@@ -96,9 +95,10 @@ impl BaselinePolicy {
         let (e, n) = (env.spec().num_envs, env.spec().num_agents);
         for w in 0..e {
             for i in 0..n {
-                policy.slots.push(policy.make(w, i, env.episode(w))?);
+                policy.slots.push(policy.make(w, i, env.episode(w).index)?);
             }
-            policy.seen.push((env.episode(w), env.episode_steps(w)));
+            let ep = env.episode(w);
+            policy.seen.push((ep.index, ep.steps));
         }
         Ok(policy)
     }
@@ -137,7 +137,8 @@ impl BaselinePolicy {
         let d = spec.observation.flat_len();
         let obs = env.outputs().obs();
         for w in 0..e {
-            let now = (env.episode(w), env.episode_steps(w));
+            let ep = env.episode(w);
+            let now = (ep.index, ep.steps);
             if now.0 != self.seen[w].0 || now.1 < self.seen[w].1 {
                 for i in 0..n {
                     self.slots[w * n + i] = self.make(w, i, now.0)?;

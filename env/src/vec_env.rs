@@ -481,11 +481,8 @@ impl crate::baseline::Arenas for VecEnv {
     fn arena(&self, w: usize) -> &dyn colcos_sim::world::ArenaView {
         &self.slots[w].world
     }
-    fn episode(&self, w: usize) -> u64 {
-        self.slots[w].episode.index
-    }
-    fn episode_steps(&self, w: usize) -> u64 {
-        self.slots[w].episode.steps
+    fn episode(&self, w: usize) -> &crate::Episode {
+        &self.slots[w].episode
     }
     fn outputs(&self) -> &Outputs {
         &self.out

@@ -476,11 +476,8 @@ impl colcos_env::baseline::Arenas for LiveEnv {
     fn arena(&self, _w: usize) -> &dyn colcos_sim::world::ArenaView {
         self.driver.host()
     }
-    fn episode(&self, _w: usize) -> u64 {
-        self.episode.index
-    }
-    fn episode_steps(&self, _w: usize) -> u64 {
-        self.episode.steps
+    fn episode(&self, _w: usize) -> &Episode {
+        &self.episode
     }
     fn outputs(&self) -> &Outputs {
         &self.out
