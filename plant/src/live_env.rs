@@ -467,23 +467,14 @@ impl LiveEnv {
 
 /// A plant's arena as the one arena a policy reads (a hand-written baseline on the twin or the rig).
 impl colcos_env::baseline::Arenas for LiveEnv {
-    fn spec(&self) -> &EnvSpec {
-        &self.spec
-    }
-    fn scenario(&self) -> &Scenario {
-        &self.scenario
+    fn made(&self) -> colcos_env::baseline::Made<'_> {
+        (&self.spec, &self.scenario, &self.out, &self.decoder)
     }
     fn arena(&self, _w: usize) -> &dyn colcos_sim::world::ArenaView {
         self.driver.host()
     }
     fn episode(&self, _w: usize) -> &Episode {
         &self.episode
-    }
-    fn outputs(&self) -> &Outputs {
-        &self.out
-    }
-    fn action_width(&self) -> usize {
-        self.decoder.width()
     }
 }
 
