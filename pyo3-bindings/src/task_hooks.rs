@@ -178,43 +178,60 @@ fn plant_view(env: &LiveEnv) -> View {
     v
 }
 
+/// What stays fixed of a batch or plant, handed to Python as a dict of these keys.
+#[derive(IntoPyObject)]
+struct TaskInfo {
+    /// (w, h) m.
+    arena: (f32, f32),
+    /// Per robot.
+    roles: Vec<String>,
+    /// The pheromones' names and their screen colours (r, g, b levels per unit).
+    pheromones: Vec<String>,
+    colours: Vec<[f32; 3]>,
+    /// m/s.
+    max_wheel_speed: f32,
+    /// m.
+    wheel_base: f32,
+    /// s.
+    dt: f32,
+}
+
+impl TaskInfo {
+    fn new(sc: &Scenario, view: Option<&dyn ArenaView>) -> Self {
+        let a = sc.arena_size();
+        let p = &sc.spec.robot;
+        TaskInfo {
+            arena: (a.x, a.y),
+            roles: (0..sc.robot_count())
+                .map(|i| view.map_or(String::new(), |w| w.role(i).to_string()))
+                .collect(),
+            pheromones: sc.spec.pheromones.iter().map(|p| p.name.clone()).collect(),
+            colours: sc.spec.pheromones.iter().map(|p| p.colour).collect(),
+            max_wheel_speed: p.max_wheel_speed,
+            wheel_base: p.wheel_base,
+            dt: sc.spec.dt,
+        }
+    }
+}
+
 /// What stays fixed: `arena` (w, h) m, `roles` [R], `pheromones` [F] names and their screen
 /// `colours` [F] (r, g, b levels per unit), `max_wheel_speed` and
 /// `wheel_base` m/s and m, `dt` s.
 #[pyfunction]
 fn task_info<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
-        let info = |sc: &Scenario, view: Option<&dyn ArenaView>| {
-            let roles: Vec<String> = (0..sc.robot_count())
-                .map(|i| view.map_or(String::new(), |w| w.role(i).to_string()))
-                .collect();
-            let names: Vec<String> = sc.spec.pheromones.iter().map(|p| p.name.clone()).collect();
-            let colours: Vec<[f32; 3]> = sc.spec.pheromones.iter().map(|p| p.colour).collect();
-            let a = sc.arena_size();
-            let p = &sc.spec.robot;
-            let (speed, base, dt) = (p.max_wheel_speed, p.wheel_base, sc.spec.dt);
-            ((a.x, a.y), roles, names, colours, speed, base, dt)
-        };
-        let (arena, roles, names, colours, speed, base, dt) = match core_of(env)? {
+        let info = match core_of(env)? {
             Core::Batch(env) => py.detach(|| {
                 let g = env.lock();
                 let world = g.env.world(0).map(|w| w as &dyn ArenaView);
-                info(g.env.scenario(), world)
+                TaskInfo::new(g.env.scenario(), world)
             }),
             Core::Plant(p) => py.detach(|| {
                 let g = p.lock();
-                info(g.scenario(), Some(g.host()))
+                TaskInfo::new(g.scenario(), Some(g.host()))
             }),
         };
-        let d = PyDict::new(py);
-        d.set_item("arena", arena)?;
-        d.set_item("roles", roles)?;
-        d.set_item("pheromones", names)?;
-        d.set_item("colours", colours)?;
-        d.set_item("max_wheel_speed", speed)?;
-        d.set_item("wheel_base", base)?;
-        d.set_item("dt", dt)?;
-        Ok(d)
+        info.into_pyobject(py)
     })
 }
 
