@@ -202,7 +202,7 @@ impl LiveEnv {
         let calibration = RigCalibration::load(scenario)
             .map_err(|e| PlantError::option("rig.screen_calibration", e.to_string()))?;
         if plant.kind == PlantKind::Rig {
-            calibration_gate::check(&calibration, plant)?;
+            calibration_gate::check(&calibration, &plant.calibration)?;
         }
         let opts = SourceOptions::new(calibration.frame_transform(scenario));
         let source = open_pose_source(&tracker, &opts)?;
