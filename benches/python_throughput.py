@@ -53,6 +53,7 @@ def python_aggregation() -> object:
     import importlib.util
 
     path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples", "tasks", "aggregation.py")
+    sys.path.insert(0, os.path.dirname(path))  # for the examples' shared `_common`
     spec = importlib.util.spec_from_file_location("bench_aggregation", path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

@@ -35,6 +35,7 @@ CHOSEN = 'deposit_actions = [{ pheromone = "red", kernel = { shape = "disc", rad
 
 
 def _example(name: str, cls: str) -> colcos.Task:
+    sys.path.insert(0, str(ROOT / "examples" / "tasks"))  # for their shared `_common`
     spec = importlib.util.spec_from_file_location(f"bench_{name}", ROOT / "examples" / "tasks" / f"{name}.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

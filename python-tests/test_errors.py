@@ -41,34 +41,30 @@ def test_scenario_without_the_task_roles():
         colcos.parallel_env(task="aggregation", scenario=text)
 
 
-def test_unknown_agent():
-    env = colcos.parallel_env()
-    env.reset(seed=0)
-    with pytest.raises(colcos.ActionError, match="unknown agent 'robot_99'"):
-        env.step({"robot_99": np.zeros(2, np.float32)})
-
-
-def test_nan_action_names_agent():
-    env = colcos.parallel_env()
-    env.reset(seed=0)
-    acts = {a: np.zeros(2, np.float32) for a in env.agents}
+def _nan_for_robot_1(agents: list[str]) -> dict[str, np.ndarray]:
+    acts = {a: np.zeros(2, np.float32) for a in agents}
     acts["robot_1"] = np.array([np.nan, 0.0], np.float32)
-    with pytest.raises(colcos.ActionError, match="robot_1.*finite"):
-        env.step(acts)
+    return acts
 
 
-def test_wrong_action_shape():
-    env = colcos.parallel_env()
+@pytest.mark.parametrize(
+    ("continuous", "actions", "match"),
+    [
+        # An agent that does not exist.
+        (True, lambda agents: {"robot_99": np.zeros(2, np.float32)}, "unknown agent 'robot_99'"),
+        # A non-finite action names its agent.
+        (True, _nan_for_robot_1, "robot_1.*finite"),
+        # The wrong shape.
+        (True, lambda agents: {"robot_0": np.zeros(3, np.float32)}, "robot_0"),
+        # A discrete action out of range.
+        (False, lambda agents: {"robot_0": 17}, "robot_0 is 17"),
+    ],
+)
+def test_bad_actions_name_the_agent(continuous, actions, match):
+    env = colcos.parallel_env(continuous=continuous)
     env.reset(seed=0)
-    with pytest.raises(colcos.ActionError, match="robot_0"):
-        env.step({"robot_0": np.zeros(3, np.float32)})
-
-
-def test_discrete_out_of_range():
-    env = colcos.parallel_env(continuous=False)
-    env.reset(seed=0)
-    with pytest.raises(colcos.ActionError, match="robot_0 is 17"):
-        env.step({"robot_0": 17})
+    with pytest.raises(colcos.ActionError, match=match):
+        env.step(actions(env.agents))
 
 
 def test_step_before_reset():

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib.util
 import pathlib
+import sys
 
 import numpy as np
 import pytest
@@ -16,6 +17,9 @@ EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples" / "tasks"
 
 
 def _load(name: str):
+    # The re-writes import their shared `_common` as a script next to them does.
+    if str(EXAMPLES) not in sys.path:
+        sys.path.insert(0, str(EXAMPLES))
     spec = importlib.util.spec_from_file_location(f"colcos_example_{name}", EXAMPLES / f"{name}.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

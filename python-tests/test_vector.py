@@ -24,10 +24,15 @@ def test_views_are_zero_copy():
     assert v.state is not None and v.state.shape == (3, 4 * 5 + 1)
 
 
-def test_next_step_autoreset():
-    v = VecEnv("aggregation", num_envs=2, max_cycles=5)
+def _still(num_envs: int, max_cycles: int, autoreset_mode: str = "next_step") -> tuple[VecEnv, np.ndarray]:
+    """A batch of `aggregation` reset with seed 0, and still wheels for its 3 agents."""
+    v = VecEnv("aggregation", num_envs=num_envs, max_cycles=max_cycles, autoreset_mode=autoreset_mode)
     v.reset(seed=0)
-    a = np.zeros((2, 3, 2), np.float32)
+    return v, np.zeros((num_envs, 3, 2), np.float32)
+
+
+def test_next_step_autoreset():
+    v, a = _still(2, 5)
     for _ in range(4):
         _, _, _, trunc, _ = v.step(a)
         assert not trunc.any()
@@ -39,9 +44,7 @@ def test_next_step_autoreset():
 
 
 def test_same_step_autoreset():
-    v = VecEnv("aggregation", num_envs=2, max_cycles=3, autoreset_mode="same_step")
-    v.reset(seed=0)
-    a = np.zeros((2, 3, 2), np.float32)
+    v, a = _still(2, 3, "same_step")
     v.step(a)
     v.step(a)
     obs, _, _, trunc, infos = v.step(a)
@@ -51,9 +54,7 @@ def test_same_step_autoreset():
 
 
 def test_disabled_autoreset_and_partial_reset():
-    v = VecEnv("aggregation", num_envs=3, max_cycles=2, autoreset_mode="disabled")
-    v.reset(seed=0)
-    a = np.zeros((3, 3, 2), np.float32)
+    v, a = _still(3, 2, "disabled")
     v.step(a)
     v.step(a)
     with pytest.raises(colcos.StateError, match="world 0"):

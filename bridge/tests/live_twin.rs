@@ -122,6 +122,18 @@ fn run_rig(
     }
 }
 
+/// A 3 s run over UDP whose tracker takes `fault` 1.5 s in, and the moment it did.
+fn run_with_tracker_fault(fault: impl FnOnce(&mut TrackerFaults)) -> (Rig, Instant) {
+    let (channel, url) = udp_channel();
+    let mut at = None;
+    let rig = run_rig(channel, url, 3.0, |faults, _| {
+        std::thread::sleep(Duration::from_millis(1500));
+        fault(&mut faults.lock().unwrap());
+        at = Some(Instant::now());
+    });
+    (rig, at.expect("the fault was set"))
+}
+
 fn wheel_speeds(p: &HostCommand) -> Option<(f32, f32)> {
     match p {
         HostCommand::WheelSpeeds { left, right } => Some((*left, *right)),
@@ -260,16 +272,8 @@ fn the_serial_link_drives_the_twin_over_a_pty() {
 #[test]
 fn tracker_silence_stops_every_robot_in_time() {
     let _alone = one_rig_at_a_time();
-    let (channel, url) = udp_channel();
-    let silent_at = Arc::new(Mutex::new(None));
-    let s = silent_at.clone();
-    let rig = run_rig(channel, url, 3.0, move |faults, _| {
-        std::thread::sleep(Duration::from_millis(1500));
-        faults.lock().unwrap().silent = true;
-        *s.lock().unwrap() = Some(Instant::now());
-    });
+    let (rig, silent_at) = run_with_tracker_fault(|f| f.silent = true);
     let twin = rig.twin.join();
-    let silent_at = silent_at.lock().unwrap().unwrap();
     let stop = twin
         .received()
         .iter()
@@ -350,16 +354,8 @@ fn stream_faults_do_not_stop_the_loop() {
 #[test]
 fn a_lost_robot_alone_is_stopped_in_time() {
     let _alone = one_rig_at_a_time();
-    let (channel, url) = udp_channel();
-    let hidden_at = Arc::new(Mutex::new(None));
-    let h = hidden_at.clone();
-    let rig = run_rig(channel, url, 3.0, move |faults, _| {
-        std::thread::sleep(Duration::from_millis(1500));
-        faults.lock().unwrap().hidden = vec![2];
-        *h.lock().unwrap() = Some(Instant::now());
-    });
+    let (rig, hidden_at) = run_with_tracker_fault(|f| f.hidden = vec![2]);
     let twin = rig.twin.join();
-    let hidden_at = hidden_at.lock().unwrap().unwrap();
     // Tracker ID 2 is the third robot, radio address 3.
     let stop = twin
         .received()

@@ -2,7 +2,9 @@
 //! written by scripts/onboard_fixture.py: both wheels at half the largest wheel speed, the left one
 //! slowed by the front-left bumper) and runs it on each robot's own readings; the bridge uploads the
 //! parameters, starts the policy and sends no wheel commands.
-use colcos_bridge::onboard::{OnboardFirmware, OnboardManifest, RUNTIME_LEN, robot_params};
+use colcos_bridge::onboard::{
+    OnboardFirmware, OnboardManifest, RUNTIME_LEN, RawReadings, robot_params,
+};
 use colcos_bridge::protocol::colias::colour_from_sim;
 use colcos_bridge::protocol::colias::{
     CommandPacket, FrameDecoder, HostCommand, PolicyMode, TELEMETRY_LEN, Telemetry,
@@ -400,7 +402,12 @@ fn a_robots_calibration_on_board_recovers_the_screen() {
                     (&own, &mut worst_own),
                     (&m.runtime_defaults, &mut worst_nominal),
                 ] {
-                    let obs = fw.encode(params, &colour, &[100; 3], &[100; 3], (0.0, 0.0));
+                    let raw = RawReadings {
+                        colour,
+                        ir_on: [100; 3],
+                        ir_off: [100; 3],
+                    };
+                    let obs = fw.encode(params, &raw, (0.0, 0.0));
                     for s in 0..4 {
                         for c in 0..3 {
                             let err = (obs[3 * s + c] as f64 - levels[c] / 255.0).abs();

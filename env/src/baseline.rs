@@ -4,7 +4,9 @@
 //! deposit rates included, from the agent's observation row. It drives any [`Arenas`]: the batch's
 //! simulated worlds or a plant's arena (a twin, the rig), so a hand-written behaviour is evaluated
 //! where a learned policy is.
+use crate::actions::ActionDecoder;
 use crate::encoding::command_to_action;
+use crate::episode::Episode;
 use crate::error::{EnvError, Result};
 use crate::outputs::Outputs;
 use crate::policy::{self, AgentPolicy};
@@ -12,25 +14,38 @@ use crate::spaces::EnvSpec;
 use colcos_sim::behaviour::{Behaviour, registry};
 use colcos_sim::rng::{self, SimRng, Stream};
 use colcos_sim::robot::ColiasParams;
+use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
 
 /// What a policy reads of an environment of a task: its spec, each arena's raw readings and episode
 /// counters, and the agents' observation rows. The batch ([`crate::VecEnv`]) and the plants'
 /// arena implement it.
 pub trait Arenas {
-    fn spec(&self) -> &EnvSpec;
-    /// The scenario the arenas were made from (its `[robot]` builds the behaviours).
-    fn scenario(&self) -> &colcos_sim::scenario::Scenario;
+    /// What the arenas were made with, fixed for their lifetime.
+    fn made(&self) -> Made<'_>;
     /// Arena `w` (`w < spec().num_envs`).
     fn arena(&self, w: usize) -> &dyn ArenaView;
-    /// Number of arena `w`'s current episode.
-    fn episode(&self, w: usize) -> u64;
-    /// Steps taken in arena `w`'s current episode.
-    fn episode_steps(&self, w: usize) -> u64;
-    fn outputs(&self) -> &Outputs;
+    /// Arena `w`'s current episode (its number and steps taken).
+    fn episode(&self, w: usize) -> &Episode;
+
+    fn spec(&self) -> &EnvSpec {
+        self.made().0
+    }
+    /// The scenario the arenas were made from (its `[robot]` builds the behaviours).
+    fn scenario(&self) -> &Scenario {
+        self.made().1
+    }
+    fn outputs(&self) -> &Outputs {
+        self.made().2
+    }
     /// Entries of an agent's continuous action (the wheels and the deposit actions).
-    fn action_width(&self) -> usize;
+    fn action_width(&self) -> usize {
+        self.made().3.width()
+    }
 }
+
+/// The spec, scenario, output buffers and action decoder of an [`Arenas`].
+pub type Made<'a> = (&'a EnvSpec, &'a Scenario, &'a Outputs, &'a ActionDecoder);
 
 /// One agent's controller.
 enum Controller {
@@ -96,9 +111,10 @@ impl BaselinePolicy {
         let (e, n) = (env.spec().num_envs, env.spec().num_agents);
         for w in 0..e {
             for i in 0..n {
-                policy.slots.push(policy.make(w, i, env.episode(w))?);
+                policy.slots.push(policy.make(w, i, env.episode(w).index)?);
             }
-            policy.seen.push((env.episode(w), env.episode_steps(w)));
+            let ep = env.episode(w);
+            policy.seen.push((ep.index, ep.steps));
         }
         Ok(policy)
     }
@@ -137,7 +153,8 @@ impl BaselinePolicy {
         let d = spec.observation.flat_len();
         let obs = env.outputs().obs();
         for w in 0..e {
-            let now = (env.episode(w), env.episode_steps(w));
+            let ep = env.episode(w);
+            let now = (ep.index, ep.steps);
             if now.0 != self.seen[w].0 || now.1 < self.seen[w].1 {
                 for i in 0..n {
                     self.slots[w * n + i] = self.make(w, i, now.0)?;

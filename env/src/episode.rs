@@ -1,7 +1,7 @@
 //! One episode's bookkeeping, shared by every environment of a task (each world of the batch, the
 //! plants' arena): how many steps it has taken, which agents have terminated, and how a step ends.
 //! "What happens when an agent terminates" is written here once.
-use crate::task::{Task, TaskState};
+use crate::task::{Outcome, Task, TaskState};
 use colcos_sim::world::ArenaView;
 
 /// The per-agent outputs a step ends with.
@@ -80,7 +80,13 @@ impl Episode {
         out: AgentOut,
     ) -> bool {
         let mut state = self.state.take().unwrap_or_else(|| task.initial_state());
-        let evaluate = |r: &mut [f32], t: &mut [bool]| task.evaluate(world, &mut state, r, t);
+        let evaluate = |rewards: &mut [f32], terminated: &mut [bool]| {
+            let out = Outcome {
+                rewards,
+                terminated,
+            };
+            task.evaluate(world, &mut state, out)
+        };
         let done = self.finish_with(evaluate, max_cycles, end, out);
         self.state = Some(state);
         done

@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::gpu_stage::GpuStage;
 use crate::outputs::OutSlices;
 use crate::world_slot::WorldSlot;
-use crate::world_step::{Begun, Ctx, Evaluation, after_motion, begin_world, finish_motion};
+use crate::world_step::{Begun, Ctx, Evaluation, begin_world, conclude_world, finish_motion};
 use colcos_sim::behaviour::WheelCommand;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -87,7 +87,7 @@ pub(crate) fn step_batch_gpu(
                 slot.world.sense_from_sums(stage.sums_of(w));
                 let mut out = buffers.world(i);
                 let in_host = host.as_deref_mut().map(|h| (h, i));
-                let done = after_motion(ctx, w, slot, &mut out, in_host);
+                let done = conclude_world(ctx, w, slot, &mut out, in_host);
                 if result.is_ok() {
                     result = done;
                 }

@@ -472,25 +472,13 @@ impl VecEnv {
 }
 
 impl crate::baseline::Arenas for VecEnv {
-    fn spec(&self) -> &EnvSpec {
-        &self.spec
-    }
-    fn scenario(&self) -> &Scenario {
-        &self.scenario
+    fn made(&self) -> crate::baseline::Made<'_> {
+        (&self.spec, &self.scenario, &self.out, &self.decoder)
     }
     fn arena(&self, w: usize) -> &dyn colcos_sim::world::ArenaView {
         &self.slots[w].world
     }
-    fn episode(&self, w: usize) -> u64 {
-        self.slots[w].episode.index
-    }
-    fn episode_steps(&self, w: usize) -> u64 {
-        self.slots[w].episode.steps
-    }
-    fn outputs(&self) -> &Outputs {
-        &self.out
-    }
-    fn action_width(&self) -> usize {
-        self.decoder.width()
+    fn episode(&self, w: usize) -> &crate::Episode {
+        &self.slots[w].episode
     }
 }

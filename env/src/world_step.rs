@@ -139,7 +139,7 @@ pub(crate) fn finish_world(
     if !finish_motion(slot, begun, host.as_mut().map(|(h, _)| &mut **h)) {
         return Ok(());
     }
-    after_motion(ctx, w, slot, out, host)
+    conclude_world(ctx, w, slot, out, host)
 }
 
 /// A world's motion finished after its host's step (nothing to do for a world that stepped alone);
@@ -157,24 +157,9 @@ pub(crate) fn finish_motion(
     true
 }
 
-/// The rest of a world's step once it has moved and sensed: rewards and outputs now, or later for a
-/// task written in Python.
-pub(crate) fn after_motion(
-    ctx: &Ctx,
-    w: usize,
-    slot: &mut WorldSlot,
-    out: &mut OutSlices,
-    host: Option<(&mut RapierHost, usize)>,
-) -> Result<()> {
-    if let Evaluation::Deferred = ctx.evaluation {
-        slot.awaiting = true;
-        return Ok(());
-    }
-    conclude_world(ctx, w, slot, out, host)
-}
-
-/// The end of a world's step once it has moved: rewards, ends of episodes, outputs, and a
-/// same-step autoreset.
+/// The end of a world's step once it has moved and sensed: rewards, ends of episodes, outputs, and a
+/// same-step autoreset; or, where the evaluation is deferred (a task written in Python), nothing
+/// until it is given.
 pub(crate) fn conclude_world(
     ctx: &Ctx,
     w: usize,
@@ -182,7 +167,10 @@ pub(crate) fn conclude_world(
     out: &mut OutSlices,
     host: Option<(&mut RapierHost, usize)>,
 ) -> Result<()> {
-    slot.awaiting = false;
+    slot.awaiting = matches!(ctx.evaluation, Evaluation::Deferred);
+    if slot.awaiting {
+        return Ok(());
+    }
     let max_cycles = ctx.writer.max_cycles;
     let agent_out = out.agent_out();
     let done = match ctx.evaluation {

@@ -38,6 +38,25 @@ fn gpu_env(c: &EnvConfig) -> Option<VecEnv> {
     }
 }
 
+/// The batch `c` on the GPU and the same batch on the CPU, or `None` (skipping) as [`gpu_env`].
+fn gpu_and_cpu(mut c: EnvConfig) -> Option<(VecEnv, VecEnv)> {
+    c.backend = Some(BackendChoice::Gpu);
+    let gpu = gpu_env(&c)?;
+    c.backend = Some(BackendChoice::Cpu);
+    Some((gpu, VecEnv::new(&c).unwrap()))
+}
+
+/// The largest difference between two grids' values, relative to the CPU grid `c`'s largest.
+fn relative_error(g: &FieldModel, c: &FieldModel) -> f32 {
+    let (FieldModel::Grid(g), FieldModel::Grid(c)) = (g, c) else {
+        panic!("grid pheromones")
+    };
+    let scale = c.values().iter().fold(1e-12f32, |m, v| m.max(v.abs()));
+    (g.values().iter().zip(c.values()))
+        .map(|(a, b)| (a - b).abs() / scale)
+        .fold(0f32, f32::max)
+}
+
 /// Continuous actions of step `step`: every agent different, some of them reversing.
 fn actions(env: &VecEnv, step: usize) -> Vec<f32> {
     let s = env.spec();
@@ -88,31 +107,18 @@ fn lockstep(
             cpu.outputs().obs(),
             "step {step}: observations differ by {worst}"
         );
-        assert_eq!(
-            gpu.outputs().rewards(),
-            cpu.outputs().rewards(),
-            "step {step}: rewards"
-        );
-        assert_eq!(
-            gpu.outputs().terminated(),
-            cpu.outputs().terminated(),
-            "step {step}"
-        );
-        assert_eq!(
-            gpu.outputs().truncated(),
-            cpu.outputs().truncated(),
-            "step {step}"
-        );
-        assert_eq!(
-            gpu.outputs().final_mask(),
-            cpu.outputs().final_mask(),
-            "step {step}"
-        );
-        assert_eq!(
-            gpu.outputs().final_obs(),
-            cpu.outputs().final_obs(),
-            "step {step}: final observations"
-        );
+        // Every other output alike, each named where it differs.
+        macro_rules! same {
+            ($($output:ident),+) => {
+                $(assert_eq!(
+                    gpu.outputs().$output(),
+                    cpu.outputs().$output(),
+                    "step {step}: {}",
+                    stringify!($output)
+                );)+
+            };
+        }
+        same!(rewards, terminated, truncated, final_mask, final_obs);
         ends += cpu.outputs().truncated().iter().filter(|&&t| t).count();
     }
     ends
@@ -130,22 +136,14 @@ fn fields_agree(gpu: &mut VecEnv, cpu: &VecEnv) {
             .zip(cpu.world(w).unwrap().pheromones())
             .enumerate()
         {
-            let (FieldModel::Grid(g), FieldModel::Grid(c)) = (&g.model, &c.model) else {
-                panic!("grid pheromones")
-            };
-            let scale = c
-                .values()
-                .iter()
-                .fold(0f32, |m, v| m.max(v.abs()))
-                .max(1e-12);
-            let err = (g.values().iter().zip(c.values()))
-                .map(|(a, b)| (a - b).abs() / scale)
-                .fold(0f32, f32::max);
+            let err = relative_error(&g.model, &c.model);
             assert!(
                 err <= 1e-5,
                 "world {w}, pheromone {k}: relative error {err:e}"
             );
-            nonzero += c.values().iter().filter(|&&v| v > 0.0).count();
+            if let FieldModel::Grid(c) = &c.model {
+                nonzero += c.values().iter().filter(|&&v| v > 0.0).count();
+            }
         }
     }
     assert!(nonzero > 0, "the fields are empty");
@@ -153,9 +151,9 @@ fn fields_agree(gpu: &mut VecEnv, cpu: &VecEnv) {
 
 #[test]
 fn trail_next_step_autoreset_equals_the_cpu() {
-    let c = cfg("trail", None, 5, BackendChoice::Gpu);
-    let Some(mut gpu) = gpu_env(&c) else { return };
-    let mut cpu = VecEnv::new(&cfg("trail", None, 5, BackendChoice::Cpu)).unwrap();
+    let Some((mut gpu, mut cpu)) = gpu_and_cpu(cfg("trail", None, 5, BackendChoice::Gpu)) else {
+        return;
+    };
     let ends = lockstep(&mut gpu, &mut cpu, 18, &[]);
     assert!(ends >= 5, "every world ended an episode ({ends} ends)");
     fields_agree(&mut gpu, &cpu);
@@ -165,9 +163,9 @@ fn trail_next_step_autoreset_equals_the_cpu() {
 fn trail_same_step_autoreset_and_partial_resets_equal_the_cpu() {
     let mut c = cfg("trail", None, 4, BackendChoice::Gpu);
     c.autoreset = AutoresetMode::SameStep;
-    let Some(mut gpu) = gpu_env(&c) else { return };
-    c.backend = Some(BackendChoice::Cpu);
-    let mut cpu = VecEnv::new(&c).unwrap();
+    let Some((mut gpu, mut cpu)) = gpu_and_cpu(c) else {
+        return;
+    };
     let resets = [
         (3, vec![false, true, false, true]),
         (9, vec![true, false, false, false]),
@@ -179,9 +177,9 @@ fn trail_same_step_autoreset_and_partial_resets_equal_the_cpu() {
 
 #[test]
 fn foraging_equals_the_cpu() {
-    let c = cfg("foraging", None, 3, BackendChoice::Gpu);
-    let Some(mut gpu) = gpu_env(&c) else { return };
-    let mut cpu = VecEnv::new(&cfg("foraging", None, 3, BackendChoice::Cpu)).unwrap();
+    let Some((mut gpu, mut cpu)) = gpu_and_cpu(cfg("foraging", None, 3, BackendChoice::Gpu)) else {
+        return;
+    };
     lockstep(&mut gpu, &mut cpu, 12, &[]);
     fields_agree(&mut gpu, &cpu);
 }
@@ -199,10 +197,10 @@ fn deposit_actions_with_diffusion_equal_the_cpu() {
     let mut c = cfg("trail", Some(text), 3, BackendChoice::Gpu);
     c.action = ActionKind::Continuous;
     c.max_cycles = 9;
-    let Some(mut gpu) = gpu_env(&c) else { return };
+    let Some((mut gpu, mut cpu)) = gpu_and_cpu(c) else {
+        return;
+    };
     assert_eq!(gpu.spec().action.flat_len(), 3, "2 wheels + 1 deposit rate");
-    c.backend = Some(BackendChoice::Cpu);
-    let mut cpu = VecEnv::new(&c).unwrap();
     lockstep(&mut gpu, &mut cpu, 14, &[(5, vec![false, true, false])]);
     fields_agree(&mut gpu, &cpu);
 }
@@ -228,9 +226,9 @@ fn auto_takes_the_cpu_for_small_batches_and_software_adapters() {
 fn renders_draw_the_batch_fields() {
     let mut c = cfg("trail", None, 2, BackendChoice::Gpu);
     c.max_cycles = 100;
-    let Some(mut gpu) = gpu_env(&c) else { return };
-    c.backend = Some(BackendChoice::Cpu);
-    let mut cpu = VecEnv::new(&c).unwrap();
+    let Some((mut gpu, mut cpu)) = gpu_and_cpu(c) else {
+        return;
+    };
     gpu.reset(None, None).unwrap();
     cpu.reset(None, None).unwrap();
     let ahead = vec![0.7f32; gpu.spec().num_envs * gpu.spec().num_agents * 2];
@@ -266,9 +264,9 @@ fn renders_draw_the_batch_fields() {
 fn deferred_steps_see_current_fields_and_conclude_as_the_cpu() {
     let mut c = cfg("trail", None, 3, BackendChoice::Gpu);
     c.max_cycles = 6;
-    let Some(mut gpu) = gpu_env(&c) else { return };
-    c.backend = Some(BackendChoice::Cpu);
-    let mut cpu = VecEnv::new(&c).unwrap();
+    let Some((mut gpu, mut cpu)) = gpu_and_cpu(c) else {
+        return;
+    };
     gpu.reset(None, None).unwrap();
     cpu.reset(None, None).unwrap();
     for step in 0..10 {
@@ -278,13 +276,7 @@ fn deferred_steps_see_current_fields_and_conclude_as_the_cpu() {
         for w in 0..3 {
             let (g, c) = (gpu.world(w).unwrap(), cpu.world(w).unwrap());
             for (pg, pc) in g.pheromones().iter().zip(c.pheromones()) {
-                let (FieldModel::Grid(g), FieldModel::Grid(c)) = (&pg.model, &pc.model) else {
-                    panic!("grid pheromones")
-                };
-                let scale = c.values().iter().fold(1e-12f32, |m, v| m.max(v.abs()));
-                let err = (g.values().iter().zip(c.values()))
-                    .map(|(a, b)| (a - b).abs() / scale)
-                    .fold(0f32, f32::max);
+                let err = relative_error(&pg.model, &pc.model);
                 assert!(
                     err <= 1e-5,
                     "step {step}, world {w}: stale fields ({err:e})"

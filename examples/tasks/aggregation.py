@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 import colcos
+from _common import Rewrite, random_steps
 
 F32 = np.float32
 #: Step of the central differences that give a grid pheromone's gradient, m (as the Rust task).
@@ -27,11 +28,8 @@ def normalize_or_zero(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndar
         return np.where(ok, x * rcp, F32(0.0)), np.where(ok, y * rcp, F32(0.0))
 
 
-class Aggregation(colcos.Task):
-    name = "aggregation_py"
+class Aggregation(Rewrite, builtin="aggregation", prefill=False):
     agent_role = "follower"
-    scenario = colcos.default_scenario("aggregation")
-    prefill_static_maps = False  # the Rust task leaves its fields as they start
 
     def __init__(
         self,
@@ -110,11 +108,5 @@ class Aggregation(colcos.Task):
 
 
 if __name__ == "__main__":
-    env = colcos.vector.VecEnv(Aggregation(), num_envs=1024, max_cycles=500)
-    env.reset(seed=0)
-    rng = np.random.default_rng(0)
-    total = 0.0
-    for _ in range(100):
-        _, rewards, _, _, _ = env.step(rng.uniform(-1, 1, (1024, env.num_agents, 2)).astype(np.float32))
-        total += float(rewards.mean())
+    total = sum(float(rewards.mean()) for _, rewards, *_ in random_steps(Aggregation(), 1024, 500, 100, low=-1.0))
     print(f"mean reward per agent-step over 100 steps of 1,024 worlds: {total / 100:.4f}")

@@ -12,15 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 import colcos
+from _common import Rewrite, random_steps
 
 F32 = np.float32
 
 
-class Alarm(colcos.Task):
-    name = "alarm_py"
-    agent_role = "agent"
-    scenario = colcos.default_scenario("alarm")
-    prefill_static_maps = False  # the Rust task leaves its fields as they start
+class Alarm(Rewrite, builtin="alarm", prefill=False):
     obs_low, obs_high = (0.0,), (1.0,)  # one extra entry: predator_near (0 or 1)
 
     def __init__(
@@ -61,13 +58,5 @@ class Alarm(colcos.Task):
 
 
 if __name__ == "__main__":
-    env = colcos.vector.VecEnv(Alarm(), num_envs=256, max_cycles=3000)
-    env.reset(seed=0)
-    rng = np.random.default_rng(0)
-    width = env.single_action_space.shape[0]
-    near = 0.0
-    for _ in range(1000):
-        a = rng.uniform(0, 1, (256, env.num_agents, width)).astype(np.float32)
-        obs, _, _, _, _ = env.step(a)
-        near += float(obs[..., -1].mean())
+    near = sum(float(obs[..., -1].mean()) for obs, *_ in random_steps(Alarm(), 256, 3000, 1000))
     print(f"share of agent-steps with the predator near: {near / 1000:.3f}")

@@ -15,15 +15,12 @@ from typing import Any
 import numpy as np
 
 import colcos
+from _common import Rewrite, random_steps
 
 F32 = np.float32
 
 
-class Colony(colcos.Task):
-    name = "colony_py"
-    agent_role = "agent"
-    scenario = colcos.default_scenario("colony")
-    prefill_static_maps = False  # the Rust task leaves its fields as they start
+class Colony(Rewrite, builtin="colony", prefill=False):
     obs_low, obs_high = (0.0,), (1.0,)  # one extra entry: carrying (0 or 1)
 
     def __init__(
@@ -94,11 +91,5 @@ class Colony(colcos.Task):
 
 
 if __name__ == "__main__":
-    env = colcos.vector.VecEnv(Colony(), num_envs=256, max_cycles=3000)
-    env.reset(seed=0)
-    rng = np.random.default_rng(0)
-    width = env.single_action_space.shape[0]
-    for _ in range(1000):
-        a = rng.uniform(0, 1, (256, env.num_agents, width)).astype(np.float32)
-        _, _, _, _, infos = env.step(a)
+    *_, infos = list(random_steps(Colony(), 256, 3000, 1000))[-1]
     print(f"units delivered in 1,000 steps of 256 worlds: {int(infos['task']['delivered'].sum())}")

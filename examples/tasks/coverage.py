@@ -14,15 +14,12 @@ from typing import Any
 import numpy as np
 
 import colcos
+from _common import Rewrite, random_steps
 
 F32 = np.float32
 
 
-class Coverage(colcos.Task):
-    name = "coverage_py"
-    agent_role = "agent"
-    scenario = colcos.default_scenario("coverage")
-    prefill_static_maps = False  # the Rust task leaves its fields as they start
+class Coverage(Rewrite, builtin="coverage", prefill=False):
 
     def __init__(self, cell: float = 0.05, cell_reward: float = 1.0, bump_penalty: float = 0.0) -> None:
         self.cell = F32(cell)
@@ -70,11 +67,5 @@ class Coverage(colcos.Task):
 
 
 if __name__ == "__main__":
-    env = colcos.vector.VecEnv(Coverage(), num_envs=256, max_cycles=3000)
-    env.reset(seed=0)
-    rng = np.random.default_rng(0)
-    width = env.single_action_space.shape[0]
-    for _ in range(1000):
-        a = rng.uniform(0, 1, (256, env.num_agents, width)).astype(np.float32)
-        _, _, _, _, infos = env.step(a)
+    *_, infos = list(random_steps(Coverage(), 256, 3000, 1000))[-1]
     print(f"mean cells covered in 1,000 steps, over 256 worlds: {infos['task']['covered'].mean():.1f}")

@@ -10,12 +10,11 @@ from __future__ import annotations
 import numpy as np
 
 import colcos
+from _common import Rewrite
 
 
-class Foraging(colcos.Task):
-    name = "foraging_py"
+class Foraging(Rewrite, builtin="foraging", prefill=True):
     agent_role = "forager"
-    scenario = colcos.default_scenario("foraging")
 
     def __init__(self) -> None:
         self.food = np.array([[1.3, 0.55]], np.float32)

@@ -10,12 +10,10 @@ from __future__ import annotations
 import numpy as np
 
 import colcos
+from _common import Rewrite, random_steps
 
 
-class Trail(colcos.Task):
-    name = "trail_py"
-    agent_role = "agent"
-    scenario = colcos.default_scenario("trail")
+class Trail(Rewrite, builtin="trail", prefill=True):
 
     def __init__(self, channel: int = 2, bump_penalty: float = 0.1) -> None:
         self.channel = channel
@@ -32,11 +30,5 @@ class Trail(colcos.Task):
 
 
 if __name__ == "__main__":
-    env = colcos.vector.VecEnv(Trail(), num_envs=1024, max_cycles=500)
-    env.reset(seed=0)
-    rng = np.random.default_rng(0)
-    total = 0.0
-    for _ in range(100):
-        _, rewards, _, _, _ = env.step(rng.uniform(-1, 1, (1024, env.num_agents, 2)).astype(np.float32))
-        total += float(rewards.mean())
+    total = sum(float(rewards.mean()) for _, rewards, *_ in random_steps(Trail(), 1024, 500, 100, low=-1.0))
     print(f"mean reward per agent-step over 100 steps of 1,024 worlds: {total / 100:.4f}")

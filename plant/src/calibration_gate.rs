@@ -1,10 +1,10 @@
 //! The rig plant's gate: real robots are driven only with a current, precise screen calibration.
-use crate::{PlantError, PlantOptions};
+use crate::{CalibrationLimits, PlantError};
 use colcos_bridge::calibrate::RigCalibration;
 
-/// The rig plant drives real robots only with a screen calibration younger than
-/// `calibration_max_age` whose error is under `calibration_max_error_mm`.
-pub(super) fn check(cal: &RigCalibration, plant: &PlantOptions) -> Result<(), PlantError> {
+/// The rig plant drives real robots only with a screen calibration younger than `limits.max_age`
+/// whose error is under `limits.max_error_mm`.
+pub(super) fn check(cal: &RigCalibration, limits: &CalibrationLimits) -> Result<(), PlantError> {
     let key = "rig.screen_calibration";
     let Some(screen) = &cal.screen else {
         return Err(PlantError::option(
@@ -12,12 +12,12 @@ pub(super) fn check(cal: &RigCalibration, plant: &PlantOptions) -> Result<(), Pl
             "the rig plant needs a screen calibration: run `colcos calibrate screen` and name its file here",
         ));
     };
-    if screen.rms_mm.is_nan() || screen.rms_mm > plant.calibration_max_error_mm {
+    if screen.rms_mm.is_nan() || screen.rms_mm > limits.max_error_mm {
         return Err(PlantError::option(
             key,
             format!(
                 "its error is {:.2} mm RMS, more than the {} mm allowed: calibrate again",
-                screen.rms_mm, plant.calibration_max_error_mm
+                screen.rms_mm, limits.max_error_mm
             ),
         ));
     }
@@ -25,14 +25,14 @@ pub(super) fn check(cal: &RigCalibration, plant: &PlantOptions) -> Result<(), Pl
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64());
     match parse_utc(&screen.date) {
-        Some(t) if now - t <= plant.calibration_max_age => Ok(()),
+        Some(t) if now - t <= limits.max_age => Ok(()),
         Some(t) => Err(PlantError::option(
             key,
             format!(
                 "it was measured {} ({:.1} days ago), more than the {:.1} days allowed: calibrate again",
                 screen.date,
                 (now - t) / 86400.0,
-                plant.calibration_max_age / 86400.0
+                limits.max_age / 86400.0
             ),
         )),
         None => Err(PlantError::option(

@@ -24,5 +24,5 @@ mod twin_scenario;
 
 pub use goto::GoTo;
 pub use live_env::{GoToReport, LiveEnv};
-pub use options::{PlantError, PlantKind, PlantOptions};
+pub use options::{CalibrationLimits, PlantError, PlantKind, PlantOptions};
 pub use twin_scenario::TwinScenario;

@@ -202,7 +202,7 @@ impl LiveEnv {
         let calibration = RigCalibration::load(scenario)
             .map_err(|e| PlantError::option("rig.screen_calibration", e.to_string()))?;
         if plant.kind == PlantKind::Rig {
-            calibration_gate::check(&calibration, plant)?;
+            calibration_gate::check(&calibration, &plant.calibration)?;
         }
         let opts = SourceOptions::new(calibration.frame_transform(scenario));
         let source = open_pose_source(&tracker, &opts)?;
@@ -467,26 +467,14 @@ impl LiveEnv {
 
 /// A plant's arena as the one arena a policy reads (a hand-written baseline on the twin or the rig).
 impl colcos_env::baseline::Arenas for LiveEnv {
-    fn spec(&self) -> &EnvSpec {
-        &self.spec
-    }
-    fn scenario(&self) -> &Scenario {
-        &self.scenario
+    fn made(&self) -> colcos_env::baseline::Made<'_> {
+        (&self.spec, &self.scenario, &self.out, &self.decoder)
     }
     fn arena(&self, _w: usize) -> &dyn colcos_sim::world::ArenaView {
         self.driver.host()
     }
-    fn episode(&self, _w: usize) -> u64 {
-        self.episode.index
-    }
-    fn episode_steps(&self, _w: usize) -> u64 {
-        self.episode.steps
-    }
-    fn outputs(&self) -> &Outputs {
-        &self.out
-    }
-    fn action_width(&self) -> usize {
-        self.decoder.width()
+    fn episode(&self, _w: usize) -> &Episode {
+        &self.episode
     }
 }
 

@@ -41,10 +41,8 @@ pub struct PlantOptions {
     pub goto: bool,
     /// Longest a reset's go-to may take, s.
     pub goto_timeout: f64,
-    /// `rig`: the screen calibration may be at most this old, s (a week by default) ...
-    pub calibration_max_age: f64,
-    /// ... and its RMS reprojection error at most this, mm.
-    pub calibration_max_error_mm: f64,
+    /// `rig`: how fresh and precise the screen calibration must be.
+    pub calibration: CalibrationLimits,
     /// `twin` started here: the scenario the twin plays (its true tracker latency, sensors, robot
     /// body) where it differs from the host's; None: the host's own.
     pub twin_scenario: Option<TwinScenario>,
@@ -62,10 +60,28 @@ impl PlantOptions {
             log: None,
             goto: true,
             goto_timeout: 30.0,
-            calibration_max_age: 7.0 * 86400.0,
-            calibration_max_error_mm: 3.0,
+            calibration: CalibrationLimits::default(),
             twin_scenario: None,
             twin_truth: None,
+        }
+    }
+}
+
+/// What the rig plant asks of its screen calibration before it drives real robots.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CalibrationLimits {
+    /// Oldest it may be, s.
+    pub max_age: f64,
+    /// Largest RMS reprojection error, mm.
+    pub max_error_mm: f64,
+}
+
+impl Default for CalibrationLimits {
+    /// A week, 3 mm.
+    fn default() -> Self {
+        CalibrationLimits {
+            max_age: 7.0 * 86400.0,
+            max_error_mm: 3.0,
         }
     }
 }

@@ -3,7 +3,7 @@
 //! `OverflowError`). Python numbers and numpy scalars are accepted alike; booleans are not numbers.
 use crate::errors::Kind;
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
 
 /// `repr(value)`, shortened: messages quote what was given without flooding the terminal.
 pub fn show(v: &Bound<'_, PyAny>) -> String {
@@ -119,6 +119,69 @@ pub fn opt_text(v: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Option<Str
     match v {
         Some(v) if !v.is_none() => text(v, name).map(Some),
         _ => Ok(None),
+    }
+}
+
+/// `v`, unless it is absent or None.
+pub fn given<'a, 'py>(v: Option<&'a Bound<'py, PyAny>>) -> Option<&'a Bound<'py, PyAny>> {
+    v.filter(|v| !v.is_none())
+}
+
+/// A path: a str or an `os.PathLike`.
+pub fn path(v: &Bound<'_, PyAny>, name: &str) -> PyResult<std::path::PathBuf> {
+    v.extract().map_err(|_| {
+        Kind::ArgumentType.err(format!(
+            "{name} must be a path (str or os.PathLike), got {}",
+            show(v)
+        ))
+    })
+}
+
+/// A constructor's keyword arguments, taken out one by one by name: those left at the end were not
+/// expected.
+pub struct Keywords<'py> {
+    left: Bound<'py, PyDict>,
+    class: &'static str,
+}
+
+impl<'py> Keywords<'py> {
+    /// The arguments `kw` of a constructor of `class` (a copy: the caller's dict is left alone).
+    pub fn new(
+        py: Python<'py>,
+        kw: Option<&Bound<'py, PyDict>>,
+        class: &'static str,
+    ) -> PyResult<Self> {
+        let left = match kw {
+            Some(d) => d.copy()?,
+            None => PyDict::new(py),
+        };
+        Ok(Keywords { left, class })
+    }
+
+    /// Argument `name`, None where it was not given or given as None.
+    pub fn take(&self, name: &str) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let v = self.left.get_item(name)?;
+        if v.is_some() {
+            self.left.del_item(name)?;
+        }
+        Ok(v.filter(|v| !v.is_none()))
+    }
+
+    /// Argument `name`, a string or None.
+    pub fn text(&self, name: &str) -> PyResult<Option<String>> {
+        self.take(name)?.map(|v| text(&v, name)).transpose()
+    }
+
+    /// Refuses the first argument not taken, as Python refuses an unknown keyword.
+    pub fn finish(self) -> PyResult<()> {
+        match self.left.keys().iter().next() {
+            Some(k) => Err(Kind::ArgumentType.err(format!(
+                "{}() got an unexpected keyword argument {}",
+                self.class,
+                show(&k)
+            ))),
+            None => Ok(()),
+        }
     }
 }
 

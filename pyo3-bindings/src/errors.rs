@@ -10,24 +10,26 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyTuple, PyType};
 
-/// A kind of error: one Python class each.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    Colcos,
-    Scenario,
-    Task,
-    Action,
-    State,
-    Backend,
-    Display,
-    ArgumentType,
-    ActionType,
-    UnknownAgent,
-    Internal,
-    Unreachable,
+/// Declares [`Kind`] and its Python classes from one list, in order, parents first: each entry's
+/// doc comment is its class's docstring, `< Parent` its colcos base and `+ "Builtin"` its builtin
+/// base.
+macro_rules! kinds {
+    ($($(#[doc = $doc:literal])+ $kind:ident = $name:literal $(< $parent:ident)? $(+ $builtin:literal)?;)+) => {
+        /// A kind of error: one Python class each.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum Kind {
+            $($(#[doc = $doc])+ $kind,)+
+        }
+
+        /// Every class: kind, class name, parent colcos class, builtin base, docstring.
+        const CLASSES: &[Class] = &[
+            $((Kind::$kind, $name, kinds!(@opt $(Kind::$parent)?), kinds!(@opt $($builtin)?), concat!($($doc, "\n"),+)),)+
+        ];
+    };
+    (@opt) => { None };
+    (@opt $v:expr) => { Some($v) };
 }
 
-/// (kind, class name, parent colcos class, extra builtin base, docstring).
 type Class = (
     Kind,
     &'static str,
@@ -36,94 +38,33 @@ type Class = (
     &'static str,
 );
 
-/// Every class, parents first, in the order of [`Kind`].
-const CLASSES: [Class; 12] = [
-    (
-        Kind::Colcos,
-        "ColcosError",
-        None,
-        Some("ValueError"),
-        "Base of every error colcos raises on bad input (a ValueError).",
-    ),
-    (
-        Kind::Scenario,
-        "ScenarioError",
-        Some(Kind::Colcos),
-        None,
-        "A scenario file or text could not be read, parsed or validated.",
-    ),
-    (
-        Kind::Task,
-        "TaskError",
-        Some(Kind::Colcos),
-        None,
-        "Unknown task, or an unknown or invalid task/environment argument (named in the message).",
-    ),
-    (
-        Kind::Action,
-        "ActionError",
-        Some(Kind::Colcos),
-        None,
-        "Actions of the wrong shape, non-finite, out of range, or for an unknown agent.",
-    ),
-    (
-        Kind::State,
-        "StateError",
-        Some(Kind::Colcos),
-        Some("RuntimeError"),
-        "A call that is not valid now (e.g. step before reset); also a RuntimeError.",
-    ),
-    (
-        Kind::Backend,
-        "BackendError",
-        Some(Kind::Colcos),
-        None,
-        "The field backend asked for cannot be used (e.g. backend=\"gpu\" where there is no GPU adapter).",
-    ),
-    (
-        Kind::Display,
-        "DisplayError",
-        Some(Kind::Colcos),
-        None,
-        "No window can be opened (no X/Wayland display, no GPU adapter for it, or built without it).",
-    ),
-    (
-        Kind::ArgumentType,
-        "ArgumentTypeError",
-        Some(Kind::Task),
-        Some("TypeError"),
-        "An argument of the wrong type (e.g. seed='3', continuous='False'); also a TypeError.",
-    ),
-    (
-        Kind::ActionType,
-        "ActionTypeError",
-        Some(Kind::Action),
-        Some("TypeError"),
-        "An action of the wrong type (None, a string, a dict, ...); also a TypeError.",
-    ),
-    (
-        Kind::UnknownAgent,
-        "UnknownAgentError",
-        Some(Kind::Action),
-        Some("KeyError"),
-        "An action for an agent that does not exist; also a KeyError.",
-    ),
-    (
-        Kind::Internal,
-        "InternalError",
-        Some(Kind::Colcos),
-        Some("RuntimeError"),
-        "A bug inside colcos, caught before it could take the interpreter down; please report it.",
-    ),
-    (
-        Kind::Unreachable,
-        "PlantUnreachableError",
-        Some(Kind::State),
-        Some("ConnectionError"),
-        "A twin's or rig's tracker or robot link cannot be reached (the URL and the reason are named; \
-         the robots were told to stop); also a ConnectionError.",
-    ),
-];
+kinds! {
+    /// Base of every error colcos raises on bad input (a ValueError).
+    Colcos = "ColcosError" + "ValueError";
+    /// A scenario file or text could not be read, parsed or validated.
+    Scenario = "ScenarioError" < Colcos;
+    /// Unknown task, or an unknown or invalid task/environment argument (named in the message).
+    Task = "TaskError" < Colcos;
+    /// Actions of the wrong shape, non-finite, out of range, or for an unknown agent.
+    Action = "ActionError" < Colcos;
+    /// A call that is not valid now (e.g. step before reset); also a RuntimeError.
+    State = "StateError" < Colcos + "RuntimeError";
+    /// The field backend asked for cannot be used (e.g. backend="gpu" where there is no GPU adapter).
+    Backend = "BackendError" < Colcos;
+    /// No window can be opened (no X/Wayland display, no GPU adapter for it, or built without it).
+    Display = "DisplayError" < Colcos;
+    /// An argument of the wrong type (e.g. seed='3', continuous='False'); also a TypeError.
+    ArgumentType = "ArgumentTypeError" < Task + "TypeError";
+    /// An action of the wrong type (None, a string, a dict, ...); also a TypeError.
+    ActionType = "ActionTypeError" < Action + "TypeError";
+    /// An action for an agent that does not exist; also a KeyError.
+    UnknownAgent = "UnknownAgentError" < Action + "KeyError";
+    /// A bug inside colcos, caught before it could take the interpreter down; please report it.
+    Internal = "InternalError" < Colcos + "RuntimeError";
+    /// A twin's or rig's tracker or robot link cannot be reached (the URL and the reason are named;
+    /// the robots were told to stop); also a ConnectionError.
+    Unreachable = "PlantUnreachableError" < State + "ConnectionError";
+}
 
 static TYPES: PyOnceLock<Vec<Py<PyType>>> = PyOnceLock::new();
 
@@ -133,7 +74,7 @@ fn make_types(py: Python<'_>) -> PyResult<Vec<Py<PyType>>> {
     // KeyError quotes its message in str(); the colcos classes print it as given.
     let plain_str = builtins.getattr("BaseException")?.getattr("__str__")?;
     let mut made: Vec<Py<PyType>> = Vec::with_capacity(CLASSES.len());
-    for (kind, name, parent, builtin, doc) in CLASSES {
+    for &(kind, name, parent, builtin, doc) in CLASSES {
         let mut bases: Vec<Bound<'_, PyAny>> = Vec::new();
         if let Some(p) = parent {
             bases.push(made[p as usize].bind(py).clone().into_any());
@@ -144,7 +85,9 @@ fn make_types(py: Python<'_>) -> PyResult<Vec<Py<PyType>>> {
         debug_assert_eq!(made.len(), kind as usize);
         let dict = PyDict::new(py);
         dict.set_item("__module__", "colcos")?;
-        dict.set_item("__doc__", doc)?;
+        // One line per doc comment line, each with its leading space.
+        let doc: Vec<&str> = doc.lines().map(str::trim).collect();
+        dict.set_item("__doc__", doc.join(" "))?;
         dict.set_item("__str__", &plain_str)?;
         let ty = type_fn.call1((name, PyTuple::new(py, bases)?, dict))?;
         made.push(ty.cast_into::<PyType>()?.unbind());
@@ -172,7 +115,7 @@ impl Kind {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
-    for (kind, name, ..) in CLASSES {
+    for &(kind, name, ..) in CLASSES {
         m.add(name, kind.class(py)?)?;
     }
     Ok(())

@@ -3,6 +3,7 @@
 //! exception tree. The GIL is released around every reset and step, and before any lock is taken.
 use pyo3::prelude::*;
 
+mod arena_io;
 mod args;
 mod baseline;
 mod errors;

@@ -1,13 +1,11 @@
 //! `colcos._core.Plant`: one arena of a task on the digital twin, the lab's rig or a recorded rig run,
 //! with the buffers, spec and methods of a one-world `VecEnv`, so that the PettingZoo faces run on it
 //! unchanged. The GIL is released around every call that waits on the arena (reset, step).
-use crate::args::{self, guard};
+use crate::arena_io::{self, action_width, owned_actions};
+use crate::args::{self, Keywords, guard};
 use crate::errors::{Kind, to_py};
-use crate::vec_env::{Owned, Ptrs, action_width, output_views, owned_actions};
-use colcos_env::Actions;
 use colcos_plant::{LiveEnv, PlantError, PlantKind, PlantOptions, TwinScenario};
 use colcos_sim::scenario::Scenario;
-use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
@@ -74,60 +72,33 @@ impl PyPlant {
 
 #[pymethods]
 impl PyPlant {
-    /// `plant`: "twin", "rig" or "replay"; `tracker`/`robots`: the URLs (a twin without them starts
-    /// in this process on loopback); `log`: the rig log to replay, or to write (twin, rig);
-    /// `goto`: reset drives the robots to the episode's start poses, for at most `goto_timeout` s.
-    /// `twin_scenario` (a file) / `twin_scenario_text` (TOML) / `twin_overrides_json` (a JSON object
-    /// of key paths and values over the host's scenario): what a twin started here plays instead;
-    /// `truth` (a file of `[[robot]]` entries, `colcos twin --truth`): its robots' hidden values.
-    /// The other arguments are `VecEnv`'s (one world).
+    /// `plant`: "twin", "rig" or "replay"; keyword arguments `tracker`/`robots`: the URLs (a twin
+    /// without them starts in this process on loopback); `log`: the rig log to replay, or to write
+    /// (twin, rig); `goto`: reset drives the robots to the episode's start poses, for at most
+    /// `goto_timeout` s. `twin_scenario` (a file) / `twin_scenario_text` (TOML) /
+    /// `twin_overrides_json` (a JSON object of key paths and values over the host's scenario): what
+    /// a twin started here plays instead; `truth` (a file of `[[robot]]` entries, `colcos twin
+    /// --truth`): its robots' hidden values. The others are `VecEnv`'s (one world).
     #[new]
-    #[pyo3(signature = (plant, task, tracker=None, robots=None, log=None, goto=None, goto_timeout=None, twin_scenario=None, twin_scenario_text=None, twin_overrides_json=None, seed=None, scenario=None, scenario_text=None, max_cycles=None, action=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None, physics=None, truth=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (plant, task, **options))]
     fn new(
         py: Python<'_>,
         plant: &Bound<'_, PyAny>,
         task: &Bound<'_, PyAny>,
-        tracker: Option<&Bound<'_, PyAny>>,
-        robots: Option<&Bound<'_, PyAny>>,
-        log: Option<&Bound<'_, PyAny>>,
-        goto: Option<&Bound<'_, PyAny>>,
-        goto_timeout: Option<&Bound<'_, PyAny>>,
-        twin_scenario: Option<&Bound<'_, PyAny>>,
-        twin_scenario_text: Option<&Bound<'_, PyAny>>,
-        twin_overrides_json: Option<&Bound<'_, PyAny>>,
-        seed: Option<&Bound<'_, PyAny>>,
-        scenario: Option<&Bound<'_, PyAny>>,
-        scenario_text: Option<&Bound<'_, PyAny>>,
-        max_cycles: Option<&Bound<'_, PyAny>>,
-        action: Option<&Bound<'_, PyAny>>,
-        global_state: Option<&Bound<'_, PyAny>>,
-        patch_pixels: Option<&Bound<'_, PyAny>>,
-        patch_side: Option<&Bound<'_, PyAny>>,
-        params_json: Option<&Bound<'_, PyAny>>,
-        backend: Option<&Bound<'_, PyAny>>,
-        physics: Option<&Bound<'_, PyAny>>,
-        truth: Option<&Bound<'_, PyAny>>,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         guard(|| {
+            let kw = Keywords::new(py, options, "Plant")?;
             let kind: PlantKind = args::text(plant, "plant")?.parse().map_err(plant_err)?;
             let mut opts = PlantOptions::new(kind);
-            opts.tracker = args::opt_text(tracker, "tracker")?;
-            opts.robots = args::opt_text(robots, "robots")?;
-            opts.log = match log.filter(|l| !l.is_none()) {
-                Some(l) => Some(l.extract::<std::path::PathBuf>().map_err(|_| {
-                    Kind::ArgumentType.err(format!(
-                        "log must be a path (str or os.PathLike), got {}",
-                        args::show(l)
-                    ))
-                })?),
-                None => None,
-            };
-            if let Some(g) = goto.filter(|g| !g.is_none()) {
-                opts.goto = args::flag(g, "goto")?;
+            opts.tracker = kw.text("tracker")?;
+            opts.robots = kw.text("robots")?;
+            opts.log = kw.take("log")?.map(|l| args::path(&l, "log")).transpose()?;
+            if let Some(g) = kw.take("goto")? {
+                opts.goto = args::flag(&g, "goto")?;
             }
-            let timeout = match goto_timeout.filter(|t| !t.is_none()) {
-                Some(t) => args::real(t, "goto_timeout")?,
+            let timeout = match kw.take("goto_timeout")? {
+                Some(t) => args::real(&t, "goto_timeout")?,
                 None => opts.goto_timeout,
             };
             if !(0.0..=600.0).contains(&timeout) {
@@ -137,29 +108,13 @@ impl PyPlant {
             }
             opts.goto_timeout = timeout;
             opts.twin_scenario = twin_choice(
-                args::opt_text(twin_scenario, "twin_scenario")?,
-                args::opt_text(twin_scenario_text, "twin_scenario_text")?,
-                args::opt_text(twin_overrides_json, "twin_overrides_json")?,
+                kw.text("twin_scenario")?,
+                kw.text("twin_scenario_text")?,
+                kw.text("twin_overrides_json")?,
             )?;
-            opts.twin_truth = args::opt_text(truth, "truth")?.map(std::path::PathBuf::from);
-            let one = Some(1u64.into_pyobject(py)?.into_any());
-            let cfg = crate::vec_env::config(
-                task,
-                one.as_ref(),
-                seed,
-                one.as_ref(),
-                scenario,
-                scenario_text,
-                max_cycles,
-                action,
-                None,
-                global_state,
-                patch_pixels,
-                patch_side,
-                params_json,
-                backend,
-                physics,
-            )?;
+            opts.twin_truth = kw.text("truth")?.map(std::path::PathBuf::from);
+            let cfg = crate::vec_env::config(task, &kw, false)?;
+            kw.finish()?;
             let env = py.detach(|| LiveEnv::new(&cfg, &opts)).map_err(plant_err)?;
             let s = env.spec();
             let (num_agents, width) = (s.num_agents, action_width(&s.action));
@@ -185,18 +140,13 @@ impl PyPlant {
     /// `state [1,S]` and `patch [1,N,P,P,3]` if enabled.
     fn views<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
         guard(|| {
-            let py = slf.py();
-            let owner = slf.clone().into_any();
             let me: &PyPlant = slf.get();
-            let (ptrs, spec) = py.detach(|| {
+            let buffers = || {
                 let mut g = me.lock();
-                (Ptrs(g.buffer_ptrs()), g.spec().clone())
-            });
-            let d = PyDict::new(py);
-            // SAFETY: the buffers are allocated once in LiveEnv::new and never reallocated; each view
-            // keeps `owner` (and so the plant) alive.
-            unsafe { output_views(&d, &owner, &ptrs.0, &spec)? };
-            Ok(d)
+                (g.buffer_ptrs(), g.spec().clone())
+            };
+            // SAFETY: the buffers are allocated once in LiveEnv::new and never reallocated.
+            unsafe { arena_io::views(slf.as_any(), buffers) }
         })
     }
 
@@ -210,13 +160,10 @@ impl PyPlant {
         mask: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         guard(|| {
-            if mask.is_some_and(|m| !m.is_none()) {
+            if args::given(mask).is_some() {
                 return Err(Kind::Task.err("a plant has one world: reset takes no mask"));
             }
-            let seed = match seed.filter(|s| !s.is_none()) {
-                Some(s) => Some(args::seed(s, "seed")?),
-                None => None,
-            };
+            let seed = arena_io::opt_seed(seed)?;
             py.detach(|| self.lock().reset(seed)).map_err(plant_err)
         })
     }
@@ -226,11 +173,8 @@ impl PyPlant {
     fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
         guard(|| {
             let acts = owned_actions(actions, 1, self.num_agents, self.width)?;
-            py.detach(|| match &acts {
-                Owned::Discrete(a) => self.lock().step(Actions::Discrete(a)),
-                Owned::Continuous(a) => self.lock().step(Actions::Continuous(a)),
-            })
-            .map_err(plant_err)
+            py.detach(|| self.lock().step(acts.actions()))
+                .map_err(plant_err)
         })
     }
 
@@ -243,17 +187,11 @@ impl PyPlant {
         width: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
-            if let Some(w) = world.filter(|w| !w.is_none()) {
+            if let Some(w) = args::given(world) {
                 args::int_in(w, "world", 0, 0)?;
             }
-            let width = match width.filter(|w| !w.is_none()) {
-                Some(x) => args::int_in(x, "width", 16, 4096)? as u32,
-                None => 640,
-            };
-            let img = py.detach(|| self.lock().render(width));
-            let (w, h) = (img.width() as usize, img.height() as usize);
-            let flat = PyArray1::from_vec(py, img.into_raw());
-            Ok(flat.reshape([h, w, 3])?.into_any())
+            let width = arena_io::render_width(width, 4096)?;
+            arena_io::image(py, py.detach(|| self.lock().render(width)))
         })
     }
 
@@ -274,15 +212,8 @@ impl PyPlant {
     #[pyo3(signature = (world=0))]
     fn poses<'py>(&self, py: Python<'py>, world: usize) -> PyResult<Bound<'py, PyAny>> {
         check_world(world)?;
-        let flat: Vec<f32> = py.detach(|| {
-            let g = self.lock();
-            colcos_sim::world::ArenaView::poses(g.host())
-                .iter()
-                .flat_map(|p| [p.pos.x, p.pos.y, p.heading])
-                .collect()
-        });
-        let r = flat.len() / 3;
-        Ok(PyArray1::from_vec(py, flat).reshape([r, 3])?.into_any())
+        let poses = py.detach(|| colcos_sim::world::ArenaView::poses(self.lock().host()).to_vec());
+        arena_io::pose_rows(py, poses)
     }
 
     /// The scenario actually used, as TOML.

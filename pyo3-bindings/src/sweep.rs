@@ -9,6 +9,17 @@ use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// A pool of `threads` workers (None: one per core) for a sweep's runs.
+fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool, SweepError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| SweepError::Run {
+            id: 0,
+            message: e.to_string(),
+        })
+}
+
 /// A run's id, its cells and its poses (`run_traced`).
 type TracedRow<'py> = (u64, Vec<String>, Bound<'py, pyo3::types::PyDict>);
 
@@ -140,14 +151,7 @@ impl Sweep {
     ) -> PyResult<Vec<(u64, Vec<String>)>> {
         let plan = self.plan.clone();
         py.detach(move || {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads.unwrap_or(0))
-                .build()
-                .map_err(|e| SweepError::Run {
-                    id: 0,
-                    message: e.to_string(),
-                })?;
-            let rows = pool.install(|| colcos_sweep::run_ids(&plan, &ids))?;
+            let rows = pool(threads)?.install(|| colcos_sweep::run_ids(&plan, &ids))?;
             Ok(rows.iter().map(|r| (r.id, r.fields(&plan))).collect())
         })
         .map_err(to_py)
@@ -179,14 +183,7 @@ impl Sweep {
         let runs: Vec<(u64, Vec<String>, Trace)> = py
             .detach(move || {
                 use rayon::prelude::*;
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads.unwrap_or(0))
-                    .build()
-                    .map_err(|e| SweepError::Run {
-                        id: 0,
-                        message: e.to_string(),
-                    })?;
-                pool.install(|| {
+                pool(threads)?.install(|| {
                     ids.par_iter()
                         .map(|&id| {
                             let (row, trace) =

@@ -2,13 +2,14 @@
 //! worlds move; then the hooks' rewards and terminations end it), the state of every world as numpy
 //! arrays, and the fields sampled at any points, each once per batched step over all worlds.
 //! Functions of the module rather than methods: the env's own class stays about stepping.
+use crate::arena_io::{action_width, flat, owned_actions};
 use crate::args::guard;
 use crate::errors::{Kind, to_py};
 use crate::plant::{PyPlant, plant_err};
 use crate::task_view::{Counters, View};
-use crate::vec_env::{Owned, PyVecEnv, action_width, owned_actions};
+use crate::vec_env::PyVecEnv;
+use colcos_env::VecEnv;
 use colcos_env::encoding::OBS_DIM;
-use colcos_env::{Actions, VecEnv};
 use colcos_plant::LiveEnv;
 use colcos_sim::field::Pheromone;
 use colcos_sim::robot::Pose;
@@ -52,14 +53,8 @@ fn step_deferred(
                 (s.num_envs, s.num_agents, action_width(&s.action))
             });
             let acts = owned_actions(actions, e, n, width)?;
-            py.detach(|| {
-                let mut g = env.lock();
-                match &acts {
-                    Owned::Discrete(a) => g.env.step_deferred(Actions::Discrete(a)),
-                    Owned::Continuous(a) => g.env.step_deferred(Actions::Continuous(a)),
-                }
-            })
-            .map_err(to_py)
+            py.detach(|| env.lock().env.step_deferred(acts.actions()))
+                .map_err(to_py)
         }
         Core::Plant(plant) => {
             let (n, width) = py.detach(|| {
@@ -67,14 +62,8 @@ fn step_deferred(
                 (g.spec().num_agents, action_width(&g.spec().action))
             });
             let acts = owned_actions(actions, 1, n, width)?;
-            py.detach(|| {
-                let mut g = plant.lock();
-                match &acts {
-                    Owned::Discrete(a) => g.step_deferred(Actions::Discrete(a)),
-                    Owned::Continuous(a) => g.step_deferred(Actions::Continuous(a)),
-                }
-            })
-            .map_err(plant_err)
+            py.detach(|| plant.lock().step_deferred(acts.actions()))
+                .map_err(plant_err)
         }
     })
 }
@@ -88,8 +77,8 @@ fn conclude(
     terminated: PyReadonlyArrayDyn<'_, bool>,
 ) -> PyResult<()> {
     guard(|| {
-        let r: Vec<f32> = rewards.as_array().iter().copied().collect();
-        let t: Vec<bool> = terminated.as_array().iter().copied().collect();
+        let r = flat(&rewards);
+        let t = flat(&terminated);
         match core_of(env)? {
             Core::Batch(env) => py.detach(|| env.lock().env.conclude(&r, &t)).map_err(to_py),
             Core::Plant(p) => py.detach(|| p.lock().conclude(&r, &t)).map_err(plant_err),
@@ -189,44 +178,71 @@ fn plant_view(env: &LiveEnv) -> View {
     v
 }
 
+/// What stays fixed of a batch or plant, handed to Python as a dict of these keys.
+#[derive(IntoPyObject)]
+struct TaskInfo {
+    /// (w, h) m.
+    arena: (f32, f32),
+    /// Per robot.
+    roles: Vec<String>,
+    /// The pheromones' names and their screen colours (r, g, b levels per unit).
+    pheromones: Vec<String>,
+    colours: Vec<[f32; 3]>,
+    /// m/s.
+    max_wheel_speed: f32,
+    /// m.
+    wheel_base: f32,
+    /// s.
+    dt: f32,
+}
+
+impl TaskInfo {
+    fn new(sc: &Scenario, view: Option<&dyn ArenaView>) -> Self {
+        let a = sc.arena_size();
+        let p = &sc.spec.robot;
+        TaskInfo {
+            arena: (a.x, a.y),
+            roles: (0..sc.robot_count())
+                .map(|i| view.map_or(String::new(), |w| w.role(i).to_string()))
+                .collect(),
+            pheromones: sc.spec.pheromones.iter().map(|p| p.name.clone()).collect(),
+            colours: sc.spec.pheromones.iter().map(|p| p.colour).collect(),
+            max_wheel_speed: p.max_wheel_speed,
+            wheel_base: p.wheel_base,
+            dt: sc.spec.dt,
+        }
+    }
+}
+
 /// What stays fixed: `arena` (w, h) m, `roles` [R], `pheromones` [F] names and their screen
 /// `colours` [F] (r, g, b levels per unit), `max_wheel_speed` and
 /// `wheel_base` m/s and m, `dt` s.
 #[pyfunction]
 fn task_info<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
-        let info = |sc: &Scenario, view: Option<&dyn ArenaView>| {
-            let roles: Vec<String> = (0..sc.robot_count())
-                .map(|i| view.map_or(String::new(), |w| w.role(i).to_string()))
-                .collect();
-            let names: Vec<String> = sc.spec.pheromones.iter().map(|p| p.name.clone()).collect();
-            let colours: Vec<[f32; 3]> = sc.spec.pheromones.iter().map(|p| p.colour).collect();
-            let a = sc.arena_size();
-            let p = &sc.spec.robot;
-            let (speed, base, dt) = (p.max_wheel_speed, p.wheel_base, sc.spec.dt);
-            ((a.x, a.y), roles, names, colours, speed, base, dt)
-        };
-        let (arena, roles, names, colours, speed, base, dt) = match core_of(env)? {
+        let info = match core_of(env)? {
             Core::Batch(env) => py.detach(|| {
                 let g = env.lock();
                 let world = g.env.world(0).map(|w| w as &dyn ArenaView);
-                info(g.env.scenario(), world)
+                TaskInfo::new(g.env.scenario(), world)
             }),
             Core::Plant(p) => py.detach(|| {
                 let g = p.lock();
-                info(g.scenario(), Some(g.host()))
+                TaskInfo::new(g.scenario(), Some(g.host()))
             }),
         };
-        let d = PyDict::new(py);
-        d.set_item("arena", arena)?;
-        d.set_item("roles", roles)?;
-        d.set_item("pheromones", names)?;
-        d.set_item("colours", colours)?;
-        d.set_item("max_wheel_speed", speed)?;
-        d.set_item("wheel_base", base)?;
-        d.set_item("dt", dt)?;
-        Ok(d)
+        info.into_pyobject(py)
     })
+}
+
+/// The points per world P of `points` of shape `shape`, which must be `[e, P, 2]`.
+fn points_per_world(shape: &[usize], e: usize) -> Result<usize, String> {
+    if shape.len() != 3 || shape[0] != e || shape[2] != 2 {
+        return Err(format!(
+            "points must have shape ({e}, P, 2) = (num_envs, points, xy), got {shape:?}"
+        ));
+    }
+    Ok(shape[1])
 }
 
 /// Every pheromone's value at `points` float32 `[E, P, 2]` (m) of each world: float32 `[E, P, F]`.
@@ -238,16 +254,11 @@ fn sample_fields<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     guard(|| {
         let shape = points.shape().to_vec();
-        let pts: Vec<f32> = points.as_array().iter().copied().collect();
+        let pts = flat(&points);
         // Every pheromone's value at each world's points: (values, worlds, points, pheromones).
         let sample = |worlds: &[&[Pheromone]]| {
-            let e = worlds.len();
-            if shape.len() != 3 || shape[0] != e || shape[2] != 2 {
-                return Err(format!(
-                    "points must have shape ({e}, P, 2) = (num_envs, points, xy), got {shape:?}"
-                ));
-            }
-            let (p, f) = (shape[1], worlds.first().map_or(0, |w| w.len()));
+            let (e, p) = (worlds.len(), points_per_world(&shape, worlds.len())?);
+            let f = worlds.first().map_or(0, |w| w.len());
             let mut out = Vec::with_capacity(e * p * f);
             for (phs, xy) in worlds.iter().zip(pts.chunks_exact(2 * p.max(1))) {
                 for q in xy.chunks_exact(2) {
@@ -267,7 +278,7 @@ fn sample_fields<'py>(
             }),
             Core::Plant(pl) => py.detach(|| sample(&[pl.lock().host().pheromones()])),
         };
-        let (out, e, p, f) = sampled.map_err(|m| Kind::Action.err(m))?;
+        let (out, e, p, f) = sampled.map_err(|m: String| Kind::Action.err(m))?;
         Ok(PyArray1::from_vec(py, out).reshape([e, p, f])?.into_any())
     })
 }
@@ -287,15 +298,10 @@ fn sample_gradients<'py>(
             return Err(Kind::Action.err(format!("step must be finite and > 0, got {step}")));
         }
         let shape = points.shape().to_vec();
-        let pts: Vec<f32> = points.as_array().iter().copied().collect();
+        let pts = flat(&points);
         let sample = |worlds: &[&dyn ArenaView]| {
-            let e = worlds.len();
-            if shape.len() != 3 || shape[0] != e || shape[2] != 2 {
-                return Err(format!(
-                    "points must have shape ({e}, P, 2) = (num_envs, points, xy), got {shape:?}"
-                ));
-            }
-            let (p, f) = (shape[1], worlds.first().map_or(0, |w| w.pheromones().len()));
+            let (e, p) = (worlds.len(), points_per_world(&shape, worlds.len())?);
+            let f = worlds.first().map_or(0, |w| w.pheromones().len());
             let (mut values, mut grads) = (Vec::with_capacity(e * p * f), Vec::new());
             grads.reserve(2 * e * p * f);
             for (world, xy) in worlds.iter().zip(pts.chunks_exact(2 * p.max(1))) {
@@ -323,7 +329,7 @@ fn sample_gradients<'py>(
                 sample(&[g.host() as &dyn ArenaView])
             }),
         };
-        let (values, grads, e, p, f) = sampled.map_err(|m| Kind::Action.err(m))?;
+        let (values, grads, e, p, f) = sampled.map_err(|m: String| Kind::Action.err(m))?;
         Ok((
             PyArray1::from_vec(py, values)
                 .reshape([e, p, f])?
@@ -346,8 +352,8 @@ fn place_robots(
     poses: PyReadonlyArrayDyn<'_, f32>,
 ) -> PyResult<()> {
     guard(|| {
-        let worlds: Vec<i64> = worlds.as_array().iter().copied().collect();
-        let robots: Vec<i64> = robots.as_array().iter().copied().collect();
+        let worlds = flat(&worlds);
+        let robots = flat(&robots);
         let shape = poses.shape().to_vec();
         if shape != [worlds.len(), robots.len(), 3] {
             return Err(Kind::Action.err(format!(
@@ -356,7 +362,7 @@ fn place_robots(
                 robots.len()
             )));
         }
-        let p: Vec<f32> = poses.as_array().iter().copied().collect();
+        let p = flat(&poses);
         let index = |i: i64, what: &str| {
             usize::try_from(i).map_err(|_| Kind::Action.err(format!("{what} {i} is negative")))
         };

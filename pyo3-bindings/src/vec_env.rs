@@ -3,16 +3,12 @@
 //! Threads: every call waits for the environment's lock with the GIL released (`py.detach`), so
 //! that a thread stepping (which holds the lock and has released the GIL) and a thread asking for
 //! anything else never wait on each other. Every entry point runs under `args::guard`.
-use crate::args::{self, guard};
+use crate::arena_io::{self, action_width, owned_actions};
+use crate::args::{self, Keywords, guard};
 use crate::errors::{Kind, to_py};
 use crate::limits;
-use colcos_env::{
-    ActionKind, Actions, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource, Space, VecEnv,
-};
-use numpy::ndarray::{ArrayView, IxDyn};
-use numpy::{
-    Element, PyArray, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods,
-};
+use colcos_env::{ActionKind, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource, VecEnv};
+use numpy::{PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
@@ -46,61 +42,20 @@ impl PyVecEnv {
     }
 }
 
-/// Raw buffer pointers carried out of a `detach` closure.
-pub(crate) struct Ptrs<T>(pub T);
-// SAFETY: plain addresses of buffers owned by the env, only dereferenced with the GIL held while the
-// env is alive (see `views`).
-unsafe impl<T> Send for Ptrs<T> {}
-
-/// A numpy view of the elements at `ptr` shaped `shape`, keeping `owner` alive.
-///
-/// # Safety
-/// `ptr..ptr + product(shape)` must stay valid for as long as `owner` lives.
-pub(crate) unsafe fn view<'py, T: Element>(
-    owner: &Bound<'py, PyAny>,
-    ptr: *mut T,
-    shape: Vec<usize>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let a = unsafe { ArrayView::from_shape_ptr(IxDyn(&shape), ptr as *const T) };
-    Ok(unsafe { PyArray::borrow_from_array(&a, owner.clone()) }.into_any())
-}
-
-/// The configuration from the constructor's arguments, each checked and named.
-#[allow(clippy::too_many_arguments)]
+/// The configuration from a constructor's task and keyword arguments, each checked and named, of
+/// one world (`batch` false: a plant's) or of a batch (also `num_envs`, `num_threads` and
+/// `autoreset_mode`). Takes the arguments it knows out of `kw`.
 pub(crate) fn config(
     task: &Bound<'_, PyAny>,
-    num_envs: Option<&Bound<'_, PyAny>>,
-    seed: Option<&Bound<'_, PyAny>>,
-    num_threads: Option<&Bound<'_, PyAny>>,
-    scenario: Option<&Bound<'_, PyAny>>,
-    scenario_text: Option<&Bound<'_, PyAny>>,
-    max_cycles: Option<&Bound<'_, PyAny>>,
-    action: Option<&Bound<'_, PyAny>>,
-    autoreset_mode: Option<&Bound<'_, PyAny>>,
-    global_state: Option<&Bound<'_, PyAny>>,
-    patch_pixels: Option<&Bound<'_, PyAny>>,
-    patch_side: Option<&Bound<'_, PyAny>>,
-    params_json: Option<&Bound<'_, PyAny>>,
-    backend: Option<&Bound<'_, PyAny>>,
-    physics: Option<&Bound<'_, PyAny>>,
+    kw: &Keywords<'_>,
+    batch: bool,
 ) -> PyResult<EnvConfig> {
-    fn some<'a, 'py>(v: Option<&'a Bound<'py, PyAny>>) -> Option<&'a Bound<'py, PyAny>> {
-        v.filter(|v| !v.is_none())
-    }
     let mut cfg = EnvConfig::new(args::text(task, "task")?);
-    let scenario_path = match some(scenario) {
-        Some(p) => Some(p.extract::<std::path::PathBuf>().map_err(|_| {
-            Kind::ArgumentType.err(format!(
-                "scenario must be a path (str or os.PathLike), got {}",
-                args::show(p)
-            ))
-        })?),
-        None => None,
-    };
-    cfg.scenario = match (
-        scenario_path,
-        args::opt_text(scenario_text, "scenario_text")?,
-    ) {
+    let scenario_path = kw
+        .take("scenario")?
+        .map(|p| args::path(&p, "scenario"))
+        .transpose()?;
+    cfg.scenario = match (scenario_path, kw.text("scenario_text")?) {
         (Some(_), Some(_)) => {
             return Err(Kind::Task.err("give either scenario (a path) or scenario_text, not both"));
         }
@@ -108,7 +63,7 @@ pub(crate) fn config(
         (None, Some(t)) => ScenarioSource::Text(t),
         (None, None) => ScenarioSource::Default,
     };
-    if let Some(s) = args::opt_text(params_json, "params_json")? {
+    if let Some(s) = kw.text("params_json")? {
         let v: serde_json::Value = serde_json::from_str(&s).map_err(|e| {
             Kind::Task.err(format!(
                 "task parameters (params_json) are not valid JSON: {e}"
@@ -117,41 +72,48 @@ pub(crate) fn config(
         limits::check_params("", &v).map_err(|e| Kind::Task.err(e))?;
         cfg.params = v;
     }
-    if let Some(n) = some(num_envs) {
-        cfg.num_envs = args::int_in(n, "num_envs", 1, limits::MAX_NUM_ENVS)? as usize;
+    if batch {
+        if let Some(n) = kw.take("num_envs")? {
+            cfg.num_envs = args::int_in(&n, "num_envs", 1, limits::MAX_NUM_ENVS)? as usize;
+        }
+        if let Some(t) = kw.take("num_threads")? {
+            let threads = args::int_in(&t, "num_threads", 1, limits::MAX_THREADS)?;
+            cfg.num_threads = Some(threads as usize);
+        }
+        if let Some(a) = kw.text("autoreset_mode")? {
+            cfg.autoreset = a.parse::<AutoresetMode>().map_err(to_py)?;
+        }
+    } else {
+        cfg.num_threads = Some(1);
     }
-    if let Some(s) = some(seed) {
-        cfg.seed = args::seed(s, "seed")?;
+    if let Some(s) = arena_io::opt_seed(kw.take("seed")?.as_ref())? {
+        cfg.seed = s;
     }
-    if let Some(t) = some(num_threads) {
-        cfg.num_threads = Some(args::int_in(t, "num_threads", 1, limits::MAX_THREADS)? as usize);
-    }
-    if let Some(m) = some(max_cycles) {
+    if let Some(m) = kw.take("max_cycles")? {
         // 0: the scenario's duration.
-        cfg.max_cycles = args::int_in(m, "max_cycles", 0, limits::MAX_CYCLES)?;
+        cfg.max_cycles = args::int_in(&m, "max_cycles", 0, limits::MAX_CYCLES)?;
     }
-    if let Some(a) = args::opt_text(action, "action")? {
+    if let Some(a) = kw.text("action")? {
         cfg.action = a.parse::<ActionKind>().map_err(to_py)?;
     }
-    if let Some(a) = args::opt_text(autoreset_mode, "autoreset_mode")? {
-        cfg.autoreset = a.parse::<AutoresetMode>().map_err(to_py)?;
+    if let Some(g) = kw.take("global_state")? {
+        cfg.global_state = args::flag(&g, "global_state")?;
     }
-    if let Some(g) = some(global_state) {
-        cfg.global_state = args::flag(g, "global_state")?;
-    }
-    if let Some(p) = some(patch_pixels) {
-        let pixels = args::int_in(p, "patch_pixels", 1, limits::MAX_PATCH_PIXELS)? as usize;
-        let side = match some(patch_side) {
-            Some(s) => args::real(s, "patch_side")? as f32,
+    let side = kw.take("patch_side")?;
+    if let Some(p) = kw.take("patch_pixels")? {
+        let pixels = args::int_in(&p, "patch_pixels", 1, limits::MAX_PATCH_PIXELS)? as usize;
+        let side = match side {
+            Some(s) => args::real(&s, "patch_side")? as f32,
             None => PatchConfig::default().side,
         };
         cfg.patch = Some(PatchConfig { pixels, side });
     }
-    cfg.backend = args::opt_text(backend, "backend")?
+    cfg.backend = kw
+        .text("backend")?
         .map(|b| b.parse::<colcos_sim::field::BackendChoice>())
         .transpose()
         .map_err(|e| Kind::Task.err(format!("backend: {e}")))?;
-    cfg.physics = match args::opt_text(physics, "physics")?.as_deref() {
+    cfg.physics = match kw.text("physics")?.as_deref() {
         None => None,
         Some("rapier") => Some(colcos_sim::robot::PhysicsBackend::Rapier),
         Some("discs") => Some(colcos_sim::robot::PhysicsBackend::Discs),
@@ -166,45 +128,20 @@ pub(crate) fn config(
 
 #[pymethods]
 impl PyVecEnv {
+    /// `task` and the keyword arguments `num_envs`, `seed`, `num_threads`, `scenario` (a path) or
+    /// `scenario_text`, `max_cycles`, `action`, `autoreset_mode`, `global_state`, `patch_pixels`,
+    /// `patch_side`, `params_json`, `backend`, `physics` (None: the default).
     #[new]
-    #[pyo3(signature = (task, num_envs=None, seed=None, num_threads=None, scenario=None, scenario_text=None, max_cycles=None, action=None, autoreset_mode=None, global_state=None, patch_pixels=None, patch_side=None, params_json=None, backend=None, physics=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (task, **options))]
     fn new(
         py: Python<'_>,
         task: &Bound<'_, PyAny>,
-        num_envs: Option<&Bound<'_, PyAny>>,
-        seed: Option<&Bound<'_, PyAny>>,
-        num_threads: Option<&Bound<'_, PyAny>>,
-        scenario: Option<&Bound<'_, PyAny>>,
-        scenario_text: Option<&Bound<'_, PyAny>>,
-        max_cycles: Option<&Bound<'_, PyAny>>,
-        action: Option<&Bound<'_, PyAny>>,
-        autoreset_mode: Option<&Bound<'_, PyAny>>,
-        global_state: Option<&Bound<'_, PyAny>>,
-        patch_pixels: Option<&Bound<'_, PyAny>>,
-        patch_side: Option<&Bound<'_, PyAny>>,
-        params_json: Option<&Bound<'_, PyAny>>,
-        backend: Option<&Bound<'_, PyAny>>,
-        physics: Option<&Bound<'_, PyAny>>,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         guard(|| {
-            let cfg = config(
-                task,
-                num_envs,
-                seed,
-                num_threads,
-                scenario,
-                scenario_text,
-                max_cycles,
-                action,
-                autoreset_mode,
-                global_state,
-                patch_pixels,
-                patch_side,
-                params_json,
-                backend,
-                physics,
-            )?;
+            let kw = Keywords::new(py, options, "VecEnv")?;
+            let cfg = config(task, &kw, true)?;
+            kw.finish()?;
             let env = py
                 .detach(|| {
                     limits::check_batch_memory(&cfg)?;
@@ -243,18 +180,13 @@ impl PyVecEnv {
     /// `final_obs [E,N,D]`, `final_mask [E] bool`.
     fn views<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
         guard(|| {
-            let py = slf.py();
-            let owner = slf.clone().into_any();
             let me: &PyVecEnv = slf.get();
-            let (ptrs, spec) = py.detach(|| {
+            let buffers = || {
                 let mut g = me.lock();
-                (Ptrs(g.env.buffer_ptrs()), g.env.spec().clone())
-            });
-            let d = PyDict::new(py);
-            // SAFETY: the buffers are allocated once in VecEnv::new and never reallocated; each view
-            // keeps `owner` (and so the VecEnv) alive.
-            unsafe { output_views(&d, &owner, &ptrs.0, &spec)? };
-            Ok(d)
+                (g.env.buffer_ptrs(), g.env.spec().clone())
+            };
+            // SAFETY: the buffers are allocated once in VecEnv::new and never reallocated.
+            unsafe { arena_io::views(slf.as_any(), buffers) }
         })
     }
 
@@ -268,14 +200,8 @@ impl PyVecEnv {
         mask: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         guard(|| {
-            let seed = match seed.filter(|s| !s.is_none()) {
-                Some(s) => Some(args::seed(s, "seed")?),
-                None => None,
-            };
-            let mask = match mask.filter(|m| !m.is_none()) {
-                Some(m) => Some(self.mask(m)?),
-                None => None,
-            };
+            let seed = arena_io::opt_seed(seed)?;
+            let mask = args::given(mask).map(|m| self.mask(m)).transpose()?;
             py.detach(|| self.lock().env.reset(seed, mask.as_deref()))
                 .map_err(to_py)
         })
@@ -287,14 +213,8 @@ impl PyVecEnv {
         guard(|| {
             let (e, n) = (self.num_envs, self.num_agents);
             let acts = owned_actions(actions, e, n, self.width)?;
-            py.detach(|| {
-                let mut g = self.lock();
-                match &acts {
-                    Owned::Discrete(a) => g.env.step(Actions::Discrete(a)),
-                    Owned::Continuous(a) => g.env.step(Actions::Continuous(a)),
-                }
-            })
-            .map_err(to_py)
+            py.detach(|| self.lock().env.step(acts.actions()))
+                .map_err(to_py)
         })
     }
 
@@ -308,14 +228,8 @@ impl PyVecEnv {
         width: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
-            let w = match world.filter(|w| !w.is_none()) {
-                Some(w) => self.world_index(w)?,
-                None => 0,
-            };
-            let width = match width.filter(|w| !w.is_none()) {
-                Some(x) => args::int_in(x, "width", 16, limits::MAX_RENDER_WIDTH)? as u32,
-                None => 640,
-            };
+            let w = args::given(world).map_or(Ok(0), |w| self.world_index(w))?;
+            let width = arena_io::render_width(width, limits::MAX_RENDER_WIDTH)?;
             let img = py.detach(|| {
                 let g = self.lock();
                 let size = g.env.scenario().spec.screen.size;
@@ -336,9 +250,7 @@ impl PyVecEnv {
                 Ok(env_err) => to_py(env_err),
                 Err(msg) => Kind::Task.err(msg),
             })?;
-            let (w, h) = (img.width() as usize, img.height() as usize);
-            let flat = PyArray1::from_vec(py, img.into_raw());
-            Ok(flat.reshape([h, w, 3])?.into_any())
+            arena_io::image(py, img)
         })
     }
 
@@ -367,17 +279,11 @@ impl PyVecEnv {
     ) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
             let w = self.world_index(world)?;
-            let (flat, r) = py.detach(|| {
+            let poses = py.detach(|| {
                 let g = self.lock();
-                let world = g.env.world(w);
-                let flat: Vec<f32> = world
-                    .iter()
-                    .flat_map(|w| w.poses())
-                    .flat_map(|p| [p.pos.x, p.pos.y, p.heading])
-                    .collect();
-                (flat, world.map_or(0, |w| w.robot_count()))
+                g.env.world(w).map_or_else(Vec::new, |w| w.poses().to_vec())
             });
-            Ok(PyArray1::from_vec(py, flat).reshape([r, 3])?.into_any())
+            arena_io::pose_rows(py, poses)
         })
     }
 
@@ -419,102 +325,6 @@ impl PyVecEnv {
     }
 }
 
-/// Puts numpy views of the output buffers at `bufs` into `d`: `obs [E,N,D]`, `rewards`,
-/// `terminated`, `truncated`, `shield [E,N]`, `final_obs [E,N,D]`, `final_mask [E]`, and `state [E,S]`
-/// and `patch [E,N,P,P,3]` where `spec` has them.
-///
-/// # Safety
-/// The buffers must be those of an `Outputs` made for `spec` and stay valid for as long as `owner`
-/// lives.
-pub(crate) unsafe fn output_views<'py>(
-    d: &Bound<'py, PyDict>,
-    owner: &Bound<'py, PyAny>,
-    bufs: &colcos_env::BufferPtrs,
-    spec: &colcos_env::EnvSpec,
-) -> PyResult<()> {
-    let (e, n) = (spec.num_envs, spec.num_agents);
-    let obs = vec![e, n, spec.observation.flat_len()];
-    unsafe {
-        d.set_item("obs", view(owner, bufs.obs, obs.clone())?)?;
-        d.set_item("rewards", view(owner, bufs.rewards, vec![e, n])?)?;
-        d.set_item("terminated", view(owner, bufs.terminated, vec![e, n])?)?;
-        d.set_item("truncated", view(owner, bufs.truncated, vec![e, n])?)?;
-        d.set_item("shield", view(owner, bufs.shield, vec![e, n])?)?;
-        d.set_item("final_obs", view(owner, bufs.final_obs, obs)?)?;
-        d.set_item("final_mask", view(owner, bufs.final_mask, vec![e])?)?;
-        if let Some(s) = &spec.state {
-            d.set_item("state", view(owner, bufs.state, vec![e, s.flat_len()])?)?;
-        }
-        if let Some(Space::Box { shape, .. }) = &spec.patch {
-            let patch = vec![e, n, shape[0], shape[1], shape[2]];
-            d.set_item("patch", view(owner, bufs.patch, patch)?)?;
-        }
-    }
-    Ok(())
-}
-
-/// Actions copied out of numpy (before the env's lock is taken, with the GIL held).
-pub(crate) enum Owned {
-    Continuous(Vec<f32>),
-    Discrete(Vec<i64>),
-}
-
-/// `actions` checked and copied: int64 `[e, n]` (discrete) or float32 `[e, n, 2]`, C-contiguous or
-/// not.
-/// The width of a continuous action row, or None for discrete actions.
-pub(crate) fn action_width(space: &Space) -> Option<usize> {
-    match space {
-        Space::Box { shape, .. } => Some(shape.iter().product()),
-        Space::Discrete { .. } => None,
-    }
-}
-
-pub(crate) fn owned_actions(
-    actions: &Bound<'_, PyAny>,
-    e: usize,
-    n: usize,
-    width: Option<usize>,
-) -> PyResult<Owned> {
-    let Some(w) = width else {
-        let a: PyReadonlyArrayDyn<'_, i64> = actions.extract().map_err(|_| {
-            Kind::ActionType.err(format!(
-                "discrete actions must be an int64 numpy array of shape ({e}, {n}) = \
-                 (num_envs, num_agents), got {}",
-                args::show(actions)
-            ))
-        })?;
-        if a.shape() != [e, n] {
-            return Err(Kind::Action.err(format!(
-                "actions have shape {:?}, expected ({e}, {n}) = (num_envs, num_agents)",
-                a.shape()
-            )));
-        }
-        return Ok(Owned::Discrete(a.as_array().iter().copied().collect()));
-    };
-    let row = if w == 2 {
-        "wheels".to_string()
-    } else {
-        format!("2 wheels + {} deposit rates", w - 2)
-    };
-    let a: PyReadonlyArrayDyn<'_, f32> = actions.extract().map_err(|_| {
-        Kind::ActionType.err(format!(
-            "continuous actions must be a float32 numpy array of shape ({e}, {n}, {w}) = \
-             (num_envs, num_agents, {row}), got {}",
-            args::show(actions)
-        ))
-    })?;
-    if a.shape() != [e, n, w] {
-        return Err(Kind::Action.err(format!(
-            "actions have shape {:?}, expected ({e}, {n}, {w}) = (num_envs, num_agents, {row})",
-            a.shape()
-        )));
-    }
-    Ok(Owned::Continuous(match a.as_slice() {
-        Ok(src) => src.to_vec(),
-        Err(_) => a.as_array().iter().copied().collect(),
-    }))
-}
-
 impl PyVecEnv {
     /// A reset mask: a 1-D bool array (or sequence of bools) of length num_envs.
     fn mask(&self, m: &Bound<'_, PyAny>) -> PyResult<Vec<bool>> {
@@ -531,7 +341,7 @@ impl PyVecEnv {
                 a.shape()
             )));
         }
-        Ok(a.as_array().iter().copied().collect())
+        Ok(arena_io::flat(&a))
     }
 }
 

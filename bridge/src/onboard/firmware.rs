@@ -113,25 +113,19 @@ impl OnboardFirmware {
         unsafe { (self.write_params)(params.as_mut_ptr(), offset, count, values.as_ptr()) == 1 }
     }
 
-    /// `<prefix>_encode_with`: the 17 observations the policy sees for raw readings (colour in the
-    /// telemetry's order) and the wheel speeds last chosen.
-    pub fn encode(
-        &self,
-        params: &[f32],
-        colour: &[[u16; 3]; 4],
-        ir_on: &[u16; 3],
-        ir_off: &[u16; 3],
-        last: (f32, f32),
-    ) -> [f32; 17] {
+    /// `<prefix>_encode_with`: the 17 observations the policy sees for raw readings and the wheel
+    /// speeds last chosen.
+    pub fn encode(&self, params: &[f32], raw: &RawReadings, last: (f32, f32)) -> [f32; 17] {
         let mut obs = [0.0f32; 17];
         if params.len() == RUNTIME_LEN {
+            let (colour, ir_on, ir_off) = raw.ptrs();
             // SAFETY: sizes as the header declares them; `obs` holds the 17 outputs.
             unsafe {
                 (self.encode_with)(
                     params.as_ptr(),
-                    colour.as_flattened().as_ptr(),
-                    ir_on.as_ptr(),
-                    ir_off.as_ptr(),
+                    colour,
+                    ir_on,
+                    ir_off,
                     last.0,
                     last.1,
                     obs.as_mut_ptr(),
@@ -143,30 +137,44 @@ impl OnboardFirmware {
 
     /// `<prefix>_step_with`: the wheel speeds (m/s) the policy chooses from raw readings, `last` the
     /// speeds it chose before.
-    pub fn step(
-        &self,
-        params: &[f32],
-        colour: &[[u16; 3]; 4],
-        ir_on: &[u16; 3],
-        ir_off: &[u16; 3],
-        last: (f32, f32),
-    ) -> (f32, f32) {
+    pub fn step(&self, params: &[f32], raw: &RawReadings, last: (f32, f32)) -> (f32, f32) {
         if params.len() != RUNTIME_LEN {
             return (0.0, 0.0);
         }
         let (mut left, mut right) = last;
+        let (colour, ir_on, ir_off) = raw.ptrs();
         // SAFETY: sizes as the header declares them: 59 params, 12 colour counts, 3 + 3 bumper counts.
         unsafe {
             (self.step_with)(
                 params.as_ptr(),
-                colour.as_flattened().as_ptr(),
-                ir_on.as_ptr(),
-                ir_off.as_ptr(),
+                colour,
+                ir_on,
+                ir_off,
                 &mut left,
                 &mut right,
             )
         };
         (left, right)
+    }
+}
+
+/// A robot's raw readings as its firmware takes them: the colour counts (in the telemetry's order)
+/// and the IR bumpers' counts with the emitters on and off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RawReadings {
+    pub colour: [[u16; 3]; 4],
+    pub ir_on: [u16; 3],
+    pub ir_off: [u16; 3],
+}
+
+impl RawReadings {
+    /// The arrays as the C takes them: 12 colour counts, 3 and 3 bumper counts.
+    fn ptrs(&self) -> (*const u16, *const u16, *const u16) {
+        (
+            self.colour.as_flattened().as_ptr(),
+            self.ir_on.as_ptr(),
+            self.ir_off.as_ptr(),
+        )
     }
 }
 

@@ -1,7 +1,7 @@
 //! The twin's robots as firmware with an on-board policy: each keeps its own runtime parameter
 //! block, takes `PWP` and `PRN`, runs the policy on its own readings every control tick while it is
 //! on, and goes back to the host's commands on any motion command or when its link falls silent.
-use super::OnboardFirmware;
+use super::{OnboardFirmware, RawReadings};
 use crate::protocol::colias::{HostCommand, OnboardStatus, PolicyMode};
 use colcos_sim::behaviour::WheelCommand;
 
@@ -89,17 +89,11 @@ impl OnboardFleet {
     }
 
     /// One control tick of robot `i`'s policy on its raw readings: the wheel command it drives with.
-    pub fn control(
-        &mut self,
-        i: usize,
-        colour: &[[u16; 3]; 4],
-        ir_on: &[u16; 3],
-        ir_off: &[u16; 3],
-    ) -> WheelCommand {
+    pub fn control(&mut self, i: usize, raw: &RawReadings) -> WheelCommand {
         let Some(r) = self.robots.get_mut(i) else {
             return WheelCommand::STOP;
         };
-        r.last = self.firmware.step(&r.params, colour, ir_on, ir_off, r.last);
+        r.last = self.firmware.step(&r.params, raw, r.last);
         WheelCommand {
             left: r.last.0,
             right: r.last.1,

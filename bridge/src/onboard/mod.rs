@@ -9,7 +9,7 @@ mod fleet;
 mod manifest;
 mod upload;
 
-pub use firmware::OnboardFirmware;
+pub use firmware::{OnboardFirmware, RawReadings};
 pub use fleet::OnboardFleet;
 pub use manifest::{ManifestEncoding, OnboardManifest};
 pub use upload::robot_params;

@@ -2,7 +2,7 @@
 //! channel (a pseudo-terminal, so the bridge's real serial code runs, or UDP), applies them to the
 //! simulated robots, and answers data requests with 96-byte telemetry frames.
 use super::plant::{FIRMWARE_TIMEOUT, TwinArena};
-use crate::onboard::OnboardFleet;
+use crate::onboard::{OnboardFleet, RawReadings};
 use crate::protocol::colias::{
     BROADCAST_ID, COMMAND_LEN, CommandPacket, FrameDecoder, HostCommand, MotionKind, Telemetry,
     colour_from_sim,
@@ -246,8 +246,15 @@ impl RobotEnd {
                 continue;
             }
             let colour = colour_from_sim(plant.colour_counts(i, frame));
-            let (on, off) = bumper_counts(plant.bumpers(i));
-            let cmd = fleet.control(i, &colour, &on, &off);
+            let (ir_on, ir_off) = bumper_counts(plant.bumpers(i));
+            let cmd = fleet.control(
+                i,
+                &RawReadings {
+                    colour,
+                    ir_on,
+                    ir_off,
+                },
+            );
             plant.drive(i, cmd);
         }
     }

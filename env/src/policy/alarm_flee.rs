@@ -3,7 +3,7 @@
 //! An agent that senses the predator (`predator_near`, entry 17) lays `alarm` and runs straight on
 //! at full speed; one that reads alarm flees down its gradient; otherwise it keeps still, which
 //! draws no predator toward it. Bumps turn it away as in every baseline.
-use super::{AgentPolicy, Walker, gradient_angle, steer, strength};
+use super::{AgentPolicy, Walker, down_gradient_angle, steer, strength};
 use colcos_sim::rng::SimRng;
 
 /// The alarm channel of the built-in scenario (red).
@@ -19,14 +19,11 @@ pub struct AlarmFlee {
 impl AgentPolicy for AlarmFlee {
     fn act(&mut self, obs: &[f32], _rng: &mut SimRng, out: &mut [f32]) {
         let near = obs.get(17).is_some_and(|&v| v > 0.5);
-        for rate in out.iter_mut().skip(2) {
-            *rate = near as u8 as f32;
-        }
+        out[2..].fill(near as u8 as f32);
         let (l, r) = if let Some(w) = self.walker.avoid(obs) {
             w
         } else if strength(obs, ALARM) > ALERT {
-            let up = gradient_angle(obs, ALARM);
-            steer(1.0, up - up.signum() * std::f32::consts::PI, 0.1)
+            steer(1.0, down_gradient_angle(obs, ALARM), 0.1)
         } else if near {
             (1.0, 1.0)
         } else {

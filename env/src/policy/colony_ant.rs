@@ -6,7 +6,7 @@
 //! (ants reverse at the food and at the nest), which puts it on the trail it has just laid. Off any
 //! trail it walks at random. Expects the built-in scenario's channels (home red, food green, nest
 //! blue) and deposit actions (food, then home), and the carrying flag at entry 17.
-use super::{AgentPolicy, Walker, gradient_angle, level, steer, strength};
+use super::{AgentPolicy, Walker, down_gradient_angle, gradient_angle, level, steer, strength};
 use colcos_sim::rng::SimRng;
 
 const HOME: usize = 0;
@@ -55,8 +55,7 @@ impl AgentPolicy for ColonyAnt {
             let (l, r) = along(obs, FOOD);
             // Leave the nest behind: the food trail leads away from it.
             let away = if strength(obs, NEST) > TRAIL {
-                let a = gradient_angle(obs, NEST);
-                (0.05 * (a - a.signum() * std::f32::consts::PI)).clamp(-0.1, 0.1)
+                (0.05 * down_gradient_angle(obs, NEST)).clamp(-0.1, 0.1)
             } else {
                 0.0
             };

@@ -3,9 +3,8 @@
 //! The agent always lays `visited` (its only deposit action) and walks at random; where its sensors
 //! read `visited` it steers down the trail's gradient, into ground nobody has marked. Its own fresh
 //! trail lies behind it, so that gradient pushes it on rather than turning it.
-use super::{AgentPolicy, Walker, gradient_angle, steer, strength};
+use super::{AgentPolicy, Walker, down_gradient_angle, steer, strength};
 use colcos_sim::rng::SimRng;
-use std::f32::consts::PI;
 
 /// The visited channel of the built-in scenario (green).
 const VISITED: usize = 1;
@@ -20,14 +19,11 @@ pub struct CoverageWalk {
 
 impl AgentPolicy for CoverageWalk {
     fn act(&mut self, obs: &[f32], rng: &mut SimRng, out: &mut [f32]) {
-        for rate in out.iter_mut().skip(2) {
-            *rate = 1.0;
-        }
+        out[2..].fill(1.0);
         let (l, r) = if let Some(w) = self.walker.avoid(obs) {
             w
         } else if strength(obs, VISITED) > SEEN {
-            let up = gradient_angle(obs, VISITED);
-            steer(SPEED, up - up.signum() * PI, 0.15)
+            steer(SPEED, down_gradient_angle(obs, VISITED), 0.15)
         } else {
             self.walker.walk(SPEED, rng)
         };

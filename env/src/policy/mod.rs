@@ -69,6 +69,12 @@ fn gradient_angle(obs: &[f32], c: usize) -> f32 {
     (level(obs, 2, c) - level(obs, 0, c)).atan2(level(obs, 1, c) - level(obs, 3, c))
 }
 
+/// Egocentric direction of the falling gradient of channel `c`: away from its source.
+fn down_gradient_angle(obs: &[f32], c: usize) -> f32 {
+    let up = gradient_angle(obs, c);
+    up - up.signum() * std::f32::consts::PI
+}
+
 /// Wheels (fractions) driving at `speed` while turning toward egocentric angle `angle`.
 fn steer(speed: f32, angle: f32, gain: f32) -> (f32, f32) {
     let turn = (gain * angle).clamp(-0.3, 0.3);

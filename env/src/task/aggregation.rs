@@ -16,7 +16,7 @@
 //! leader (the aggregation phase: gather). The first term is dense and depends on the follower's own
 //! action only, which is what makes the task learnable in minutes; the others are the state's cost.
 //! No termination: episodes end by truncation.
-use super::{Task, check_non_negative, parse_params, require_role};
+use super::{Outcome, Task, TaskState, check_non_negative, parse_params, require_role};
 use crate::error::Result;
 use colcos_sim::channel::Channel;
 use colcos_sim::scenario::Scenario;
@@ -74,12 +74,8 @@ pub struct Aggregation {
     agents: Vec<usize>,
     leader: usize,
     predators: Vec<usize>,
-    capture_distance: f32,
-    capture_penalty: f32,
-    distance_weight: f32,
-    progress_weight: f32,
-    alarm_weight: f32,
-    alarm_threshold: f32,
+    /// The parameters as given, each weight and distance checked.
+    p: Params,
     alarm_channel: usize,
     inv_diagonal: f32,
 }
@@ -90,18 +86,22 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
     let leader = require_role(scenario, &p.leader_role, "aggregation.leader_role")?[0];
     // A scenario without a predator is allowed: pure aggregation.
     let predators = super::robots_with_role(scenario, &p.predator_role);
-    let alarm_channel = p.alarm_channel.index();
+    for (key, v) in [
+        ("capture_distance", p.capture_distance),
+        ("capture_penalty", p.capture_penalty),
+        ("distance_weight", p.distance_weight),
+        ("progress_weight", p.progress_weight),
+        ("alarm_weight", p.alarm_weight),
+        ("alarm_threshold", p.alarm_threshold),
+    ] {
+        check_non_negative(&format!("aggregation.{key}"), v)?;
+    }
     Ok(Box::new(Aggregation {
         agents,
         leader,
         predators,
-        capture_distance: check_non_negative("aggregation.capture_distance", p.capture_distance)?,
-        capture_penalty: check_non_negative("aggregation.capture_penalty", p.capture_penalty)?,
-        distance_weight: check_non_negative("aggregation.distance_weight", p.distance_weight)?,
-        progress_weight: check_non_negative("aggregation.progress_weight", p.progress_weight)?,
-        alarm_weight: check_non_negative("aggregation.alarm_weight", p.alarm_weight)?,
-        alarm_threshold: check_non_negative("aggregation.alarm_threshold", p.alarm_threshold)?,
-        alarm_channel,
+        alarm_channel: p.alarm_channel.index(),
+        p,
         inv_diagonal: 1.0 / scenario.arena_size().length().max(1e-6),
     }))
 }
@@ -128,13 +128,7 @@ impl Task for Aggregation {
     fn agents(&self) -> &[usize] {
         &self.agents
     }
-    fn evaluate(
-        &self,
-        world: &dyn ArenaView,
-        _state: &mut super::TaskState,
-        rewards: &mut [f32],
-        _terminated: &mut [bool],
-    ) {
+    fn evaluate(&self, world: &dyn ArenaView, _state: &mut TaskState, out: Outcome<'_>) {
         let poses = world.poses();
         let robots = world.robots();
         let obs = world.observations();
@@ -145,14 +139,14 @@ impl Task for Aggregation {
             0.0
         };
         let leader = poses[self.leader].pos;
-        let c2 = self.capture_distance * self.capture_distance;
+        let c2 = self.p.capture_distance * self.p.capture_distance;
         let c = self.alarm_channel;
-        for (r, &i) in rewards.iter_mut().zip(&self.agents) {
+        for (r, &i) in out.rewards.iter_mut().zip(&self.agents) {
             let p = poses[i].pos;
             let to_leader = leader - p;
             let d = to_leader.length();
             let (alarm, grad) = level_and_gradient(world, c, p);
-            let goal = if alarm > self.alarm_threshold {
+            let goal = if alarm > self.p.alarm_threshold {
                 -grad.normalize_or_zero()
             } else {
                 to_leader.normalize_or_zero()
@@ -161,15 +155,15 @@ impl Task for Aggregation {
             let velocity = Vec2::from_angle(poses[i].heading) * forward;
             let free = (1.0 - obs[i].max_bumper()).clamp(0.0, 1.0);
             let progress = (velocity.dot(goal) * inv_max_speed).clamp(-1.0, 1.0) * free;
-            let mut reward = self.progress_weight * progress
-                - self.distance_weight * d * self.inv_diagonal
-                - self.alarm_weight * alarm.min(1.0);
+            let mut reward = self.p.progress_weight * progress
+                - self.p.distance_weight * d * self.inv_diagonal
+                - self.p.alarm_weight * alarm.min(1.0);
             if self
                 .predators
                 .iter()
                 .any(|&k| poses[k].pos.distance_squared(p) < c2)
             {
-                reward -= self.capture_penalty;
+                reward -= self.p.capture_penalty;
             }
             *r = reward;
         }
@@ -218,7 +212,11 @@ mod tests {
             world.step_with_commands(&commands);
         }
         let mut rewards = [0.0];
-        task.evaluate(&world, &mut Vec::new(), &mut rewards, &mut [false]);
+        let out = Outcome {
+            rewards: &mut rewards,
+            terminated: &mut [false],
+        };
+        task.evaluate(&world, &mut Vec::new(), out);
         rewards[0]
     }
 

@@ -14,7 +14,8 @@
 //! No termination: a captured agent may escape and be safe again. A scenario without a robot of
 //! `predator_role` is refused (nothing would threaten the agents).
 use super::{
-    ExtraObs, Task, TaskState, check_non_negative, check_positive, parse_params, require_role,
+    ExtraObs, Outcome, Task, TaskState, check_non_negative, check_positive, parse_params,
+    require_role,
 };
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
@@ -26,11 +27,7 @@ pub const DESCRIPTION: &str =
     "stay out of a roaming predator's reach; agents near it may lay an alarm that warns the others";
 pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/alarm.toml");
 
-const EXTRA: &[ExtraObs] = &[ExtraObs {
-    name: "predator_near",
-    low: 0.0,
-    high: 1.0,
-}];
+const EXTRA: &[ExtraObs] = &[ExtraObs::flag("predator_near")];
 
 #[derive(Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -112,21 +109,15 @@ impl Task for Alarm {
         let poses = world.poses();
         out[0] = (self.nearest2(poses, poses[self.agents[k]].pos) <= self.sense2) as u8 as f32;
     }
-    fn evaluate(
-        &self,
-        world: &dyn ArenaView,
-        _state: &mut TaskState,
-        rewards: &mut [f32],
-        _terminated: &mut [bool],
-    ) {
+    fn evaluate(&self, world: &dyn ArenaView, _state: &mut TaskState, out: Outcome<'_>) {
         let poses = world.poses();
         let mut safe = 0usize;
-        for (r, &i) in rewards.iter_mut().zip(&self.agents) {
+        for (r, &i) in out.rewards.iter_mut().zip(&self.agents) {
             let captured = self.nearest2(poses, poses[i].pos) <= self.capture2;
             safe += !captured as usize;
             *r = if captured { -self.capture_penalty } else { 0.0 };
         }
         let team = self.safe_reward * safe as f32 / self.agents.len() as f32;
-        rewards.iter_mut().for_each(|r| *r += team);
+        out.rewards.iter_mut().for_each(|r| *r += team);
     }
 }

@@ -16,8 +16,8 @@
 //! the lowest agent index that reaches it in that step. In the built-in scenario the agents may lay
 //! `food` (green) and `home` (red) trails; the nest glows blue (a fixed Gaussian source).
 use super::{
-    ExtraObs, Task, TaskState, check_non_negative, check_positive, parse_params, point_in_arena,
-    require_role,
+    ExtraObs, Outcome, Task, TaskState, check_non_negative, check_positive, parse_params,
+    point_in_arena, points_in_arena, require_role,
 };
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
@@ -28,11 +28,7 @@ use serde::Deserialize;
 pub const DESCRIPTION: &str = "central-place foraging: carry food from finite patches to the nest, laying food and home trails";
 pub const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/colony.toml");
 
-const EXTRA: &[ExtraObs] = &[ExtraObs {
-    name: "carrying",
-    low: 0.0,
-    high: 1.0,
-}];
+const EXTRA: &[ExtraObs] = &[ExtraObs::flag("carrying")];
 
 #[derive(Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -122,14 +118,11 @@ impl Colony {
         if p.food_amount == 0 {
             return Err(EnvError::param("colony.food_amount", "must be at least 1"));
         }
-        let food = (p.food.iter().enumerate())
-            .map(|(j, q)| point_in_arena(scenario, &format!("colony.food[{j}]"), *q))
-            .collect::<Result<Vec<_>>>()?;
         Ok(Colony {
             agents,
             nest: point_in_arena(scenario, "colony.nest", p.nest)?,
             nest_radius: check_positive("colony.nest_radius", p.nest_radius)?,
-            food,
+            food: points_in_arena(scenario, "colony.food", &p.food)?,
             food_radius: check_positive("colony.food_radius", p.food_radius)?,
             food_amount: p.food_amount,
             delivery_reward: check_non_negative("colony.delivery_reward", p.delivery_reward)?,
@@ -165,18 +158,12 @@ impl Task for Colony {
     fn observe(&self, _world: &dyn ArenaView, state: &[u32], k: usize, out: &mut [f32]) {
         out[0] = self.layout().carrying(state, k) as u8 as f32;
     }
-    fn evaluate(
-        &self,
-        world: &dyn ArenaView,
-        state: &mut TaskState,
-        rewards: &mut [f32],
-        _terminated: &mut [bool],
-    ) {
+    fn evaluate(&self, world: &dyn ArenaView, state: &mut TaskState, out: Outcome<'_>) {
         let poses = world.poses();
         let patches = self.food.len();
         let (nest2, food2) = (self.nest_radius.powi(2), self.food_radius.powi(2));
         let mut delivered = 0u32;
-        for (k, (r, &i)) in rewards.iter_mut().zip(&self.agents).enumerate() {
+        for (k, (r, &i)) in out.rewards.iter_mut().zip(&self.agents).enumerate() {
             let p = poses[i].pos;
             *r = -self.step_penalty;
             let carry = patches + k;
@@ -196,7 +183,7 @@ impl Task for Colony {
         state[patches + self.agents.len()] += delivered;
         if delivered > 0 {
             let team = self.delivery_reward * delivered as f32;
-            rewards.iter_mut().for_each(|r| *r += team);
+            out.rewards.iter_mut().for_each(|r| *r += team);
         }
     }
 }

@@ -13,7 +13,9 @@
 //! so an episode's team return is `cell_reward` times the cells covered (minus the bumps): each
 //! cell pays once per episode. No termination. The observation has no extra entry: the only memory
 //! of where the team has been is what it lays.
-use super::{Task, TaskState, check_non_negative, check_positive, parse_params, require_role};
+use super::{
+    Outcome, Task, TaskState, check_non_negative, check_positive, parse_params, require_role,
+};
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
@@ -110,13 +112,7 @@ impl Task for Coverage {
     fn initial_state(&self) -> TaskState {
         vec![0; self.cells() + 1]
     }
-    fn evaluate(
-        &self,
-        world: &dyn ArenaView,
-        state: &mut TaskState,
-        rewards: &mut [f32],
-        _terminated: &mut [bool],
-    ) {
+    fn evaluate(&self, world: &dyn ArenaView, state: &mut TaskState, out: Outcome<'_>) {
         let poses = world.poses();
         let obs = world.observations();
         let inv = 1.0 / self.cell;
@@ -135,7 +131,7 @@ impl Task for Coverage {
         let count = self.cells();
         state[count] += new;
         let team = self.cell_reward * new as f32;
-        for (r, &i) in rewards.iter_mut().zip(&self.agents) {
+        for (r, &i) in out.rewards.iter_mut().zip(&self.agents) {
             *r = team - self.bump_penalty * obs[i].max_bumper();
         }
     }

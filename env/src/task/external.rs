@@ -2,7 +2,7 @@
 //! by a `colcos.Task` written in Python, once per batched step over every world (see
 //! `VecEnv::step_deferred` and `VecEnv::conclude`). Here only the agents are chosen: the robots
 //! whose group has role `agent_role`.
-use super::{Task, parse_params, require_role};
+use super::{Outcome, Task, TaskState, parse_params, require_role};
 use crate::error::Result;
 use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
@@ -57,13 +57,7 @@ impl Task for External {
     }
     /// Nothing of its own: a deferred step's rewards and terminations are given to
     /// `VecEnv::conclude`; a plain step hands out none.
-    fn evaluate(
-        &self,
-        _world: &dyn ArenaView,
-        _state: &mut super::TaskState,
-        rewards: &mut [f32],
-        _terminated: &mut [bool],
-    ) {
-        rewards.fill(0.0);
+    fn evaluate(&self, _world: &dyn ArenaView, _state: &mut TaskState, out: Outcome<'_>) {
+        out.rewards.fill(0.0);
     }
 }

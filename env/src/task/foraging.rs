@@ -5,7 +5,9 @@
 //! agent terminates when it reaches a branch end: `+food_reward` at a food end, `-wrong_end_penalty`
 //! at any other; every step costs `step_penalty`. At reset the static maps are brought to their
 //! steady state `e J` (the paper assumes the trails are already laid).
-use super::{Task, check_non_negative, parse_params, require_role};
+use super::{
+    Outcome, Task, TaskState, check_non_negative, parse_params, points_in_arena, require_role,
+};
 use crate::error::{EnvError, Result};
 use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
@@ -70,27 +72,10 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
             "give at least one food end [[x, y], ...]",
         ));
     }
-    let arena = scenario.arena_size();
-    let points = |key: &str, v: &[[f32; 2]]| -> Result<Vec<Vec2>> {
-        v.iter()
-            .enumerate()
-            .map(|(k, q)| {
-                let q = Vec2::from(*q);
-                if q.is_finite() && q.x >= 0.0 && q.y >= 0.0 && q.x <= arena.x && q.y <= arena.y {
-                    Ok(q)
-                } else {
-                    Err(EnvError::param(
-                        format!("foraging.{key}[{k}]"),
-                        format!("{q} lies outside the arena {arena}"),
-                    ))
-                }
-            })
-            .collect()
-    };
     Ok(Box::new(Foraging {
         agents,
-        food: points("food", &p.food)?,
-        empty: points("empty", &p.empty)?,
+        food: points_in_arena(scenario, "foraging.food", &p.food)?,
+        empty: points_in_arena(scenario, "foraging.empty", &p.empty)?,
         reach_distance: check_non_negative("foraging.reach_distance", p.reach_distance)?,
         food_reward: check_non_negative("foraging.food_reward", p.food_reward)?,
         wrong_end_penalty: check_non_negative("foraging.wrong_end_penalty", p.wrong_end_penalty)?,
@@ -112,18 +97,13 @@ impl Task for Foraging {
         }
         super::prefill_static_maps(pheromones)
     }
-    fn evaluate(
-        &self,
-        world: &dyn ArenaView,
-        _state: &mut super::TaskState,
-        rewards: &mut [f32],
-        terminated: &mut [bool],
-    ) {
+    fn evaluate(&self, world: &dyn ArenaView, _state: &mut TaskState, out: Outcome<'_>) {
         let poses = world.poses();
         let r2 = self.reach_distance * self.reach_distance;
-        for ((r, t), &i) in rewards
+        for ((r, t), &i) in out
+            .rewards
             .iter_mut()
-            .zip(terminated.iter_mut())
+            .zip(out.terminated.iter_mut())
             .zip(&self.agents)
         {
             let p = poses[i].pos;

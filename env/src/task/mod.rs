@@ -32,6 +32,17 @@ pub struct ExtraObs {
     pub high: f32,
 }
 
+impl ExtraObs {
+    /// A 0-or-1 entry.
+    pub const fn flag(name: &'static str) -> Self {
+        ExtraObs {
+            name,
+            low: 0.0,
+            high: 1.0,
+        }
+    }
+}
+
 /// An RL problem over a scenario.
 pub trait Task: Send + Sync {
     /// Registry name (`"aggregation"`).
@@ -54,15 +65,15 @@ pub trait Task: Send + Sync {
     /// Writes agent `k`'s extra observation entries (`out`: one per [`Self::extra_observations`]).
     /// `state` is empty before the episode's first step.
     fn observe(&self, _world: &dyn ArenaView, _state: &[u32], _k: usize, _out: &mut [f32]) {}
-    /// Rewards after a step, one per agent, and which agents have reached a terminal state. Entries of
-    /// `terminated` are only ever set to true here, never cleared. `state` is this episode's memory.
-    fn evaluate(
-        &self,
-        world: &dyn ArenaView,
-        state: &mut TaskState,
-        rewards: &mut [f32],
-        terminated: &mut [bool],
-    );
+    /// Writes the step's [`Outcome`] in `world`; `state` is this episode's memory.
+    fn evaluate(&self, world: &dyn ArenaView, state: &mut TaskState, out: Outcome<'_>);
+}
+
+/// What a task hands out after a step: a reward per agent, and which agents have reached a terminal
+/// state (entries only ever set to true, never cleared).
+pub struct Outcome<'a> {
+    pub rewards: &'a mut [f32],
+    pub terminated: &'a mut [bool],
 }
 
 /// Deserialises a task's parameter object, naming the key at fault; unknown keys are refused.
@@ -135,6 +146,14 @@ pub fn point_in_arena(scenario: &Scenario, key: &str, q: [f32; 2]) -> Result<gla
             format!("{q} lies outside the arena {arena}"),
         ))
     }
+}
+
+/// The points `qs` of parameter `key` (`key[0]`, `key[1]`, ...), each refused unless it lies in the
+/// scenario's arena.
+pub fn points_in_arena(scenario: &Scenario, key: &str, qs: &[[f32; 2]]) -> Result<Vec<glam::Vec2>> {
+    (qs.iter().enumerate())
+        .map(|(j, q)| point_in_arena(scenario, &format!("{key}[{j}]"), *q))
+        .collect()
 }
 
 /// A finite, positive parameter.

@@ -6,7 +6,7 @@
 //!
 //! `maze = true` runs the loop as a walled corridor (the built-in `trail_maze` scenario: an island and
 //! an outer wall, `[[obstacles]]`); the bumper penalty then also counts the walls.
-use super::{Task, check_non_negative, parse_params, require_role};
+use super::{Outcome, Task, TaskState, check_non_negative, parse_params, require_role};
 use crate::error::{EnvError, Result};
 use colcos_sim::channel::Channel;
 use colcos_sim::field::Pheromone;
@@ -91,16 +91,10 @@ impl Task for Trail {
     fn on_reset(&self, pheromones: &mut [Pheromone]) -> bool {
         super::prefill_static_maps(pheromones)
     }
-    fn evaluate(
-        &self,
-        world: &dyn ArenaView,
-        _state: &mut super::TaskState,
-        rewards: &mut [f32],
-        _terminated: &mut [bool],
-    ) {
+    fn evaluate(&self, world: &dyn ArenaView, _state: &mut TaskState, out: Outcome<'_>) {
         let obs = world.observations();
         let params = world.robot_params();
-        for (r, &i) in rewards.iter_mut().zip(&self.agents) {
+        for (r, &i) in out.rewards.iter_mut().zip(&self.agents) {
             let (forward, _) = world.robots()[i].drive.body_velocity(params);
             let o = &obs[i];
             *r = forward * self.inv_max_speed * o.strength(self.channel)

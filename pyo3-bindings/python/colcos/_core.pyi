@@ -1,6 +1,7 @@
 """Type stubs of the native module `colcos._core`."""
 
-from typing import Any
+import os
+from typing import Any, TypedDict, Unpack
 
 import numpy as np
 import numpy.typing as npt
@@ -34,82 +35,67 @@ def discrete_actions() -> list[tuple[float, float]]: ...
 def _test_panic(msg: str) -> None: ...
 def rig_identify(log: str, scenario: str, out: str | None = None, pose_delay: float | None = None) -> str: ...
 
-class VecEnv:
-    def __init__(
-        self,
-        task: str,
-        num_envs: int | None = None,
-        seed: int | None = None,
-        num_threads: int | None = None,
-        scenario: str | None = None,
-        scenario_text: str | None = None,
-        max_cycles: int | None = None,
-        action: str | None = None,
-        autoreset_mode: str | None = None,
-        global_state: bool | None = None,
-        patch_pixels: int | None = None,
-        patch_side: float | None = None,
-        params_json: str | None = None,
-        backend: str | None = None,
-        physics: str | None = None,
-    ) -> None: ...
+class _WorldOptions(TypedDict, total=False):
+    """The keyword arguments of `VecEnv` and `Plant` alike (None: the default)."""
+
+    seed: int | None
+    scenario: str | os.PathLike[str] | None
+    scenario_text: str | None
+    max_cycles: int | None
+    action: str | None
+    global_state: bool | None
+    patch_pixels: int | None
+    patch_side: float | None
+    params_json: str | None
+    backend: str | None
+    physics: str | None
+
+class _BatchOptions(_WorldOptions, total=False):
+    num_envs: int | None
+    num_threads: int | None
+    autoreset_mode: str | None
+
+class _PlantOptions(_WorldOptions, total=False):
+    tracker: str | None
+    robots: str | None
+    log: str | os.PathLike[str] | None
+    goto: bool | None
+    goto_timeout: float | None
+    twin_scenario: str | None
+    twin_scenario_text: str | None
+    twin_overrides_json: str | None
+    truth: str | None
+
+class _Arena:
+    """What `VecEnv` and `Plant` both offer (a base of the stubs only: each is its own class)."""
+
     @property
     def backend_name(self) -> str: ...
     @property
     def backend_info(self) -> str: ...
     def spec(self) -> dict[str, Any]: ...
     def views(self) -> dict[str, np.ndarray]: ...
-    def reset(self, seed: int | None = None, mask: npt.NDArray[np.bool_] | None = None) -> None: ...
     def step(self, actions: np.ndarray) -> None: ...
     def render(self, world: int | None = None, width: int | None = None) -> npt.NDArray[np.uint8]: ...
+    def scenario_toml(self) -> str: ...
+
+class VecEnv(_Arena):
+    def __init__(self, task: str, **options: Unpack[_BatchOptions]) -> None: ...
+    def reset(self, seed: int | None = None, mask: npt.NDArray[np.bool_] | None = None) -> None: ...
     def episode_steps(self, world: int) -> int: ...
     def episode(self, world: int) -> int: ...
     def poses(self, world: int) -> npt.NDArray[np.float32]: ...
     def roles(self) -> list[str]: ...
-    def scenario_toml(self) -> str: ...
     @property
     def seed(self) -> int: ...
 
-class Plant:
-    def __init__(
-        self,
-        plant: str,
-        task: str,
-        tracker: str | None = None,
-        robots: str | None = None,
-        log: str | None = None,
-        goto: bool = True,
-        goto_timeout: float = 30.0,
-        seed: int | None = None,
-        scenario: str | None = None,
-        scenario_text: str | None = None,
-        max_cycles: int | None = None,
-        action: str | None = None,
-        global_state: bool | None = None,
-        patch_pixels: int | None = None,
-        patch_side: float | None = None,
-        params_json: str | None = None,
-        backend: str | None = None,
-        physics: str | None = None,
-        twin_scenario: str | None = None,
-        twin_scenario_text: str | None = None,
-        twin_overrides_json: str | None = None,
-        truth: str | None = None,
-    ) -> None: ...
-    @property
-    def backend_name(self) -> str: ...
-    @property
-    def backend_info(self) -> str: ...
-    def spec(self) -> dict[str, Any]: ...
-    def views(self) -> dict[str, np.ndarray]: ...
+class Plant(_Arena):
+    def __init__(self, plant: str, task: str, **options: Unpack[_PlantOptions]) -> None: ...
     def reset(self, seed: int | None = None, mask: None = None) -> None: ...
-    def step(self, actions: np.ndarray) -> None: ...
-    def render(self, world: int | None = None, width: int | None = None) -> npt.NDArray[np.uint8]: ...
     def episode_steps(self, world: int = 0) -> int: ...
     def episode(self, world: int = 0) -> int: ...
     def poses(self, world: int = 0) -> npt.NDArray[np.float32]: ...
     def plant_info(self) -> dict[str, Any]: ...
-    def scenario_toml(self) -> str: ...
     def stop(self, reason: str = ...) -> None: ...
     def close(self, reason: str = ...) -> None: ...
     @property
