@@ -19,6 +19,11 @@ fn inside(phys: &ArenaPhysics, size: Vec2, r: f32) {
 }
 
 /// A grid of robots with spacing `gap` (m) between centres.
+/// Robots with the default body at `poses` in a 1 m x 1 m arena, moved by `backend`.
+fn unit_arena(poses: &[Pose], backend: PhysicsBackend) -> ArenaPhysics {
+    ArenaPhysics::with_backend(Vec2::ONE, &ColiasParams::default(), poses, backend)
+}
+
 fn grid(n: usize, size: Vec2, gap: f32) -> Vec<Pose> {
     let cols = ((size.x - 2.0 * gap) / gap).floor().max(1.0) as usize;
     (0..n)
@@ -82,10 +87,7 @@ fn a_hundred_robots_pushed_into_a_wall_stay_inside() {
 fn head_on_robots_do_not_overlap() {
     for backend in BACKENDS {
         let p = ColiasParams::default();
-        let size = Vec2::new(1.0, 1.0);
-        let mut phys = ArenaPhysics::with_backend(
-            size,
-            &p,
+        let mut phys = unit_arena(
             &[
                 Pose::new(0.3, 0.5, 0.0),
                 Pose::new(0.7, 0.5, std::f32::consts::PI),
@@ -110,12 +112,7 @@ fn head_on_robots_do_not_overlap() {
 fn set_pose_teleports() {
     for backend in BACKENDS {
         let p = ColiasParams::default();
-        let mut phys = ArenaPhysics::with_backend(
-            Vec2::new(1.0, 1.0),
-            &p,
-            &[Pose::new(0.3, 0.5, 0.0)],
-            backend,
-        );
+        let mut phys = unit_arena(&[Pose::new(0.3, 0.5, 0.0)], backend);
         assert_eq!(phys.len(), 1);
         phys.set_pose(0, Pose::new(0.6, 0.4, 1.0));
         assert_eq!(phys.poses()[0], Pose::new(0.6, 0.4, 1.0));
@@ -277,10 +274,9 @@ fn free_steps_match(seed: u32, obstacles: Option<Arc<Obstacles>>) {
 #[test]
 fn constant_speed_in_free_space_is_analytic() {
     for backend in BACKENDS {
-        let p = ColiasParams::default();
         let (v, heading) = (0.2f32, 0.5f32);
         let start = Pose::new(0.3, 0.3, heading);
-        let mut phys = ArenaPhysics::with_backend(Vec2::new(1.0, 1.0), &p, &[start], backend);
+        let mut phys = unit_arena(&[start], backend);
         for _ in 0..50 {
             phys.step(&[(v, 0.0)], DT);
         }
@@ -310,9 +306,7 @@ fn constant_speed_in_free_space_is_analytic() {
 fn robots_pushed_together_overlap_at_most_a_millimetre() {
     for backend in BACKENDS {
         let p = ColiasParams::default();
-        let mut phys = ArenaPhysics::with_backend(
-            Vec2::new(1.0, 1.0),
-            &p,
+        let mut phys = unit_arena(
             &[
                 Pose::new(0.45, 0.5, 0.0),
                 Pose::new(0.55, 0.5, std::f32::consts::PI),

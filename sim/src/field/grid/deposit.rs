@@ -156,14 +156,9 @@ mod tests {
 
     /// The deposit as first written: every cell of the bounding box weighed.
     fn deposit_whole_box(g: &mut GridField, kernel: &Kernel, a: Vec2, b: Vec2, amount: f32) {
-        let GridSpec { nx, ny, cell } = *g.spec();
+        let GridSpec { nx, cell, .. } = *g.spec();
         let support = kernel.support();
-        let (i0, i1) = g
-            .spec
-            .cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
-        let (j0, j1) = g
-            .spec
-            .cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
+        let ((i0, i1), (j0, j1)) = g.spec.segment_cells(a, b, support);
         let (ab, len2) = (b - a, (b - a).length_squared());
         for j in j0..j1 {
             for i in i0..i1 {
