@@ -1,8 +1,9 @@
 //! The screen of eq. (1) composed on the GPU, and the colour sensors' footprint sampling on the GPU.
 //!
 //! A world's screen is a list of [`ScreenLayer`]s (one per pheromone, in the world's order): a grid
-//! field of a [`GpuGrids`] batch, or a set of Gaussian sources. [`GpuScreen::render`] gives the same
-//! 8-bit image as [`colcos_sim::screen::render`]; [`GpuScreen::sense`] gives the same mean levels as
+//! field of a [`GpuGrids`] batch, or a set of Gaussian sources. [`GpuScreen::render_to_buffer`]
+//! composes the same 8-bit image as [`colcos_sim::screen::render`] ([`GpuScreen::read_image`]
+//! reads it back); [`GpuScreen::sense`] gives the same mean levels as
 //! [`colcos_sim::sensors::ColourSensor::screen_levels`] for many sensors of many worlds at once, and only
 //! those readings come back.
 //!
@@ -458,24 +459,17 @@ impl GpuScreen {
         self.image.as_ref().map(|(b, w, h)| (b, *w, *h))
     }
 
-    /// Eq. (1) for world `world` at `width x height`, read back as an image (the same pixels as
-    /// [`colcos_sim::screen::render`]).
-    pub fn render(
-        &mut self,
-        grids: Option<&GpuGrids>,
-        scene: &ScreenScene,
-        world: usize,
-        screen: &ScreenSpec,
-        width: u32,
-        height: u32,
-    ) -> Result<image::RgbImage> {
-        self.render_to_buffer(grids, scene, world, screen, width, height)?;
+    /// The last image of [`GpuScreen::render_to_buffer`] read back (the same pixels as
+    /// [`colcos_sim::screen::render`]); an empty image before the first.
+    pub fn read_image(&self) -> Result<image::RgbImage> {
+        let Some((buf, width, height)) = self.image_buffer() else {
+            return Ok(image::RgbImage::new(0, 0));
+        };
         let mut img = image::RgbImage::new(width, height);
         let pixels = width as u64 * height as u64;
         if pixels == 0 {
             return Ok(img);
         }
-        let buf = &self.image.as_ref().expect("rendered").0;
         let bytes = self.ctx.read_buffer(buf, 0, pixels * 4)?;
         for (o, i) in img.chunks_exact_mut(3).zip(bytes.chunks_exact(4)) {
             o.copy_from_slice(&i[..3]);

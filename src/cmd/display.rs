@@ -225,8 +225,10 @@ pub fn main(args: DisplayArgs) -> Result<()> {
             Some(ctx) => {
                 let mut g = GpuFrames::new(ctx.clone(), &world)?;
                 let scene = g.upload(&world)?;
+                let (grids, screen) = (g.grids.as_ref(), world.screen());
                 g.screen
-                    .render(g.grids.as_ref(), &scene, 0, world.screen(), size.0, size.1)?
+                    .render_to_buffer(grids, &scene, 0, screen, size.0, size.1)?;
+                g.screen.read_image()?
             }
             None => screen::render(world.pheromones(), world.screen(), size.0, size.1),
         };
