@@ -52,14 +52,8 @@ fn wall_seeking_behaviours_are_refused_and_case_two_passes() {
 /// short episode each; `colcos rig check` with its defaults runs three of 20 s).
 #[test]
 fn every_shipped_scenario_passes_the_pre_flight() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
     let mut failed = Vec::new();
-    let mut paths: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    paths.sort();
+    let paths = colcos_testkit::scenarios::shipped(&["scenarios"]);
     assert!(paths.len() >= 10, "{paths:?}");
     for path in paths {
         let (ok, text) = rig_check(&path);

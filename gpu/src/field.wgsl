@@ -177,9 +177,9 @@ fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     let line = line_of(gid, P.ny);
     if (!line.on) { return; }
     let nx = P.nx;
-    let row = line.i;
-    let s = line.s + row * nx;
-    let d = line.d + row * nx;
+    let first = line.i * nx;
+    let s = line.s + first;
+    let d = line.d + first;
     let e = line.e;
     let m = e.coef;
     let cp = e.coef + nx;
@@ -187,7 +187,7 @@ fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var i = 0u; i < nx; i = i + 1u) {
         var fv: f32;
         if (e.inj >= 0) {
-            fv = exact(e.a * vals[s + i]) + exact(e.b * inj[u32(e.inj) + row * nx + i]);
+            fv = exact(e.a * vals[s + i]) + exact(e.b * inj[u32(e.inj) + first + i]);
         } else {
             fv = exact(e.a * vals[s + i]);
         }

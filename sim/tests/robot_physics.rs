@@ -83,28 +83,29 @@ fn a_hundred_robots_pushed_into_a_wall_stay_inside() {
     }
 }
 
+/// The largest overlap (diameter minus centre distance; negative while apart) of two robots that
+/// start facing each other at x = `from` and `to` m (y = 0.5 m) and drive at full speed for 4 s.
+fn head_on_overlap(from: f32, to: f32, backend: PhysicsBackend) -> f32 {
+    let p = ColiasParams::default();
+    let facing = [
+        Pose::new(from, 0.5, 0.0),
+        Pose::new(to, 0.5, std::f32::consts::PI),
+    ];
+    let mut phys = unit_arena(&facing, backend);
+    let mut worst = f32::NEG_INFINITY;
+    for _ in 0..200 {
+        phys.step(&[(p.max_wheel_speed, 0.0); 2], DT);
+        let d = (phys.poses()[0].pos - phys.poses()[1].pos).length();
+        worst = worst.max(2.0 * p.radius - d);
+    }
+    worst
+}
+
 #[test]
 fn head_on_robots_do_not_overlap() {
     for backend in BACKENDS {
-        let p = ColiasParams::default();
-        let mut phys = unit_arena(
-            &[
-                Pose::new(0.3, 0.5, 0.0),
-                Pose::new(0.7, 0.5, std::f32::consts::PI),
-            ],
-            backend,
-        );
-        let mut min_gap = f32::INFINITY;
-        for _ in 0..200 {
-            phys.step(&[(p.max_wheel_speed, 0.0), (p.max_wheel_speed, 0.0)], DT);
-            let d = (phys.poses()[0].pos - phys.poses()[1].pos).length();
-            min_gap = min_gap.min(d);
-        }
-        assert!(
-            min_gap > 2.0 * p.radius - 0.002,
-            "overlap {} m",
-            2.0 * p.radius - min_gap
-        );
+        let overlap = head_on_overlap(0.3, 0.7, backend);
+        assert!(overlap < 0.002, "{backend:?}: overlap {overlap} m");
     }
 }
 
@@ -305,20 +306,7 @@ fn constant_speed_in_free_space_is_analytic() {
 #[test]
 fn robots_pushed_together_overlap_at_most_a_millimetre() {
     for backend in BACKENDS {
-        let p = ColiasParams::default();
-        let mut phys = unit_arena(
-            &[
-                Pose::new(0.45, 0.5, 0.0),
-                Pose::new(0.55, 0.5, std::f32::consts::PI),
-            ],
-            backend,
-        );
-        let mut worst = 0.0f32;
-        for _ in 0..200 {
-            phys.step(&[(p.max_wheel_speed, 0.0); 2], DT);
-            let d = (phys.poses()[0].pos - phys.poses()[1].pos).length();
-            worst = worst.max(2.0 * p.radius - d);
-        }
+        let worst = head_on_overlap(0.45, 0.55, backend);
         assert!(worst <= 1e-3, "{backend:?}: overlap {worst} m");
     }
 }

@@ -246,6 +246,20 @@ pub fn wanderers(speed: f64) -> Scenario {
     )
 }
 
+/// The TOML files in the repository's folders `dirs` (e.g. `scenarios`, `scenarios/sweeps`),
+/// sorted: the scenario and sweep files shipped with it.
+pub fn shipped(dirs: &[&str]) -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut files: Vec<PathBuf> = dirs
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap().flatten())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    files
+}
+
 /// The manifest of the policy exported for the on-board tests (`bridge/tests/data/onboard`, written
 /// by `scripts/onboard_fixture.py`: both wheels at half the largest wheel speed, the left one slowed
 /// by the front-left bumper).
