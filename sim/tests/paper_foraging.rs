@@ -101,50 +101,37 @@ fn follows_the_lap_and_prefers_cyan() {
 fn detects_bifurcations() {
     use BifurcationKind::{CyanBlue, Magenta, Plain};
     let th = 0.3;
-    // (right, front, left, back sensor colours, what is detected, why).
+    // (right, front, left, back sensor colours; what is detected; the case).
     let cases = [
-        (
-            [BLUE_, OFF, BLUE_, BLUE_],
-            Some(Plain),
-            "front off the trail, both sides on it: the wedge between two branches",
-        ),
+        // Front off the trail, both sides on it: the wedge between two branches.
+        ([BLUE_, OFF, BLUE_, BLUE_], Some(Plain), "wedge"),
+        // Different colours left and right.
         (
             [BLUE_, CYAN, CYAN, CYAN],
             Some(CyanBlue),
-            "different colours left and right",
+            "blue right, cyan left",
         ),
         (
             [CYAN, CYAN, BLUE_, CYAN],
             Some(CyanBlue),
-            "different colours right and left",
+            "cyan right, blue left",
         ),
-        (
-            [MAGENTA, CYAN, CYAN, CYAN],
-            Some(Magenta),
-            "magenta on one side",
-        ),
-        ([BLUE_, BLUE_, BLUE_, BLUE_], None, "a plain trail"),
-        ([OFF, BLUE_, BLUE_, BLUE_], None, "the edge of a trail"),
-        (
-            [OFF, OFF, BLUE_, BLUE_],
-            None,
-            "the edge of a trail, front off",
-        ),
+        ([MAGENTA, CYAN, CYAN, CYAN], Some(Magenta), "magenta right"),
+        // A plain trail, or a robot at the edge of one, is not a bifurcation.
+        ([BLUE_, BLUE_, BLUE_, BLUE_], None, "plain trail"),
+        ([OFF, BLUE_, BLUE_, BLUE_], None, "edge, right off"),
+        ([OFF, OFF, BLUE_, BLUE_], None, "edge, right and front off"),
+        // Magenta seen by the front sensor first (the SRP piece starts a few cm into the blue branch).
         (
             [CYAN, MAGENTA, BLUE_, CYAN],
             Some(Magenta),
-            "magenta seen by the front sensor first (the SRP piece starts a few cm into the blue branch)",
+            "magenta in front",
         ),
-        (
-            [MAGENTA, BLUE_, BLUE_, BLUE_],
-            None,
-            "blue beside magenta with the front on the trail: entering an SRP piece at an angle, one trail",
-        ),
-        (
-            [MAGENTA, OFF, BLUE_, BLUE_],
-            Some(Magenta),
-            "the same sides with the front off is the wedge of a fork",
-        ),
+        // Blue beside magenta with the front on the trail: entering an SRP piece at an angle, one
+        // trail...
+        ([MAGENTA, BLUE_, BLUE_, BLUE_], None, "into an SRP piece"),
+        // ...but the same sides with the front off is the wedge of a fork.
+        ([MAGENTA, OFF, BLUE_, BLUE_], Some(Magenta), "magenta fork"),
     ];
     for ([right, front, left, back], want, why) in cases {
         let got = detect_bifurcation(&obs(right, front, left, back), th);

@@ -12,24 +12,24 @@ pub use colcos_sim::run::RunReport;
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Scenario file (TOML).
-    pub scenario: PathBuf,
+    scenario: PathBuf,
     /// Output directory [default: runs/<scenario file name without .toml>].
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    out: Option<PathBuf>,
     /// Override the scenario's seed.
     #[arg(long)]
-    pub seed: Option<u64>,
+    seed: Option<u64>,
     /// Override the scenario's duration, s.
     #[arg(long)]
-    pub duration: Option<f32>,
+    duration: Option<f32>,
     #[command(flatten)]
-    pub pool: super::ThreadsArg,
+    pool: super::ThreadsArg,
     /// No progress bar.
     #[arg(long)]
-    pub quiet: bool,
+    quiet: bool,
     /// Field backend: cpu, gpu or auto (overrides the scenario's `field.backend`).
     #[arg(long)]
-    pub backend: Option<colcos_sim::field::BackendChoice>,
+    backend: Option<colcos_sim::field::BackendChoice>,
 }
 
 /// `colcos run`: the scenario run to its end (or to Ctrl-C / SIGTERM), what it wrote listed in `text`.
