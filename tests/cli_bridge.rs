@@ -74,8 +74,7 @@ fn check_refuses_a_missing_screen_calibration_naming_the_key() {
     } else {
         format!("{text}\n[rig]\nscreen_calibration = \"nowhere/screen.json\"\n")
     };
-    let path = dir.path().join("s.toml");
-    std::fs::write(&path, text).unwrap();
+    let path = common::write(dir.path(), "s.toml", &text);
     let stderr = failed(colcos(&["check"]).arg(&path));
     assert!(stderr.contains("rig.screen_calibration"), "{stderr}");
     assert!(stderr.contains("nowhere/screen.json"), "{stderr}");

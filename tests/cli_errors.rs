@@ -33,8 +33,7 @@ fn assert_fails(args: &[&str], needles: &[&str]) {
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
+    let path = common::write(dir, name, text);
     path.to_str().unwrap().to_owned()
 }
 

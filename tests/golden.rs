@@ -88,15 +88,8 @@ fn large_swarm() {
     let dir = tempfile::tempdir().unwrap();
     // Enough robots and deposits that every parallel path is taken (robots, banded deposits, field
     // rows), written out as a scenario file.
-    let scenario = dir.path().join("large.toml");
-    std::fs::write(
-        &scenario,
-        colcos_testkit::scenarios::large_swarm()
-            .build()
-            .unwrap()
-            .to_toml(),
-    )
-    .unwrap();
+    let large = colcos_testkit::scenarios::large_swarm().build().unwrap();
+    let scenario = common::write(dir.path(), "large.toml", &large.to_toml());
     let out = dir.path().join("out");
     let got = run_into(&["run", scenario.to_str().unwrap(), "--quiet"], &out);
     check("large swarm", got, LARGE);

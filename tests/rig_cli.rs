@@ -31,13 +31,12 @@ fn rig_check(scenario: &std::path::Path) -> (bool, String) {
 #[test]
 fn wall_seeking_behaviours_are_refused_and_case_two_passes() {
     let dir = tempfile::tempdir().unwrap();
-    let walls = dir.path().join("walls.toml");
-    std::fs::write(
-        &walls,
+    let walls = common::write(
+        dir.path(),
+        "walls.toml",
         "duration = 10.0\n[screen]\nresolution = [640, 640]\nsize = [0.3, 0.3]\n\
          [[robots]]\ncount = 3\nbehaviour = \"wander\"\nparams = { speed = 0.3 }\n",
-    )
-    .unwrap();
+    );
     let (ok, text) = rig_check(&walls);
     assert!(
         !ok && text.contains("pre-flight refused: walled = "),
@@ -70,8 +69,7 @@ fn an_excitation_that_would_leave_the_arena_is_refused_with_the_reason() {
     let base = "name = \"lab\"\nduration = 10.0\n[[robots]]\ncount = 2\nbehaviour = \"wander\"\n";
     // No tracker or radio is there: the refusal must come before either is opened.
     let excite = |name: &str, extra: &str| {
-        let path = dir.path().join(name);
-        std::fs::write(&path, format!("{base}{extra}")).unwrap();
+        let path = common::write(dir.path(), name, &format!("{base}{extra}"));
         let out = dir.path().join("out");
         colcos(&[
             "rig",
@@ -108,12 +106,8 @@ fn an_excitation_that_would_leave_the_arena_is_refused_with_the_reason() {
     // A log of the identify fixture's scenario, identified against another one.
     let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/bridge/tests/data/identify");
     let scenario = std::fs::read_to_string(format!("{fixture}/scenario.toml")).unwrap();
-    let other = dir.path().join("other.toml");
-    std::fs::write(
-        &other,
-        scenario.replace("name = \"identify\"", "name = \"other\""),
-    )
-    .unwrap();
+    let other = scenario.replace("name = \"identify\"", "name = \"other\"");
+    let other = common::write(dir.path(), "other.toml", &other);
     let fit = dir.path().join("fit.toml");
     let (ok, text) = colcos(&[
         "rig",

@@ -1,5 +1,6 @@
 //! Running the `colcos` binary, for the command-line tests (each uses its part).
 #![allow(dead_code)]
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// `colcos` with `args`, run from the repository's root (where `scenarios/` is).
@@ -28,4 +29,11 @@ pub fn failed(command: &mut Command) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(!out.status.success(), "{command:?} succeeded: {stderr}");
     stderr
+}
+
+/// Writes `text` to the file `name` in `dir`; its path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
 }
