@@ -1,6 +1,8 @@
 //! `colcos display SCENARIO`: the scenario's screen image, eq. (1), in a window at the field's rate (one
 //! world step per frame), full screen on a chosen monitor or windowed; or `--png` headless.
-use anyhow::{Context, Result};
+#[cfg(feature = "display")]
+use anyhow::Context;
+use anyhow::Result;
 use colcos_sim::field::BackendChoice;
 use colcos_sim::prelude::*;
 use colcos_sim::screen;
@@ -57,6 +59,7 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 /// Widest and tallest image `--size` accepts, px.
 const MAX_SIDE: u32 = 8192;
 
+#[cfg(feature = "display")]
 fn rgba(img: image::RgbImage) -> Vec<u8> {
     image::DynamicImage::ImageRgb8(img).to_rgba8().into_raw()
 }
