@@ -69,30 +69,37 @@ fn bench(c: &mut Criterion) {
         "\n== swarm_step summary (dt = 20 ms, {} threads) ==",
         rayon::current_num_threads()
     );
-    let big_s = time_steps(&mut w_big, 10, 100);
-    report(
-        "10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, disc solver",
-        big_s,
-        0.02,
-        2.0,
-        Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)),
-    );
-    let big_r = time_steps(&mut w_big_rapier, 5, 30);
-    report(
-        "10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, rapier",
-        big_r,
-        0.02,
-        2.0,
-        Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR)),
-    );
-    let small_s = time_steps(&mut w_small, 50, 2000);
-    report(
-        "100 robots, 65-inch screen, 5 mm grid x3",
-        small_s,
-        0.02,
-        100.0,
-        None,
-    );
+    let argos = Some(("ARGoS (10,000 robots at 1.4x)", ARGOS_10K_REAL_TIME_FACTOR));
+    // (label, world, warm-up steps, timed steps, real-time factor to reach, peer to compare with)
+    let runs = [
+        (
+            "10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, disc solver",
+            &mut w_big,
+            10,
+            100,
+            2.0,
+            argos,
+        ),
+        (
+            "10,000 robots, 14.4 x 8.1 m, 1 cm grid x3, rapier",
+            &mut w_big_rapier,
+            5,
+            30,
+            2.0,
+            argos,
+        ),
+        (
+            "100 robots, 65-inch screen, 5 mm grid x3",
+            &mut w_small,
+            50,
+            2000,
+            100.0,
+            None,
+        ),
+    ];
+    for (label, world, warm, n, target, peer) in runs {
+        report(label, time_steps(world, warm, n), 0.02, target, peer);
+    }
 }
 
 criterion_group! {

@@ -18,54 +18,32 @@ pub struct Cli {
 #[derive(Subcommand)]
 pub enum Command {
     /// Run a scenario: writes trajectory.csv, screen.png, run.gif, fields/*.npy and summary.json.
-    Run {
-        /// Scenario file (TOML).
-        scenario: PathBuf,
-        /// Output directory [default: runs/<scenario file name without .toml>].
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override the scenario's seed.
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Override the scenario's duration, s.
-        #[arg(long)]
-        duration: Option<f32>,
-        /// Worker threads, 1 to 1024 (default: all cores). Results do not depend on it.
-        // 0 would silently mean "all cores"; beyond 1024 each thread's stack only costs memory.
-        #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
-        threads: Option<usize>,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-        /// Field backend: cpu, gpu or auto (overrides the scenario's `field.backend`).
-        #[arg(long)]
-        backend: Option<crate::sim::field::BackendChoice>,
-    },
+    Run(crate::cmd::run::RunArgs),
     /// Show a scenario's screen image in a window (full screen on a chosen monitor, or windowed), or
     /// render it headless to PNG.
-    Display(crate::display::DisplayArgs),
+    Display(crate::cmd::display::DisplayArgs),
     /// Reproduce the paper's case studies (all trials in parallel): figures, CSVs, summary.json/.md.
-    Experiment(crate::experiment::ExperimentArgs),
+    Experiment(crate::cmd::experiment::ExperimentArgs),
     /// Drive real robots with a scenario's behaviours: poses from the tracker, pheromone injected and
     /// the field stepped by the simulator, commands over the radio link, safety stops by a watchdog.
-    Bridge(crate::rig::BridgeArgs),
+    Bridge(crate::cmd::bridge::BridgeArgs),
     /// The digital twin: the simulator serving the rig's wire formats (SwarmCon over TCP, the robots'
     /// serial protocol over a pseudo-terminal or UDP) for `colcos bridge` to drive.
-    Twin(crate::rig::TwinArgs),
+    Twin(crate::cmd::twin::TwinArgs),
     /// Calibrate the rig over its own wires (screen <-> camera, latency, colour sensors); each writes
     /// a file the scenario's `[rig]` section names.
-    Calibrate(crate::calibrate::CalibrateArgs),
+    Calibrate(crate::cmd::calibrate::CalibrateArgs),
     /// Put a rig log (`rig.mcap`) through the live loop again and check that the same inputs give
     /// the same command bytes.
-    Replay(crate::replay::ReplayArgs),
+    Replay(crate::cmd::replay::ReplayArgs),
     /// The rig's pre-flight: `colcos rig check SCENARIO` runs the behaviours on a digital twin first.
     Rig {
         #[command(subcommand)]
-        command: crate::preflight::RigCommand,
+        command: crate::cmd::rig::RigCommand,
     },
     /// Run a batch of scenarios over axes of parameters and seeds (a sweep file), in parallel and
     /// resumable: results.csv, plots/ and summary.md (docs/sweeps.md).
-    Sweep(crate::sweep::SweepArgs),
+    Sweep(crate::cmd::sweep::SweepArgs),
     /// Check a scenario file and print what it sets up, without running it.
     Check { scenario: PathBuf },
     /// List the behaviours a scenario can name.

@@ -5,15 +5,10 @@ pub use colcos_bridge as bridge;
 pub use colcos_sim as sim;
 
 pub mod backend;
-pub mod calibrate;
 pub mod cli;
-pub mod display;
-pub mod experiment;
-pub mod identify;
-pub mod preflight;
-pub mod replay;
+pub mod cmd;
 pub mod report;
-pub mod rig;
-pub mod run;
 pub mod scenario_write;
-pub mod sweep;
+
+// The case studies and the run library, under the names the tests and examples use.
+pub use cmd::{experiment, run};

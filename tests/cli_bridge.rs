@@ -1,6 +1,7 @@
 //! `colcos bridge` against a tracker that is not there: the address and the reason are said once,
 //! with plain sentences (no Rust debug forms), and the run fails instead of reporting success.
-use std::process::Command;
+mod common;
+use common::{colcos, failed};
 
 fn dead_port() -> u16 {
     let l = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
@@ -13,19 +14,18 @@ fn a_bridge_whose_tracker_is_not_there_says_so_once_and_fails() {
     let tracker = format!("swarmcon://127.0.0.1:{}", dead_port());
     let robots = format!("udp://127.0.0.1:{}", dead_port());
     let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/case2_alarm.toml");
-    let out = Command::new(env!("CARGO_BIN_EXE_colcos"))
-        .args([
-            "bridge",
-            scenario,
-            "--tracker",
-            &tracker,
-            "--robots",
-            &robots,
-        ])
-        .args(["--duration", "2", "--quiet", "--out"])
-        .arg(dir.path())
-        .output()
-        .unwrap();
+    let out = colcos(&[
+        "bridge",
+        scenario,
+        "--tracker",
+        &tracker,
+        "--robots",
+        &robots,
+    ])
+    .args(["--duration", "2", "--quiet", "--out"])
+    .arg(dir.path())
+    .output()
+    .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{stderr}");
     let port = tracker.trim_start_matches("swarmcon://");
@@ -74,15 +74,8 @@ fn check_refuses_a_missing_screen_calibration_naming_the_key() {
     } else {
         format!("{text}\n[rig]\nscreen_calibration = \"nowhere/screen.json\"\n")
     };
-    let path = dir.path().join("s.toml");
-    std::fs::write(&path, text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_colcos"))
-        .arg("check")
-        .arg(&path)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "{stderr}");
+    let path = common::write(dir.path(), "s.toml", &text);
+    let stderr = failed(colcos(&["check"]).arg(&path));
     assert!(stderr.contains("rig.screen_calibration"), "{stderr}");
     assert!(stderr.contains("nowhere/screen.json"), "{stderr}");
 }
@@ -96,14 +89,11 @@ fn calibrate_makes_its_output_folder_before_measuring() {
     let out = dir.path().join("calib").join("screen.json");
     let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/case2_alarm.toml");
     let tracker = format!("swarmcon://127.0.0.1:{}", dead_port());
-    let run = Command::new(env!("CARGO_BIN_EXE_colcos"))
-        .args(["calibrate", "screen", scenario, "--tracker", &tracker])
-        .args(["--frames", "127.0.0.1:0", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(!run.status.success(), "{stderr}");
+    let stderr = failed(
+        colcos(&["calibrate", "screen", scenario, "--tracker", &tracker])
+            .args(["--frames", "127.0.0.1:0", "--out"])
+            .arg(&out),
+    );
     assert!(stderr.contains("--tracker"), "{stderr}");
     assert!(dir.path().join("calib").is_dir());
 }

@@ -1,26 +1,21 @@
 //! Bad input on the command line, or in the scenario it names, is a clear error at once: exit status
 //! non-zero, the key or flag named, no panic. And what `colcos check` accepts, `colcos run` runs.
+mod common;
+use colcos_testkit::parsing::TRAIL_AVOIDERS;
+use common::succeeded;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-const GOOD: &str = r#"
-duration = 0.1
-[output]
-gif_interval = 0.0
-[[pheromones]]
-name = "trail"
-colour = [0, 0, 255]
-evaporation = 10.0
-[[robots]]
-count = 3
-behaviour = "avoid"
-"#;
+/// A 0.1 s run of three robots avoiding each other, without a GIF.
+fn good() -> String {
+    TRAIL_AVOIDERS.replace(
+        "duration = 1.0",
+        "duration = 0.1\n[output]\ngif_interval = 0.0",
+    )
+}
 
 fn colcos(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_colcos"))
-        .args(args)
-        .output()
-        .expect("colcos runs")
+    common::colcos(args).output().expect("colcos runs")
 }
 
 #[track_caller]
@@ -38,8 +33,7 @@ fn assert_fails(args: &[&str], needles: &[&str]) {
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
+    let path = common::write(dir, name, text);
     path.to_str().unwrap().to_owned()
 }
 
@@ -51,7 +45,7 @@ fn check_refuses_what_run_would_refuse_when_building() {
     let image = write(
         dir.path(),
         "image.toml",
-        &GOOD.replace(
+        &good().replace(
             "evaporation = 10.0",
             "evaporation = 10.0\nmaps = [{ image = \"missing.png\", rate = 1 }]",
         ),
@@ -59,7 +53,7 @@ fn check_refuses_what_run_would_refuse_when_building() {
     let crowded = write(
         dir.path(),
         "crowded.toml",
-        &GOOD.replace("count = 3", "count = 25\nregion = [0.5, 0.5, 0.7, 0.7]"),
+        &good().replace("count = 3", "count = 25\nregion = [0.5, 0.5, 0.7, 0.7]"),
     );
     for (file, key) in [
         (&image, "pheromones[0].maps[0].image"),
@@ -73,7 +67,7 @@ fn check_refuses_what_run_would_refuse_when_building() {
 #[test]
 fn a_checked_scenario_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let file = write(dir.path(), "good.toml", GOOD);
+    let file = write(dir.path(), "good.toml", &good());
     assert!(colcos(&["check", &file]).status.success());
     let out = dir.path().join("out");
     let run = colcos(&["run", &file, "--quiet", "--out", out.to_str().unwrap()]);
@@ -91,7 +85,7 @@ fn strs(args: &[String]) -> Vec<&str> {
 #[test]
 fn run_arguments_are_bounded() {
     let dir = tempfile::tempdir().unwrap();
-    let file = write(dir.path(), "good.toml", GOOD);
+    let file = write(dir.path(), "good.toml", &good());
     let out = dir.path().join("out");
     let out = out.to_str().unwrap();
     let run = |extra: &[&'static str]| -> Vec<String> {
@@ -117,20 +111,18 @@ fn an_interrupted_run_leaves_complete_outputs() {
     for signal in ["-INT", "-TERM"] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("out");
-        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_colcos"))
-            .args([
-                "run",
-                "scenarios/three_trails.toml",
-                "--duration",
-                "600",
-                "--quiet",
-                "--out",
-            ])
-            .arg(&out)
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .stdout(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
+        let mut child = common::colcos(&[
+            "run",
+            "scenarios/three_trails.toml",
+            "--duration",
+            "600",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
         // Let it get going (the trajectory grows past its header).
         let log = out.join("trajectory.csv");
         let t0 = std::time::Instant::now();
@@ -172,16 +164,8 @@ fn a_second_run_into_the_same_directory_replaces_the_first() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let run = |scenario: &str| {
-        let st = std::process::Command::new(env!("CARGO_BIN_EXE_colcos"))
-            .args(["run", scenario, "--duration", "0.4", "--quiet", "--out"])
-            .arg(&out)
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .output()
-            .unwrap();
-        assert!(
-            st.status.success(),
-            "{}",
-            String::from_utf8_lossy(&st.stderr)
+        succeeded(
+            common::colcos(&["run", scenario, "--duration", "0.4", "--quiet", "--out"]).arg(&out),
         );
     };
     run("scenarios/three_trails.toml");
@@ -223,7 +207,8 @@ fn assert_says_once(args: &[&str], needles: &[&str], never: &[&str]) {
 #[test]
 fn scenario_errors_name_the_key_and_value_the_file_wrote() {
     let dir = tempfile::tempdir().unwrap();
-    let with = |name: &str, from: &str, to: &str| write(dir.path(), name, &GOOD.replace(from, to));
+    let with =
+        |name: &str, from: &str, to: &str| write(dir.path(), name, &good().replace(from, to));
     // A behaviour parameter of the wrong type: its value, not a placeholder.
     let params = with(
         "params.toml",
@@ -319,9 +304,8 @@ fn run_help_says_the_default_out_uses_the_file_name() {
 #[test]
 fn a_run_reports_cleanly_without_xdg_runtime_dir() {
     let dir = tempfile::tempdir().unwrap();
-    let file = write(dir.path(), "good.toml", GOOD);
-    let out = Command::new(env!("CARGO_BIN_EXE_colcos"))
-        .args(["run", &file, "--backend", "auto", "--out"])
+    let file = write(dir.path(), "good.toml", &good());
+    let out = common::colcos(&["run", &file, "--backend", "auto", "--out"])
         .arg(dir.path().join("o"))
         .env_remove("XDG_RUNTIME_DIR")
         .output()

@@ -1,5 +1,6 @@
 //! Random trail maps of case I: the generator's rules (fork angles, fit, depth, food points,
 //! determinism per seed).
+mod common;
 use colcos::experiment::layout::Corners;
 use colcos::experiment::random_map::{MapRules, check_fit, coin_share, random_map, random_maps};
 use colcos::sim::Vec2;
@@ -137,23 +138,23 @@ fn g3_reaches_the_food_on_random_maps_and_g1_less_often() {
 
 #[test]
 fn the_command_line_runs_random_maps_and_refuses_bad_options() {
-    let colcos = env!("CARGO_BIN_EXE_colcos");
     let dir = tempfile::tempdir().unwrap();
-    let out = std::process::Command::new(colcos)
-        .args([
+    // `colcos experiment case1 --maps random --quiet --out <dir>` and `args`.
+    let case1_random = |args: &[&str]| {
+        common::colcos(&[
             "experiment",
             "case1",
             "--maps",
             "random",
-            "--count",
-            "2",
-            "--trials",
-            "2",
+            "--quiet",
+            "--out",
         ])
-        .args(["--seed", "4", "--quiet", "--out"])
         .arg(dir.path())
+        .args(args)
         .output()
-        .unwrap();
+        .unwrap()
+    };
+    let out = case1_random(&["--count", "2", "--trials", "2", "--seed", "4"]);
     assert!(
         out.status.success(),
         "{}",
@@ -167,22 +168,10 @@ fn the_command_line_runs_random_maps_and_refuses_bad_options() {
     let csv = std::fs::read_to_string(dir.path().join("case1_random/maps.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "{csv}");
     for (args, want) in [
-        (vec!["--count", "0"], "--count must be at least 1"),
-        (vec!["--foods", "1"], "--foods applies to layouts A and B"),
+        (["--count", "0"], "--count must be at least 1"),
+        (["--foods", "1"], "--foods applies to layouts A and B"),
     ] {
-        let out = std::process::Command::new(colcos)
-            .args([
-                "experiment",
-                "case1",
-                "--maps",
-                "random",
-                "--quiet",
-                "--out",
-            ])
-            .arg(dir.path())
-            .args(&args)
-            .output()
-            .unwrap();
+        let out = case1_random(&args);
         assert!(!out.status.success());
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(want), "{args:?}: {err}");

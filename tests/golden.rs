@@ -1,8 +1,9 @@
 //! Golden outputs: the default scenario and both case studies, run by the `colcos` binary with a fixed
 //! seed, write exactly these bytes. A refactoring that changes any of them changes behaviour.
 //! `COLCOS_GOLDEN_PRINT=1 cargo test --release --test golden -- --nocapture` prints the current hashes.
+mod common;
+use common::{colcos, succeeded};
 use std::path::Path;
-use std::process::Command;
 
 /// FNV-1a, 64-bit: stable across Rust versions (std's hasher is not).
 fn fnv1a(bytes: &[u8]) -> u64 {
@@ -35,19 +36,9 @@ fn hashes(dir: &Path) -> Vec<(String, u64)> {
     out
 }
 
-fn colcos(args: &[&str], out: &Path) -> Vec<(String, u64)> {
-    let status = Command::new(env!("CARGO_BIN_EXE_colcos"))
-        .args(args)
-        .arg("--out")
-        .arg(out)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    assert!(
-        status.status.success(),
-        "colcos {args:?}: {}",
-        String::from_utf8_lossy(&status.stderr)
-    );
+/// Runs `colcos args --out <out>`, and hashes what it wrote.
+fn run_into(args: &[&str], out: &Path) -> Vec<(String, u64)> {
+    succeeded(colcos(args).arg("--out").arg(out));
     hashes(out)
 }
 
@@ -63,20 +54,22 @@ fn check(label: &str, got: Vec<(String, u64)>, want: &[(&str, u64)]) {
     assert_eq!(got, want, "{label}: outputs changed");
 }
 
+/// Runs `colcos args` into a fresh directory and checks what it wrote against `want`.
+fn assert_golden(label: &str, args: &[&str], want: &[(&str, u64)]) {
+    let dir = tempfile::tempdir().unwrap();
+    check(label, run_into(args, dir.path()), want);
+}
+
 #[test]
 fn default_scenario() {
-    let dir = tempfile::tempdir().unwrap();
-    let got = colcos(
-        &[
-            "run",
-            "scenarios/three_trails.toml",
-            "--duration",
-            "6",
-            "--quiet",
-        ],
-        dir.path(),
-    );
-    check("three_trails", got, THREE_TRAILS);
+    let args = [
+        "run",
+        "scenarios/three_trails.toml",
+        "--duration",
+        "6",
+        "--quiet",
+    ];
+    assert_golden("three_trails", &args, THREE_TRAILS);
 }
 
 #[test]
@@ -86,9 +79,7 @@ fn case_studies_as_scenarios() {
         ("scenarios/case1_layout_b_g2.toml", CASE1_B_G2),
         ("scenarios/case2_alarm.toml", CASE2),
     ] {
-        let dir = tempfile::tempdir().unwrap();
-        let got = colcos(&["run", file, "--duration", "40", "--quiet"], dir.path());
-        check(file, got, want);
+        assert_golden(file, &["run", file, "--duration", "40", "--quiet"], want);
     }
 }
 
@@ -97,38 +88,27 @@ fn large_swarm() {
     let dir = tempfile::tempdir().unwrap();
     // Enough robots and deposits that every parallel path is taken (robots, banded deposits, field
     // rows), written out as a scenario file.
-    let scenario = dir.path().join("large.toml");
-    std::fs::write(
-        &scenario,
-        colcos_testkit::scenarios::large_swarm()
-            .build()
-            .unwrap()
-            .to_toml(),
-    )
-    .unwrap();
+    let large = colcos_testkit::scenarios::large_swarm().build().unwrap();
+    let scenario = common::write(dir.path(), "large.toml", &large.to_toml());
     let out = dir.path().join("out");
-    let got = colcos(&["run", scenario.to_str().unwrap(), "--quiet"], &out);
+    let got = run_into(&["run", scenario.to_str().unwrap(), "--quiet"], &out);
     check("large swarm", got, LARGE);
 }
 
 #[test]
 fn case_studies_as_experiments() {
-    let dir = tempfile::tempdir().unwrap();
-    let got = colcos(
-        &[
-            "experiment",
-            "all",
-            "--trials",
-            "2",
-            "--runs",
-            "1",
-            "--seed",
-            "3",
-            "--quiet",
-        ],
-        dir.path(),
-    );
-    check("experiment all", got, EXPERIMENTS);
+    let args = [
+        "experiment",
+        "all",
+        "--trials",
+        "2",
+        "--runs",
+        "1",
+        "--seed",
+        "3",
+        "--quiet",
+    ];
+    assert_golden("experiment all", &args, EXPERIMENTS);
 }
 
 const LARGE: &[(&str, u64)] = &[

@@ -9,11 +9,27 @@ fn colcos() -> Command {
     Command::new(env!("CARGO_BIN_EXE_colcos"))
 }
 
+/// `colcos sweep <file> --out <out>`, more arguments to come.
+fn sweep(file: &Path, out: &Path) -> Command {
+    let mut c = colcos();
+    c.arg("sweep").arg(file).arg("--out").arg(out);
+    c
+}
+
 fn write_sweep(dir: &Path, name: &str, body: &str) -> PathBuf {
     let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/case2_alarm.toml");
     let path = dir.join(name);
     std::fs::write(&path, format!("scenario = \"{}\"\n{body}", base.display())).unwrap();
     path
+}
+
+/// A fresh directory holding the sweep file `name` (case II, `body`), the file, and the output
+/// directory to give the sweep there.
+fn new_sweep(name: &str, body: &str) -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = write_sweep(tmp.path(), name, body);
+    let out = tmp.path().join("out");
+    (tmp, file, out)
 }
 
 fn rows(out: &Path) -> usize {
@@ -24,19 +40,12 @@ fn rows(out: &Path) -> usize {
 
 #[test]
 fn an_interrupted_sweep_says_so_and_exits_non_zero() {
-    let tmp = tempfile::tempdir().unwrap();
     // 400 runs of 30 s on one thread: seconds of work, stopped after the first rows.
-    let file = write_sweep(
-        tmp.path(),
+    let (_tmp, file, out) = new_sweep(
         "long.toml",
         "duration = 30.0\nseeds = 200\nmetrics = [\"s_mean\"]\n[[axes]]\nkey = \"robots[1].count\"\nvalues = [1, 3]\n",
     );
-    let out = tmp.path().join("out");
-    let mut child = colcos()
-        .arg("sweep")
-        .arg(&file)
-        .arg("--out")
-        .arg(&out)
+    let mut child = sweep(&file, &out)
         .args(["--threads", "1", "--quiet"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -68,11 +77,7 @@ fn an_interrupted_sweep_says_so_and_exits_non_zero() {
         assert!(first.contains(&want), "first line {first:?} lacks {want:?}");
     }
     // The command it prints finishes the sweep.
-    let o = colcos()
-        .arg("sweep")
-        .arg(&file)
-        .arg("--out")
-        .arg(&out)
+    let o = sweep(&file, &out)
         .args(["--resume", "--quiet"])
         .output()
         .unwrap();
@@ -84,22 +89,12 @@ fn an_interrupted_sweep_says_so_and_exits_non_zero() {
 
 #[test]
 fn an_axis_without_effect_is_said_to_have_none() {
-    let tmp = tempfile::tempdir().unwrap();
     // The AGP follows the leader, refreshed every step: its evaporation never acts.
-    let file = write_sweep(
-        tmp.path(),
+    let (_tmp, file, out) = new_sweep(
         "inert.toml",
         "duration = 5.0\nseeds = 2\nmetrics = [\"s_mean\", \"nn_distance\"]\n[[axes]]\nname = \"agp_e\"\nkeys = [\"pheromones[0].evaporation\", \"robots[0].emits[0].evaporation\"]\nrange = { from = 2.5, to = 40.0, steps = 3, scale = \"log\" }\n[[axes]]\nname = \"followers\"\nkey = \"robots[1].count\"\nvalues = [1, 3]\n",
     );
-    let out = tmp.path().join("out");
-    let o = colcos()
-        .arg("sweep")
-        .arg(&file)
-        .arg("--out")
-        .arg(&out)
-        .arg("--quiet")
-        .output()
-        .unwrap();
+    let o = sweep(&file, &out).arg("--quiet").output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(

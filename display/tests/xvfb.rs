@@ -92,15 +92,25 @@ fn show_and_capture(
     r
 }
 
-fn check(name: &str, img: image::RgbaImage, extra: &[&str], whole_screen: bool) {
+/// A fresh folder for the images of test `name`, or why the window tests cannot run here (no X
+/// display to open a window on, or no ImageMagick `import` to take a screenshot with).
+fn shots_dir(name: &str) -> Result<std::path::PathBuf, &'static str> {
     if std::env::var_os("DISPLAY").is_none() {
-        return skip("DISPLAY is not set (run under xvfb-run, see gpu/ci.sh)");
+        return Err("DISPLAY is not set (run under xvfb-run, see gpu/ci.sh)");
     }
     if Command::new("import").arg("-version").output().is_err() {
-        return skip("ImageMagick's `import` is not installed (apt-get install imagemagick)");
+        return Err("ImageMagick's `import` is not installed (apt-get install imagemagick)");
     }
     let dir = std::env::temp_dir().join(format!("colcos-xvfb-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    Ok(dir)
+}
+
+fn check(name: &str, img: image::RgbaImage, extra: &[&str], whole_screen: bool) {
+    let dir = match shots_dir(name) {
+        Ok(dir) => dir,
+        Err(why) => return skip(why),
+    };
     let input = dir.join("input.png");
     img.save(&input).unwrap();
     let shot_path = dir.join("shot.png");
@@ -172,14 +182,10 @@ fn fullscreen_screenshot_matches_headless_png() {
 #[test]
 fn viewer_screenshot_matches_headless_png_and_reopens() {
     use colcos_display::{DisplayOptions, Viewer};
-    if std::env::var_os("DISPLAY").is_none() {
-        return skip("DISPLAY is not set (run under xvfb-run, see gpu/ci.sh)");
-    }
-    if Command::new("import").arg("-version").output().is_err() {
-        return skip("ImageMagick's `import` is not installed (apt-get install imagemagick)");
-    }
-    let dir = std::env::temp_dir().join(format!("colcos-xvfb-{}-viewer", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = match shots_dir("viewer") {
+        Ok(dir) => dir,
+        Err(why) => return skip(why),
+    };
     let opts = || DisplayOptions {
         position: Some((0, 0)),
         decorations: false,

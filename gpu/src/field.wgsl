@@ -76,6 +76,38 @@ fn psi(e: PF, s: u32, k: u32) -> f32 {
     return e.a * vals[s + k];
 }
 
+// Work item i of `count` in a pass over field f (a cell, k = x + y nx, or a row or a column): the
+// field's plan entry and the offsets of its slot the pass reads (s) and of the other one (d); `on` is
+// false past the last item and for a field that sits the pass out (such a thread does nothing).
+struct Item {
+    i: u32,
+    s: u32,
+    d: u32,
+    e: PF,
+    on: bool,
+};
+
+fn item_of(i: u32, count: u32, f: u32) -> Item {
+    if (i >= count) {
+        var none: Item;
+        none.on = false;
+        return none;
+    }
+    let n = P.nx * P.ny;
+    let e = entry(f);
+    return Item(i, (2u * f + e.src) * n, (2u * f + 1u - e.src) * n, e, e.on != 0u);
+}
+
+// The cell that thread lid of workgroup wg of a per-cell pass takes.
+fn cell_of(wg: vec3<u32>, lid: u32) -> Item {
+    return item_of(linear_id(wg, lid), P.nx * P.ny, wg.z);
+}
+
+// The row or column (of `count`) that thread gid of a per-line pass takes.
+fn line_of(gid: vec3<u32>, count: u32) -> Item {
+    return item_of(gid.x + gid.y * P.groups_x * 64u, count, gid.z);
+}
+
 // Values at or below 1e-30, negative values and NaN become 0 after every pass, as on the CPU
 // (`FLUSH_BELOW` in sim/src/field/grid.rs: no subnormals).
 fn flush(v: f32) -> f32 {
@@ -85,17 +117,14 @@ fn flush(v: f32) -> f32 {
 // Phi <- a Phi + b J, in place.
 @compute @workgroup_size(256)
 fn evaporate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let n = P.nx * P.ny;
-    let k = linear_id(wg, lid);
-    let f = wg.z;
-    if (k >= n) { return; }
-    let e = entry(f);
-    if (e.on == 0u) { return; }
-    let s = (2u * f + e.src) * n;
+    let cell = cell_of(wg, lid);
+    if (!cell.on) { return; }
+    let e = cell.e;
+    let at = cell.s + cell.i;
     if (e.inj >= 0) {
-        vals[s + k] = flush(psi(e, s, k));
+        vals[at] = flush(psi(e, cell.s, cell.i));
     } else {
-        vals[s + k] = flush(vals[s + k] * e.a);
+        vals[at] = flush(vals[at] * e.a);
     }
 }
 
@@ -103,18 +132,13 @@ fn evaporate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
 // dst = w c + r ((l + r) + (up + dn)); walls count as the cell itself (no flux).
 @compute @workgroup_size(256)
 fn explicit_step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let nx = P.nx;
-    let ny = P.ny;
-    let n = nx * ny;
-    let k = linear_id(wg, lid);
-    let f = wg.z;
-    if (k >= n) { return; }
-    let e = entry(f);
-    if (e.on == 0u) { return; }
-    let s = (2u * f + e.src) * n;
-    let d = (2u * f + 1u - e.src) * n;
-    let x = k % nx;
-    let y = k / nx;
+    let cell = cell_of(wg, lid);
+    if (!cell.on) { return; }
+    let e = cell.e;
+    let s = cell.s;
+    let k = cell.i;
+    let x = k % P.nx;
+    let y = k / P.nx;
     let w = 1.0 - exact(4.0 * e.r);
     let c = psi(e, s, k);
     var l = c;
@@ -122,58 +146,48 @@ fn explicit_step(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation
     var up = c;
     var dn = c;
     if (x > 0u) { l = psi(e, s, k - 1u); }
-    if (x + 1u < nx) { rt = psi(e, s, k + 1u); }
-    if (y + 1u < ny) { up = psi(e, s, k + nx); }
-    if (y > 0u) { dn = psi(e, s, k - nx); }
-    vals[d + k] = flush(exact(w * c) + exact(e.r * (exact(l + rt) + exact(up + dn))));
+    if (x + 1u < P.nx) { rt = psi(e, s, k + 1u); }
+    if (y + 1u < P.ny) { up = psi(e, s, k + P.nx); }
+    if (y > 0u) { dn = psi(e, s, k - P.nx); }
+    vals[cell.d + k] = flush(exact(w * c) + exact(e.r * (exact(l + rt) + exact(up + dn))));
 }
 
 // The paper's one-sided scheme, eq. (4), conservative reading: each cell sends s/2 right and s/2 up.
 @compute @workgroup_size(256)
 fn one_sided(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let nx = P.nx;
-    let ny = P.ny;
-    let n = nx * ny;
-    let k = linear_id(wg, lid);
-    let f = wg.z;
-    if (k >= n) { return; }
-    let e = entry(f);
-    if (e.on == 0u) { return; }
-    let s = (2u * f + e.src) * n;
-    let d = (2u * f + 1u - e.src) * n;
-    let x = k % nx;
-    let y = k / nx;
-    let half = 0.5 * e.r;
+    let cell = cell_of(wg, lid);
+    if (!cell.on) { return; }
+    let x = cell.i % P.nx;
+    let y = cell.i / P.nx;
+    let half = 0.5 * cell.e.r;
     var keep_v = 0.0;
-    if (y + 1u < ny) { keep_v = half; }
+    if (y + 1u < P.ny) { keep_v = half; }
     var keep_h = 0.0;
-    if (x + 1u < nx) { keep_h = half; }
-    var v = exact(vals[s + k] * (exact(1.0 - keep_h) - keep_v));
-    if (x > 0u) { v = v + exact(half * vals[s + k - 1u]); }
-    if (y > 0u) { v = v + exact(half * vals[s + k - nx]); }
-    vals[d + k] = flush(v);
+    if (x + 1u < P.nx) { keep_h = half; }
+    let at = cell.s + cell.i;
+    var v = exact(vals[at] * (exact(1.0 - keep_h) - keep_v));
+    if (x > 0u) { v = v + exact(half * vals[at - 1u]); }
+    if (y > 0u) { v = v + exact(half * vals[at - P.nx]); }
+    vals[cell.d + cell.i] = flush(v);
 }
 
 // Backward-Euler x-solve, one thread per row (Thomas), fused with evaporation and injection.
 @compute @workgroup_size(64)
 fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let line = line_of(gid, P.ny);
+    if (!line.on) { return; }
     let nx = P.nx;
-    let ny = P.ny;
-    let n = nx * ny;
-    let row = gid.x + gid.y * P.groups_x * 64u;
-    let f = gid.z;
-    if (row >= ny) { return; }
-    let e = entry(f);
-    if (e.on == 0u) { return; }
-    let s = (2u * f + e.src) * n + row * nx;
-    let d = (2u * f + 1u - e.src) * n + row * nx;
+    let first = line.i * nx;
+    let s = line.s + first;
+    let d = line.d + first;
+    let e = line.e;
     let m = e.coef;
     let cp = e.coef + nx;
     var prev = 0.0;
     for (var i = 0u; i < nx; i = i + 1u) {
         var fv: f32;
         if (e.inj >= 0) {
-            fv = exact(e.a * vals[s + i]) + exact(e.b * inj[u32(e.inj) + row * nx + i]);
+            fv = exact(e.a * vals[s + i]) + exact(e.b * inj[u32(e.inj) + first + i]);
         } else {
             fv = exact(e.a * vals[s + i]);
         }
@@ -194,16 +208,13 @@ fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
 // Backward-Euler y-solve, one thread per column.
 @compute @workgroup_size(64)
 fn ysolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let line = line_of(gid, P.nx);
+    if (!line.on) { return; }
     let nx = P.nx;
     let ny = P.ny;
-    let n = nx * ny;
-    let col = gid.x + gid.y * P.groups_x * 64u;
-    let f = gid.z;
-    if (col >= nx) { return; }
-    let e = entry(f);
-    if (e.on == 0u) { return; }
-    let s = (2u * f + e.src) * n + col;
-    let d = (2u * f + 1u - e.src) * n + col;
+    let s = line.s + line.i;
+    let d = line.d + line.i;
+    let e = line.e;
     let m = e.coef + 2u * nx;
     let cp = m + ny;
     vals[d] = flush(vals[s] * coef[m]);
@@ -219,79 +230,44 @@ fn ysolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// Upwind advection along x by Courant number c (|c| <= 1/2), no-flux walls.
+// Upwind advection by the field's Courant number c (|c| <= 1/2) along an axis of `len` cells, `stride`
+// apart, on which the cell is the `i`th; no-flux walls.
+fn advected(cell: Item, i: u32, len: u32, stride: u32) -> f32 {
+    let s = cell.s;
+    let k = cell.i;
+    let c = cell.e.c;
+    let old = vals[s + k];
+    if (c > 0.0) {
+        if (i == len - 1u) {
+            return old + exact(c * vals[s + k - stride]);
+        } else if (i == 0u) {
+            return old * (1.0 - c);
+        }
+        return exact(old * (1.0 - c)) + exact(c * vals[s + k - stride]);
+    }
+    let ca = -c;
+    if (i == 0u) {
+        return old + exact(ca * vals[s + k + stride]);
+    } else if (i == len - 1u) {
+        return old * (1.0 - ca);
+    }
+    return exact(old * (1.0 - ca)) + exact(ca * vals[s + k + stride]);
+}
+
+// Upwind advection along x.
 @compute @workgroup_size(256)
 fn advect_x(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let nx = P.nx;
-    let n = nx * P.ny;
-    let k = linear_id(wg, lid);
-    let f = wg.z;
-    if (k >= n) { return; }
-    let e = entry(f);
-    if (e.on == 0u) { return; }
-    let s = (2u * f + e.src) * n;
-    let d = (2u * f + 1u - e.src) * n;
-    let x = k % nx;
-    let c = e.c;
-    let old = vals[s + k];
-    var v: f32;
-    if (c > 0.0) {
-        if (x == nx - 1u) {
-            v = old + exact(c * vals[s + k - 1u]);
-        } else if (x == 0u) {
-            v = old * (1.0 - c);
-        } else {
-            v = exact(old * (1.0 - c)) + exact(c * vals[s + k - 1u]);
-        }
-    } else {
-        let ca = -c;
-        if (x == 0u) {
-            v = old + exact(ca * vals[s + k + 1u]);
-        } else if (x == nx - 1u) {
-            v = old * (1.0 - ca);
-        } else {
-            v = exact(old * (1.0 - ca)) + exact(ca * vals[s + k + 1u]);
-        }
-    }
-    vals[d + k] = flush(v);
+    let cell = cell_of(wg, lid);
+    if (!cell.on) { return; }
+    vals[cell.d + cell.i] = flush(advected(cell, cell.i % P.nx, P.nx, 1u));
 }
 
 // Upwind advection along y.
 @compute @workgroup_size(256)
 fn advect_y(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let nx = P.nx;
-    let ny = P.ny;
-    let n = nx * ny;
-    let k = linear_id(wg, lid);
-    let f = wg.z;
-    if (k >= n) { return; }
-    let e = entry(f);
-    if (e.on == 0u) { return; }
-    let s = (2u * f + e.src) * n;
-    let d = (2u * f + 1u - e.src) * n;
-    let y = k / nx;
-    let c = e.c;
-    let old = vals[s + k];
-    var v: f32;
-    if (c > 0.0) {
-        if (y == ny - 1u) {
-            v = old + exact(c * vals[s + k - nx]);
-        } else if (y == 0u) {
-            v = old * (1.0 - c);
-        } else {
-            v = exact(old * (1.0 - c)) + exact(c * vals[s + k - nx]);
-        }
-    } else {
-        let ca = -c;
-        if (y == 0u) {
-            v = old + exact(ca * vals[s + k + nx]);
-        } else if (y == ny - 1u) {
-            v = old * (1.0 - ca);
-        } else {
-            v = exact(old * (1.0 - ca)) + exact(ca * vals[s + k + nx]);
-        }
-    }
-    vals[d + k] = flush(v);
+    let cell = cell_of(wg, lid);
+    if (!cell.on) { return; }
+    vals[cell.d + cell.i] = flush(advected(cell, cell.i / P.nx, P.ny, P.nx));
 }
 
 //KEXP//

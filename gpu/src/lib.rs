@@ -15,6 +15,7 @@
 
 pub mod backend;
 mod grids;
+mod program;
 
 /// The wgpu this crate is built on (for [`GpuContext`]'s device and buffers).
 pub use wgpu;

@@ -48,9 +48,9 @@ fn check_screen_and_sensors(name: &str, sc: Scenario, steps: usize, sizes: &[(u3
     let exact = ctx.f64 && colcos_gpu::is_software(&ctx.info);
     for &(w, h) in sizes {
         let cpu = screen::render(world.pheromones(), world.screen(), w, h);
-        let gpu = gs
-            .render(grids.as_ref(), &scene, 0, world.screen(), w, h)
+        gs.render_to_buffer(grids.as_ref(), &scene, 0, world.screen(), w, h)
             .unwrap();
+        let gpu = gs.read_image().unwrap();
         let mut differ = 0;
         for (a, b) in cpu.pixels().zip(gpu.pixels()) {
             if a != b {

@@ -5,45 +5,18 @@ mod common;
 use colcos_gpu::WorldFields;
 use colcos_sim::field::FieldModel;
 use colcos_sim::prelude::*;
+use colcos_testkit::scenarios::three_maps;
 use common::{compare, ctx};
 
 /// Three grid pheromones with static maps (one diffusing) and a cone trail laid by every robot.
-const SCENARIO: &str = r#"
-name = "batch"
-duration = 4.0
-seed = 9
-[screen]
-resolution = [3840, 2160]
-size = [1.439, 0.809]
-[field]
-cell = 0.01
-[[pheromones]]
-name = "red"
-colour = [255, 0, 0]
-evaporation = 5.0
-[[pheromones.maps]]
-polyline = [[0.2, 0.2], [1.2, 0.2], [1.2, 0.6]]
-width = 0.03
-rate = 0.2
-[[pheromones]]
-name = "green"
-colour = [0, 255, 0]
-evaporation = 8.0
-diffusion = 1e-5
-[[pheromones.maps]]
-polyline = [[0.2, 0.6], [0.7, 0.4], [1.2, 0.6]]
-width = 0.05
-rate = 0.15
-[[pheromones]]
-name = "blue"
-colour = [40, 0, 255]
-evaporation = 3.0
-[[robots]]
-count = 5
-behaviour = "follow"
-params = { channel = "r", speed = 0.1, sensitivity = 0.5, threshold = 0.05 }
-deposits = [{ pheromone = "blue", kernel = { shape = "cone", radius = 0.012 }, rate = 5.0 }]
-"#;
+fn scenario() -> Scenario {
+    three_maps(1e-5, 5)
+        .name("batch")
+        .seed(9)
+        .cell(0.01)
+        .build()
+        .unwrap()
+}
 
 /// Loads world `w` into the batch: its fields and its sensors' footprints.
 fn load(fields: &mut WorldFields, w: usize, world: &World) {
@@ -57,7 +30,7 @@ fn load(fields: &mut WorldFields, w: usize, world: &World) {
 #[test]
 fn worlds_sensing_from_the_batch_observe_what_cpu_worlds_observe() {
     let Some(ctx) = ctx() else { return };
-    let sc = Scenario::from_toml_str(SCENARIO, ".").unwrap();
+    let sc = scenario();
     let n = 5;
     let mut cpu: Vec<World> = (0..n)
         .map(|w| World::with_index(&sc, w as u64).unwrap())

@@ -133,16 +133,20 @@ pub fn phases(times: &[f32], alarm: &[bool]) -> Vec<Phase> {
     out
 }
 
+/// Samples `first..=last` of `s` (clipped to its end) and the first of them, when there are some and
+/// the first is positive.
+fn positive_start(s: &[f32], first: usize, last: usize) -> Option<(&[f32], f32)> {
+    let range = s.get(first..=last.min(s.len().saturating_sub(1)))?;
+    let start = range.first().copied().unwrap_or(0.0);
+    (!start.is_nan() && start > 0.0).then_some((range, start))
+}
+
 /// Relative fall of `s` over samples `first..=last`: `1 - min / s[first]` (0 for an empty range or a
 /// zero start).
 pub fn relative_fall(s: &[f32], first: usize, last: usize) -> f32 {
-    let Some(range) = s.get(first..=last.min(s.len().saturating_sub(1))) else {
+    let Some((range, start)) = positive_start(s, first, last) else {
         return 0.0;
     };
-    let start = range.first().copied().unwrap_or(0.0);
-    if start.is_nan() || start <= 0.0 {
-        return 0.0;
-    }
     let min = range.iter().copied().fold(f32::INFINITY, f32::min);
     1.0 - min / start
 }
@@ -150,13 +154,9 @@ pub fn relative_fall(s: &[f32], first: usize, last: usize) -> f32 {
 /// Relative rise of `s` over samples `first..=last`: `max / s[first] - 1` (0 for an empty range or a
 /// zero start).
 pub fn relative_rise(s: &[f32], first: usize, last: usize) -> f32 {
-    let Some(range) = s.get(first..=last.min(s.len().saturating_sub(1))) else {
+    let Some((range, start)) = positive_start(s, first, last) else {
         return 0.0;
     };
-    let start = range.first().copied().unwrap_or(0.0);
-    if start.is_nan() || start <= 0.0 {
-        return 0.0;
-    }
     let max = range.iter().copied().fold(f32::NEG_INFINITY, f32::max);
     max / start - 1.0
 }

@@ -2,6 +2,7 @@
 //! stays there while the maps inject, and a key that cannot be honoured is named in the error.
 use colcos_sim::field::FieldModel;
 use colcos_sim::prelude::*;
+use colcos_testkit::parsing::assert_all_refused;
 
 const SCENARIO: &str = r#"
 name = "preload"
@@ -27,13 +28,6 @@ fn values(world: &World) -> Vec<f32> {
     match &world.pheromones()[0].model {
         FieldModel::Grid(g) => g.values().to_vec(),
         _ => panic!("a grid field"),
-    }
-}
-
-fn error_of(text: &str) -> String {
-    match Scenario::from_toml_str(text, ".") {
-        Ok(_) => panic!("accepted: {text}"),
-        Err(e) => e.to_string(),
     }
 }
 
@@ -64,31 +58,26 @@ fn starts_at_e_j_and_stays_there() {
 
 #[test]
 fn preload_needs_maps_evaporation_and_no_diffusion() {
-    let no_evap = SCENARIO.replace("evaporation = 50.0\n", "");
-    let e = error_of(&no_evap);
-    assert!(
-        e.contains("pheromones[0].preload") && e.contains("evaporation"),
-        "{e}"
-    );
-    let diffusing = SCENARIO.replace(
-        "evaporation = 50.0\n",
-        "evaporation = 50.0\ndiffusion = 1e-5\n",
-    );
-    let e = error_of(&diffusing);
-    assert!(
-        e.contains("pheromones[0].preload") && e.contains("diffusion"),
-        "{e}"
-    );
-    let no_maps = SCENARIO.replace(
-        "maps = [{ polyline = [[0.05, 0.15], [0.35, 0.15]], width = 0.04, rate = 0.02 }]\n",
-        "",
-    );
-    let e = error_of(&no_maps);
-    assert!(
-        e.contains("pheromones[0].preload") && e.contains("maps"),
-        "{e}"
-    );
-    let not_bool = SCENARIO.replace("preload = true", "preload = 1");
-    let e = error_of(&not_bool);
-    assert!(e.contains("preload"), "{e}");
+    let map = "maps = [{ polyline = [[0.05, 0.15], [0.35, 0.15]], width = 0.04, rate = 0.02 }]\n";
+    assert_all_refused(&[
+        (
+            SCENARIO.replace("evaporation = 50.0\n", ""),
+            &["pheromones[0].preload", "evaporation"],
+        ),
+        (
+            SCENARIO.replace(
+                "evaporation = 50.0\n",
+                "evaporation = 50.0\ndiffusion = 1e-5\n",
+            ),
+            &["pheromones[0].preload", "diffusion"],
+        ),
+        (
+            SCENARIO.replace(map, ""),
+            &["pheromones[0].preload", "maps"],
+        ),
+        (
+            SCENARIO.replace("preload = true", "preload = 1"),
+            &["preload"],
+        ),
+    ]);
 }

@@ -248,26 +248,23 @@ fn a_file_of_entries_is_read_and_checked() {
     assert_eq!(own.delay(), 1);
     assert!(world.actuation(0).is_none());
 
-    std::fs::write(
-        dir.path().join("robots.toml"),
-        "[[robot]]\nindex = 1\nmotor_lag = -1.0\n",
-    )
-    .unwrap();
-    let err = World::new(&sc).err().unwrap().to_string();
-    assert!(
-        err.contains("robots.toml") && err.contains("robot[0].motor_lag") && err.contains("-1"),
-        "{err}"
-    );
-    std::fs::write(
-        dir.path().join("robots.toml"),
-        "[[robot]]\nindex = 1\nwheel_scale = [1.0, 0.9, 0.8]\n",
-    )
-    .unwrap();
-    let err = World::new(&sc).err().unwrap().to_string();
-    assert!(
-        err.contains("robot[0].wheel_scale") && err.contains("got 3"),
-        "{err}"
-    );
+    // A bad file is refused when the world is built, naming the file's key.
+    for (file, needles) in [
+        (
+            "[[robot]]\nindex = 1\nmotor_lag = -1.0\n",
+            &["robots.toml", "robot[0].motor_lag", "-1"][..],
+        ),
+        (
+            "[[robot]]\nindex = 1\nwheel_scale = [1.0, 0.9, 0.8]\n",
+            &["robot[0].wheel_scale", "got 3"],
+        ),
+    ] {
+        std::fs::write(dir.path().join("robots.toml"), file).unwrap();
+        let err = World::new(&sc).err().unwrap().to_string();
+        for n in needles {
+            assert!(err.contains(n), "{file}: {err:?} does not mention {n:?}");
+        }
+    }
     let missing = text.replace("robots.toml", "absent.toml");
     let sc = Scenario::from_toml_str(&missing, dir.path()).unwrap();
     let err = World::new(&sc).err().unwrap().to_string();

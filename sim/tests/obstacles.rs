@@ -5,6 +5,7 @@ use colcos_sim::robot::{ArenaPhysics, ColiasParams, PhysicsBackend, Pose};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::sensors::{BumperParams, BumperRays, NeighbourIndex};
 use colcos_sim::world::World;
+use colcos_testkit::parsing::assert_all_refused;
 use glam::Vec2;
 use rand::{RngExt, SeedableRng};
 use std::path::Path;
@@ -228,46 +229,43 @@ fn err(extra: &str) -> String {
 
 #[test]
 fn bad_obstacles_are_refused_naming_the_key() {
-    let e = err("[[obstacles]]\nshape = \"box\"\ncentre = [0.95, 0.5]\nsize = [0.2, 0.1]\n");
-    assert!(
-        e.contains("obstacles[0].centre") && e.contains("outside the arena"),
-        "{e}"
-    );
-    let e = err("[[obstacles]]\nshape = \"box\"\ncentre = [0.5, 0.5]\nsize = [0.0, 0.1]\n");
-    assert!(
-        e.contains("obstacles[0].size") && e.contains("[0.0, 0.1]"),
-        "{e}"
-    );
-    let e =
-        err("[[obstacles]]\nshape = \"polygon\"\npoints = [[0.1, 0.1], [0.2, 0.2], [0.3, 0.3]]\n");
-    assert!(
-        e.contains("obstacles[0].points") && e.contains("no area"),
-        "{e}"
-    );
-    let e = err(
-        "[[obstacles]]\nshape = \"polygon\"\npoints = [[0.1, 0.1], [0.3, 0.3], [0.3, 0.1], [0.1, 0.3]]\n",
-    );
-    assert!(
-        e.contains("obstacles[0].points") && e.contains("cross"),
-        "{e}"
-    );
-    let e = err("[[obstacles]]\nshape = \"disc\"\ncentre = [0.5, 0.5]\n");
-    assert!(
-        e.contains("obstacles[0].radius") && e.contains("missing"),
-        "{e}"
-    );
-    let e =
-        err("[[obstacles]]\nshape = \"disc\"\ncentre = [0.5, 0.5]\nradius = 0.1\nsize = [1, 1]\n");
-    assert!(e.contains("obstacles[0].size"), "{e}");
-    let e = err("[[obstacles]]\nshape = \"mask\"\nimage = \"no_such_mask.png\"\n");
-    assert!(
-        e.contains("obstacles[0].image") && e.contains("no_such_mask.png"),
-        "{e}"
-    );
-    let e = err(
-        "[[obstacles]]\nshape = \"wall\"\npoints = [[0.1, 0.1], [0.1, 0.1]]\nthickness = 0.01\n",
-    );
-    assert!(e.contains("obstacles[0].points[1]"), "{e}");
+    let obstacle = |body: &str| format!("{BASE}[[obstacles]]\n{body}\n");
+    assert_all_refused(&[
+        (
+            obstacle("shape = \"box\"\ncentre = [0.95, 0.5]\nsize = [0.2, 0.1]"),
+            &["obstacles[0].centre", "outside the arena"],
+        ),
+        (
+            obstacle("shape = \"box\"\ncentre = [0.5, 0.5]\nsize = [0.0, 0.1]"),
+            &["obstacles[0].size", "[0.0, 0.1]"],
+        ),
+        (
+            obstacle("shape = \"polygon\"\npoints = [[0.1, 0.1], [0.2, 0.2], [0.3, 0.3]]"),
+            &["obstacles[0].points", "no area"],
+        ),
+        (
+            obstacle(
+                "shape = \"polygon\"\npoints = [[0.1, 0.1], [0.3, 0.3], [0.3, 0.1], [0.1, 0.3]]",
+            ),
+            &["obstacles[0].points", "cross"],
+        ),
+        (
+            obstacle("shape = \"disc\"\ncentre = [0.5, 0.5]"),
+            &["obstacles[0].radius", "missing"],
+        ),
+        (
+            obstacle("shape = \"disc\"\ncentre = [0.5, 0.5]\nradius = 0.1\nsize = [1, 1]"),
+            &["obstacles[0].size"],
+        ),
+        (
+            obstacle("shape = \"mask\"\nimage = \"no_such_mask.png\""),
+            &["obstacles[0].image", "no_such_mask.png"],
+        ),
+        (
+            obstacle("shape = \"wall\"\npoints = [[0.1, 0.1], [0.1, 0.1]]\nthickness = 0.01"),
+            &["obstacles[0].points[1]"],
+        ),
+    ]);
 }
 
 #[test]

@@ -5,6 +5,7 @@ use colcos_sim::output::gif::frame_image;
 use colcos_sim::rng::{Stream, stream_of};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
+use colcos_testkit::parsing::assert_all_refused;
 
 /// One robot at `(x, 0.4)` heading along +x; `obstacle` is one `[[obstacles]]` table's body.
 fn world(x: f32, obstacle: &str) -> World {
@@ -124,26 +125,26 @@ fn a_colour_on_a_physical_obstacle_or_a_bad_one_is_refused() {
             "duration = 1.0\n[[robots]]\ncount = 1\nbehaviour = \"wander\"\n[[obstacles]]\n{body}\n"
         )
     };
-    let err = |body: &str| match Scenario::from_toml_str(&text(body), ".") {
-        Ok(_) => panic!("accepted: {body}"),
-        Err(e) => e.to_string(),
-    };
-    let e = err("shape = \"disc\"\ncentre = [0.5, 0.4]\nradius = 0.05\ncolour = [1, 2, 3]");
-    assert!(
-        e.contains("obstacles[0].colour") && e.contains("printed"),
-        "{e}"
-    );
-    let e = err(
-        "shape = \"disc\"\nkind = \"printed\"\ncentre = [0.5, 0.4]\nradius = 0.05\ncolour = [1, 2, 300]",
-    );
-    assert!(e.contains("obstacles[0].colour"), "{e}");
-    let e = err("shape = \"disc\"\nkind = \"painted\"\ncentre = [0.5, 0.4]\nradius = 0.05");
-    assert!(
-        e.contains("obstacles[0].kind") && e.contains("printed"),
-        "{e}"
-    );
-    let e = err("shape = \"disc\"\nkind = \"printed\"\ncentre = [5.0, 0.4]\nradius = 0.05");
-    assert!(e.contains("obstacles[0].centre"), "{e}");
+    assert_all_refused(&[
+        (
+            text("shape = \"disc\"\ncentre = [0.5, 0.4]\nradius = 0.05\ncolour = [1, 2, 3]"),
+            &["obstacles[0].colour", "printed"],
+        ),
+        (
+            text(
+                "shape = \"disc\"\nkind = \"printed\"\ncentre = [0.5, 0.4]\nradius = 0.05\ncolour = [1, 2, 300]",
+            ),
+            &["obstacles[0].colour"],
+        ),
+        (
+            text("shape = \"disc\"\nkind = \"painted\"\ncentre = [0.5, 0.4]\nradius = 0.05"),
+            &["obstacles[0].kind", "printed"],
+        ),
+        (
+            text("shape = \"disc\"\nkind = \"printed\"\ncentre = [5.0, 0.4]\nradius = 0.05"),
+            &["obstacles[0].centre"],
+        ),
+    ]);
 }
 
 /// `scenarios/printed_track.toml`: a `follow` robot keeps to a blue loop that only the printed

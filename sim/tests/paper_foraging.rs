@@ -47,32 +47,50 @@ fn avoids_on_a_bumper_hit() {
     assert!(c.left * c.right < 0.0, "{c:?}");
 }
 
+/// One forager deciding at each observation in turn (one random stream): what it decides, and why.
+fn assert_decides(f: &mut Foraging, cases: &[(Observation, ForagingDecision, &str)]) {
+    let mut r = rng::stream(1, 0, 0);
+    for (o, want, why) in cases {
+        assert_eq!(f.decide(o, &mut r), *want, "{why}");
+    }
+}
+
 #[test]
 fn wanders_off_the_lap() {
-    let mut f = forager();
-    let mut r = rng::stream(1, 0, 0);
-    assert_eq!(
-        f.decide(&obs(OFF, OFF, OFF, OFF), &mut r),
-        ForagingDecision::Wander
-    );
-    // Green alone (no blue) is not a trail.
-    assert_eq!(
-        f.decide(&obs(OFF, [0.0, 1.0, 0.0], OFF, OFF), &mut r),
-        ForagingDecision::Wander
+    assert_decides(
+        &mut forager(),
+        &[
+            (
+                obs(OFF, OFF, OFF, OFF),
+                ForagingDecision::Wander,
+                "nothing seen",
+            ),
+            (
+                obs(OFF, [0.0, 1.0, 0.0], OFF, OFF),
+                ForagingDecision::Wander,
+                "green alone (no blue) is not a trail",
+            ),
+        ],
     );
 }
 
 #[test]
 fn follows_the_lap_and_prefers_cyan() {
     let mut f = forager();
-    let mut r = rng::stream(1, 0, 0);
-    assert_eq!(
-        f.decide(&obs(BLUE_, BLUE_, BLUE_, BLUE_), &mut r),
-        ForagingDecision::FollowLap
-    );
-    assert_eq!(
-        f.decide(&obs(CYAN, CYAN, CYAN, CYAN), &mut r),
-        ForagingDecision::FollowCyan
+    assert_decides(
+        &mut f,
+        &[
+            (
+                obs(BLUE_, BLUE_, BLUE_, BLUE_),
+                ForagingDecision::FollowLap,
+                "blue all round",
+            ),
+            (
+                obs(CYAN, CYAN, CYAN, CYAN),
+                ForagingDecision::FollowCyan,
+                "cyan all round",
+            ),
+        ],
     );
     // On the cyan trail it steers on green: cyan on the left only turns it left.
     let c = f.steer(&obs(BLUE_, CYAN, CYAN, CYAN), Trail::Cyan);
@@ -81,47 +99,44 @@ fn follows_the_lap_and_prefers_cyan() {
 
 #[test]
 fn detects_bifurcations() {
+    use BifurcationKind::{CyanBlue, Magenta, Plain};
     let th = 0.3;
-    // Front off the trail, both sides on it: the wedge between two branches.
-    assert_eq!(
-        detect_bifurcation(&obs(BLUE_, OFF, BLUE_, BLUE_), th),
-        Some(BifurcationKind::Plain)
-    );
-    // Different colours left and right.
-    assert_eq!(
-        detect_bifurcation(&obs(BLUE_, CYAN, CYAN, CYAN), th),
-        Some(BifurcationKind::CyanBlue)
-    );
-    assert_eq!(
-        detect_bifurcation(&obs(CYAN, CYAN, BLUE_, CYAN), th),
-        Some(BifurcationKind::CyanBlue)
-    );
-    assert_eq!(
-        detect_bifurcation(&obs(MAGENTA, CYAN, CYAN, CYAN), th),
-        Some(BifurcationKind::Magenta)
-    );
-    // A plain trail, or a robot at the edge of one, is not a bifurcation.
-    assert_eq!(
-        detect_bifurcation(&obs(BLUE_, BLUE_, BLUE_, BLUE_), th),
-        None
-    );
-    assert_eq!(detect_bifurcation(&obs(OFF, BLUE_, BLUE_, BLUE_), th), None);
-    assert_eq!(detect_bifurcation(&obs(OFF, OFF, BLUE_, BLUE_), th), None);
-    // Magenta seen by the front sensor first (the SRP piece starts a few cm into the blue branch).
-    assert_eq!(
-        detect_bifurcation(&obs(CYAN, MAGENTA, BLUE_, CYAN), th),
-        Some(BifurcationKind::Magenta)
-    );
-    // Blue beside magenta with the front on the trail: entering an SRP piece at an angle, one trail.
-    assert_eq!(
-        detect_bifurcation(&obs(MAGENTA, BLUE_, BLUE_, BLUE_), th),
-        None
-    );
-    // ...but the same sides with the front off is the wedge of a fork.
-    assert_eq!(
-        detect_bifurcation(&obs(MAGENTA, OFF, BLUE_, BLUE_), th),
-        Some(BifurcationKind::Magenta)
-    );
+    // (right, front, left, back sensor colours; what is detected; the case).
+    let cases = [
+        // Front off the trail, both sides on it: the wedge between two branches.
+        ([BLUE_, OFF, BLUE_, BLUE_], Some(Plain), "wedge"),
+        // Different colours left and right.
+        (
+            [BLUE_, CYAN, CYAN, CYAN],
+            Some(CyanBlue),
+            "blue right, cyan left",
+        ),
+        (
+            [CYAN, CYAN, BLUE_, CYAN],
+            Some(CyanBlue),
+            "cyan right, blue left",
+        ),
+        ([MAGENTA, CYAN, CYAN, CYAN], Some(Magenta), "magenta right"),
+        // A plain trail, or a robot at the edge of one, is not a bifurcation.
+        ([BLUE_, BLUE_, BLUE_, BLUE_], None, "plain trail"),
+        ([OFF, BLUE_, BLUE_, BLUE_], None, "edge, right off"),
+        ([OFF, OFF, BLUE_, BLUE_], None, "edge, right and front off"),
+        // Magenta seen by the front sensor first (the SRP piece starts a few cm into the blue branch).
+        (
+            [CYAN, MAGENTA, BLUE_, CYAN],
+            Some(Magenta),
+            "magenta in front",
+        ),
+        // Blue beside magenta with the front on the trail: entering an SRP piece at an angle, one
+        // trail...
+        ([MAGENTA, BLUE_, BLUE_, BLUE_], None, "into an SRP piece"),
+        // ...but the same sides with the front off is the wedge of a fork.
+        ([MAGENTA, OFF, BLUE_, BLUE_], Some(Magenta), "magenta fork"),
+    ];
+    for ([right, front, left, back], want, why) in cases {
+        let got = detect_bifurcation(&obs(right, front, left, back), th);
+        assert_eq!(got, want, "{why}");
+    }
 }
 
 fn choices(o: &Observation, n: usize) -> (usize, Vec<ForagingDecision>) {
@@ -158,11 +173,16 @@ fn magenta_bifurcation_always_takes_the_cyan_side() {
     ));
 }
 
+/// The share of 4000 decisions at `o` that take the left branch, and the decisions.
+fn left_share(o: &Observation) -> (f64, Vec<ForagingDecision>) {
+    let n = 4000;
+    let (left, all) = choices(o, n);
+    (left as f64 / n as f64, all)
+}
+
 #[test]
 fn cyan_blue_bifurcation_takes_cyan_seven_times_in_ten() {
-    let n = 4000;
-    let (left, all) = choices(&obs(BLUE_, OFF, CYAN, CYAN), n);
-    let share = left as f64 / n as f64;
+    let (share, all) = left_share(&obs(BLUE_, OFF, CYAN, CYAN));
     assert!((share - 0.7).abs() < 0.03, "cyan share {share}");
     // The blue branch is followed on blue-but-not-green.
     assert!(all.iter().any(|d| matches!(
@@ -177,9 +197,7 @@ fn cyan_blue_bifurcation_takes_cyan_seven_times_in_ten() {
 
 #[test]
 fn plain_bifurcation_is_a_fair_coin() {
-    let n = 4000;
-    let (left, _) = choices(&obs(BLUE_, OFF, BLUE_, BLUE_), n);
-    let share = left as f64 / n as f64;
+    let (share, _) = left_share(&obs(BLUE_, OFF, BLUE_, BLUE_));
     assert!((share - 0.5).abs() < 0.03, "left share {share}");
 }
 

@@ -1,29 +1,31 @@
 //! Domain randomisation: every world draws its own values from the `[randomize]` ranges, the same for
 //! the same seed and world index, inside the ranges; bad ranges are refused by key.
-use colcos_sim::scenario::Scenario;
+use colcos_sim::scenario::{RandomizeSpec, RobotGroupSpec, Scenario, ScenarioBuilder};
 use colcos_sim::sensors::ColourSensorParams;
 use colcos_sim::world::World;
 
-const SCENARIO: &str = r#"
-duration = 1.0
-[screen]
-resolution = [384, 216]
-size = [1.0, 0.6]
-[[robots]]
-count = 3
-behaviour = "wander"
-[randomize]
-tracker_latency = [0.03, 0.08]
-position_noise = [0.0, 0.003]
-sensor_gain = [0.8, 1.2]
-crosstalk = [0.0, 0.05]
-motor_lag = [0.02, 0.1]
-max_wheel_speed = [0.2, 0.3]
-"#;
+/// Three robots wandering for 1 s on a 1 x 0.6 m screen, each world drawing from `randomize`.
+fn scenario(randomize: RandomizeSpec) -> Scenario {
+    ScenarioBuilder::new()
+        .duration(1.0)
+        .screen([384, 216], [1.0, 0.6])
+        .robots(RobotGroupSpec::new(3, "wander"))
+        .with(|s| s.randomize = randomize)
+        .build()
+        .unwrap()
+}
 
 #[test]
 fn each_world_draws_its_own_values_within_the_ranges() {
-    let sc = Scenario::from_toml_str(SCENARIO, ".").unwrap();
+    let sc = scenario(RandomizeSpec {
+        tracker_latency: Some([0.03, 0.08]),
+        position_noise: Some([0.0, 0.003]),
+        sensor_gain: Some([0.8, 1.2]),
+        crosstalk: Some([0.0, 0.05]),
+        motor_lag: Some([0.02, 0.1]),
+        max_wheel_speed: Some([0.2, 0.3]),
+        ..RandomizeSpec::default()
+    });
     let specs: Vec<_> = (0..32)
         .map(|w| World::with_index(&sc, w).unwrap().scenario().spec.clone())
         .collect();
@@ -52,8 +54,7 @@ fn each_world_draws_its_own_values_within_the_ranges() {
     let again = World::with_index(&sc, 5).unwrap();
     assert_eq!(again.scenario().spec.tracker.latency, latency[5]);
     // Without the section nothing is drawn.
-    let without = SCENARIO.split("[randomize]").next().unwrap();
-    let plain = Scenario::from_toml_str(without, ".").unwrap();
+    let plain = scenario(RandomizeSpec::default());
     let latency = World::with_index(&plain, 3)
         .unwrap()
         .scenario()

@@ -113,16 +113,21 @@ fn randomised_gain_goes_on_top_of_the_fitted_sensors() {
     assert!(ib[0] > ia[0] + 0.05, "{ia:?} {ib:?}");
 }
 
+/// Why a world whose robots read through the calibration `file` is not built.
+fn refusal(file: &str) -> String {
+    World::new(&scenario(file, true))
+        .err()
+        .expect("refused")
+        .to_string()
+}
+
 #[test]
 fn a_file_that_cannot_serve_the_scenario_is_refused_by_key() {
     // One robot in the file, two in the scenario.
     let mut one = calibration();
     one.robots.truncate(1);
     let (_dir, file) = saved(&one);
-    let err = World::new(&scenario(&file, true))
-        .err()
-        .expect("refused")
-        .to_string();
+    let err = refusal(&file);
     assert!(
         err.contains("rig.colour_calibration")
             && err.contains(&file)
@@ -134,10 +139,7 @@ fn a_file_that_cannot_serve_the_scenario_is_refused_by_key() {
     let mut singular = calibration();
     singular.robots[1].sensors[2].matrix = [[1.0; 3]; 3];
     let (_dir2, file) = saved(&singular);
-    let err = World::new(&scenario(&file, true))
-        .err()
-        .expect("refused")
-        .to_string();
+    let err = refusal(&file);
     assert!(
         err.contains("rig.colour_calibration") && err.contains("robots[1].sensors[2]"),
         "{err}"
@@ -148,20 +150,14 @@ fn a_file_that_cannot_serve_the_scenario_is_refused_by_key() {
     let path = dir.path().join("screen.json");
     std::fs::write(&path, "{\"homography\": [1, 0, 0]}").unwrap();
     let file = path.display().to_string();
-    let err = World::new(&scenario(&file, true))
-        .err()
-        .expect("refused")
-        .to_string();
+    let err = refusal(&file);
     assert!(
         err.contains("rig.colour_calibration") && err.contains("not a colour calibration file"),
         "{err}"
     );
 
     // A missing file, named.
-    let err = World::new(&scenario("/nonexistent/colour.json", true))
-        .err()
-        .expect("refused")
-        .to_string();
+    let err = refusal("/nonexistent/colour.json");
     assert!(err.contains("/nonexistent/colour.json"), "{err}");
 
     // The switch without a file is refused when the scenario is read.

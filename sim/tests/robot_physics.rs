@@ -19,6 +19,11 @@ fn inside(phys: &ArenaPhysics, size: Vec2, r: f32) {
 }
 
 /// A grid of robots with spacing `gap` (m) between centres.
+/// Robots with the default body at `poses` in a 1 m x 1 m arena, moved by `backend`.
+fn unit_arena(poses: &[Pose], backend: PhysicsBackend) -> ArenaPhysics {
+    ArenaPhysics::with_backend(Vec2::ONE, &ColiasParams::default(), poses, backend)
+}
+
 fn grid(n: usize, size: Vec2, gap: f32) -> Vec<Pose> {
     let cols = ((size.x - 2.0 * gap) / gap).floor().max(1.0) as usize;
     (0..n)
@@ -78,31 +83,29 @@ fn a_hundred_robots_pushed_into_a_wall_stay_inside() {
     }
 }
 
+/// The largest overlap (diameter minus centre distance; negative while apart) of two robots that
+/// start facing each other at x = `from` and `to` m (y = 0.5 m) and drive at full speed for 4 s.
+fn head_on_overlap(from: f32, to: f32, backend: PhysicsBackend) -> f32 {
+    let p = ColiasParams::default();
+    let facing = [
+        Pose::new(from, 0.5, 0.0),
+        Pose::new(to, 0.5, std::f32::consts::PI),
+    ];
+    let mut phys = unit_arena(&facing, backend);
+    let mut worst = f32::NEG_INFINITY;
+    for _ in 0..200 {
+        phys.step(&[(p.max_wheel_speed, 0.0); 2], DT);
+        let d = (phys.poses()[0].pos - phys.poses()[1].pos).length();
+        worst = worst.max(2.0 * p.radius - d);
+    }
+    worst
+}
+
 #[test]
 fn head_on_robots_do_not_overlap() {
     for backend in BACKENDS {
-        let p = ColiasParams::default();
-        let size = Vec2::new(1.0, 1.0);
-        let mut phys = ArenaPhysics::with_backend(
-            size,
-            &p,
-            &[
-                Pose::new(0.3, 0.5, 0.0),
-                Pose::new(0.7, 0.5, std::f32::consts::PI),
-            ],
-            backend,
-        );
-        let mut min_gap = f32::INFINITY;
-        for _ in 0..200 {
-            phys.step(&[(p.max_wheel_speed, 0.0), (p.max_wheel_speed, 0.0)], DT);
-            let d = (phys.poses()[0].pos - phys.poses()[1].pos).length();
-            min_gap = min_gap.min(d);
-        }
-        assert!(
-            min_gap > 2.0 * p.radius - 0.002,
-            "overlap {} m",
-            2.0 * p.radius - min_gap
-        );
+        let overlap = head_on_overlap(0.3, 0.7, backend);
+        assert!(overlap < 0.002, "{backend:?}: overlap {overlap} m");
     }
 }
 
@@ -110,12 +113,7 @@ fn head_on_robots_do_not_overlap() {
 fn set_pose_teleports() {
     for backend in BACKENDS {
         let p = ColiasParams::default();
-        let mut phys = ArenaPhysics::with_backend(
-            Vec2::new(1.0, 1.0),
-            &p,
-            &[Pose::new(0.3, 0.5, 0.0)],
-            backend,
-        );
+        let mut phys = unit_arena(&[Pose::new(0.3, 0.5, 0.0)], backend);
         assert_eq!(phys.len(), 1);
         phys.set_pose(0, Pose::new(0.6, 0.4, 1.0));
         assert_eq!(phys.poses()[0], Pose::new(0.6, 0.4, 1.0));
@@ -277,10 +275,9 @@ fn free_steps_match(seed: u32, obstacles: Option<Arc<Obstacles>>) {
 #[test]
 fn constant_speed_in_free_space_is_analytic() {
     for backend in BACKENDS {
-        let p = ColiasParams::default();
         let (v, heading) = (0.2f32, 0.5f32);
         let start = Pose::new(0.3, 0.3, heading);
-        let mut phys = ArenaPhysics::with_backend(Vec2::new(1.0, 1.0), &p, &[start], backend);
+        let mut phys = unit_arena(&[start], backend);
         for _ in 0..50 {
             phys.step(&[(v, 0.0)], DT);
         }
@@ -309,22 +306,7 @@ fn constant_speed_in_free_space_is_analytic() {
 #[test]
 fn robots_pushed_together_overlap_at_most_a_millimetre() {
     for backend in BACKENDS {
-        let p = ColiasParams::default();
-        let mut phys = ArenaPhysics::with_backend(
-            Vec2::new(1.0, 1.0),
-            &p,
-            &[
-                Pose::new(0.45, 0.5, 0.0),
-                Pose::new(0.55, 0.5, std::f32::consts::PI),
-            ],
-            backend,
-        );
-        let mut worst = 0.0f32;
-        for _ in 0..200 {
-            phys.step(&[(p.max_wheel_speed, 0.0); 2], DT);
-            let d = (phys.poses()[0].pos - phys.poses()[1].pos).length();
-            worst = worst.max(2.0 * p.radius - d);
-        }
+        let worst = head_on_overlap(0.45, 0.55, backend);
         assert!(worst <= 1e-3, "{backend:?}: overlap {worst} m");
     }
 }

@@ -2,38 +2,18 @@
 //! placement), work and memory beyond stated limits, and input that parsed but means nothing.
 use colcos_sim::scenario::{Scenario, parse_spec};
 use colcos_sim::world::World;
+use colcos_testkit::parsing::{
+    TRAIL_AVOIDERS as GOOD, assert_all_refused, assert_refused, assert_refused_in,
+};
 use std::path::Path;
-
-const GOOD: &str = r#"
-duration = 1.0
-[[pheromones]]
-name = "trail"
-colour = [0, 0, 255]
-evaporation = 10.0
-[[robots]]
-count = 3
-behaviour = "avoid"
-"#;
 
 fn check(text: &str, dir: &Path) -> Result<Scenario, String> {
     Scenario::from_toml_str(text, dir).map_err(|e| e.to_string())
 }
 
-#[track_caller]
-fn assert_err(text: &str, needles: &[&str]) {
-    assert_err_in(text, Path::new("."), needles);
-}
-
-#[track_caller]
-fn assert_err_in(text: &str, dir: &Path, needles: &[&str]) {
-    match check(text, dir) {
-        Ok(_) => panic!("scenario was accepted:\n{text}"),
-        Err(msg) => {
-            for n in needles {
-                assert!(msg.contains(n), "error {msg:?} does not mention {n:?}");
-            }
-        }
-    }
+/// [`GOOD`] and `table` after it.
+fn plus(table: &str) -> String {
+    format!("{GOOD}\n{table}\n")
 }
 
 fn with_map(map: &str) -> String {
@@ -54,11 +34,11 @@ fn image_maps_are_opened_by_validation() {
     let dir = tempfile::tempdir().unwrap();
     let image = |name: &str| with_map(&format!("{{ image = \"{name}\", rate = 1 }}"));
     let key = "pheromones[0].maps[0].image";
-    assert_err_in(&image("missing.png"), dir.path(), &[key, "missing.png"]);
+    assert_refused_in(&image("missing.png"), dir.path(), &[key, "missing.png"]);
     std::fs::create_dir(dir.path().join("folder.png")).unwrap();
-    assert_err_in(&image("folder.png"), dir.path(), &[key, "not a file"]);
+    assert_refused_in(&image("folder.png"), dir.path(), &[key, "not a file"]);
     std::fs::write(dir.path().join("text.png"), "not an image").unwrap();
-    assert_err_in(&image("text.png"), dir.path(), &[key, "PNG signature"]);
+    assert_refused_in(&image("text.png"), dir.path(), &[key, "PNG signature"]);
     image::RgbImage::new(4, 3)
         .save(dir.path().join("map.png"))
         .unwrap();
@@ -69,12 +49,12 @@ fn image_maps_are_opened_by_validation() {
 #[test]
 fn placement_that_cannot_succeed_is_refused_with_the_key() {
     // 25 robots fit a square packing of the 0.2 m region, but not random placement with gaps.
-    assert_err(
+    assert_refused(
         &with_robots("count = 25\nbehaviour = \"avoid\"\nregion = [0.5, 0.5, 0.7, 0.7]"),
         &["robots[0].placement", "crowded"],
     );
     // Against the walls the grid shrinks below a diameter.
-    assert_err(
+    assert_refused(
         &with_robots(
             "count = 25\nbehaviour = \"avoid\"\nplacement = \"grid\"\nregion = [0.0, 0.0, 0.2, 0.2]",
         ),
@@ -85,7 +65,7 @@ fn placement_that_cannot_succeed_is_refused_with_the_key() {
         "{}\n[arena]\nsize = [0.041, 1.0]\n",
         with_robots("count = 1\nbehaviour = \"avoid\"")
     );
-    assert_err(&narrow, &["robots[0].placement", "no room"]);
+    assert_refused(&narrow, &["robots[0].placement", "no room"]);
 }
 
 /// The validation's placement is the world's: for seeds and crowding around the edge of what fits,
@@ -132,57 +112,50 @@ fn work_and_memory_are_bounded() {
             &format!("evaporation = 10.0\n{extra}"),
         )
     };
-    // r = d dt / h^2 = 1 * 0.02 / 0.005^2 = 800: 3200 explicit sub-steps.
-    assert_err(
-        &grid("diffusion = 1.0\nscheme = \"explicit\""),
-        &["pheromones[0].diffusion", "explicit", "sub-steps", "1000"],
-    );
-    assert_err(
-        &grid("diffusion = 1.0\nscheme = \"one_sided\""),
-        &["pheromones[0].diffusion", "1000"],
-    );
-    check(
-        &grid("diffusion = 1.0\nscheme = \"implicit\""),
-        Path::new("."),
-    )
-    .expect("implicit");
-    assert_err(
-        &grid("wind = [1000.0, 0.0]"),
-        &["pheromones[0].wind", "1000"],
-    );
-    check(&grid("wind = [0.1, 0.0]"), Path::new(".")).expect("a breeze");
-    assert_err(
-        &format!("{GOOD}\n[tracker]\nrate_hz = 5000\n"),
-        &["tracker.rate_hz", "5000", "1000"],
-    );
-    assert_err(
-        &format!("{GOOD}\n[tracker]\nlatency = 60\n"),
-        &["tracker.latency", "60"],
-    );
-    assert_err(
-        &format!("{GOOD}\n[output]\ngif_width = 100000\n"),
-        &["output.gif_width", "7680"],
-    );
-    check(
-        &format!("{GOOD}\n[output]\ngif_width = 100000\ngif_interval = 0.0\n"),
-        Path::new("."),
-    )
-    .expect("no GIF, no frame size");
-    // A tall screen makes a tall GIF from a modest width.
-    assert_err(
-        &format!("{GOOD}\n[screen]\nsize = [0.1, 10.0]\n[arena]\nsize = [1.0, 1.0]\n"),
-        &["output.gif_width", "48000"],
-    );
-    assert_err(
-        &format!("{GOOD}\n[field]\ncell = 0.0001\n"),
-        &["field.cell", "GB", "1e8"],
-    );
-    assert_err(
-        &GOOD.replace("count = 3", "count = 100001"),
-        &["robots[0].count", "100000"],
-    );
+    for accepted in [
+        grid("diffusion = 1.0\nscheme = \"implicit\""),
+        grid("wind = [0.1, 0.0]"),
+        // No GIF, no frame size.
+        plus("[output]\ngif_width = 100000\ngif_interval = 0.0"),
+    ] {
+        check(&accepted, Path::new(".")).expect(&accepted);
+    }
+    assert_all_refused(&[
+        // r = d dt / h^2 = 1 * 0.02 / 0.005^2 = 800: 3200 explicit sub-steps.
+        (
+            grid("diffusion = 1.0\nscheme = \"explicit\""),
+            &["pheromones[0].diffusion", "explicit", "sub-steps", "1000"],
+        ),
+        (
+            grid("diffusion = 1.0\nscheme = \"one_sided\""),
+            &["pheromones[0].diffusion", "1000"],
+        ),
+        (
+            grid("wind = [1000.0, 0.0]"),
+            &["pheromones[0].wind", "1000"],
+        ),
+        (
+            plus("[tracker]\nrate_hz = 5000"),
+            &["tracker.rate_hz", "5000", "1000"],
+        ),
+        (plus("[tracker]\nlatency = 60"), &["tracker.latency", "60"]),
+        (
+            plus("[output]\ngif_width = 100000"),
+            &["output.gif_width", "7680"],
+        ),
+        // A tall screen makes a tall GIF from a modest width.
+        (
+            plus("[screen]\nsize = [0.1, 10.0]\n[arena]\nsize = [1.0, 1.0]"),
+            &["output.gif_width", "48000"],
+        ),
+        (plus("[field]\ncell = 0.0001"), &["field.cell", "GB", "1e8"]),
+        (
+            GOOD.replace("count = 3", "count = 100001"),
+            &["robots[0].count", "100000"],
+        ),
+    ]);
     let points = vec!["[0.1, 0.1]"; 100_001].join(", ");
-    assert_err(
+    assert_refused(
         &with_map(&format!(
             "{{ polyline = [{points}], width = 0.01, rate = 1 }}"
         )),
@@ -193,7 +166,7 @@ fn work_and_memory_are_bounded() {
         .map(|k| format!("[{}, 0.4]", 0.1 + 0.0001 * (k % 2) as f32))
         .collect::<Vec<_>>()
         .join(", ");
-    assert_err(
+    assert_refused(
         &format!(
             "{}\n[field]\ncell = 0.001\n",
             with_map(&format!(
@@ -203,7 +176,7 @@ fn work_and_memory_are_bounded() {
         &["pheromones[0].maps[0].polyline", "visits"],
     );
     // Every robot's deposit kernel covers the whole fine grid.
-    assert_err(
+    assert_refused(
         &format!(
             "{}\n[field]\ncell = 0.0005\n",
             with_robots(
@@ -228,31 +201,33 @@ count = 40000
 behaviour = "avoid"
 emits = [{ pheromone = "alarm", k = 1, sigma = [0.1, 0.1], evaporation = 5 }]
 "#;
-    assert_err(emitters, &["robots[0].emits", "1e9"]);
+    assert_refused(emitters, &["robots[0].emits", "1e9"]);
 }
 
 // Class 3: input that parses but means nothing is refused; half a table takes the defaults.
 
 #[test]
 fn arrays_of_the_wrong_length_are_refused() {
-    assert_err(
-        &format!("{GOOD}\n[screen]\nresolution = [1920, 1080, 3]\nsize = [1.439, 0.809]\n"),
-        &["screen.resolution", "expected 2 values, got 3"],
-    );
-    assert_err(
-        &with_map("{ polyline = [[0.1, 0.1], [0.2, 0.2, 0.3]], width = 0.01, rate = 1 }"),
-        &["pheromones[0].maps[0].polyline[1]", "got 3"],
-    );
-    assert_err(
-        &with_robots(
-            "count = 1\nbehaviour = \"avoid\"\nplacement = \"explicit\"\nposes = [[0.5, 0.5, 0.0, 1.0]]",
+    assert_all_refused(&[
+        (
+            plus("[screen]\nresolution = [1920, 1080, 3]\nsize = [1.439, 0.809]"),
+            &["screen.resolution", "expected 2 values, got 3"],
         ),
-        &["robots[0].poses[0]", "expected 3"],
-    );
-    assert_err(
-        &GOOD.replace("colour = [0, 0, 255]", "colour = [0, 0, 255, 1]"),
-        &["pheromones[0].colour"],
-    );
+        (
+            with_map("{ polyline = [[0.1, 0.1], [0.2, 0.2, 0.3]], width = 0.01, rate = 1 }"),
+            &["pheromones[0].maps[0].polyline[1]", "got 3"],
+        ),
+        (
+            with_robots(
+                "count = 1\nbehaviour = \"avoid\"\nplacement = \"explicit\"\nposes = [[0.5, 0.5, 0.0, 1.0]]",
+            ),
+            &["robots[0].poses[0]", "expected 3"],
+        ),
+        (
+            GOOD.replace("colour = [0, 0, 255]", "colour = [0, 0, 255, 1]"),
+            &["pheromones[0].colour"],
+        ),
+    ]);
 }
 
 #[test]
@@ -262,11 +237,11 @@ fn robots_may_not_overlap_at_the_start() {
             "count = 2\nbehaviour = \"avoid\"\nplacement = \"explicit\"\nposes = {poses}"
         ))
     };
-    assert_err(
+    assert_refused(
         &explicit("[[0.5, 0.5, 0.0], [0.5, 0.5, 90.0]]"),
         &["robots[0].poses[1]", "diameter"],
     );
-    assert_err(
+    assert_refused(
         &explicit("[[0.5, 0.5, 0.0], [0.53, 0.5, 0.0]]"),
         &["robots[0].poses[1]", "diameter"],
     );
@@ -280,39 +255,40 @@ fn robots_may_not_overlap_at_the_start() {
         "count = 1\nbehaviour = \"avoid\"\nplacement = \"explicit\"\nposes = [[0.5, 0.5, 0.0]]\n\
          [[robots]]\ncount = 1\nbehaviour = \"avoid\"\nplacement = \"explicit\"\nposes = [[0.51, 0.5, 0.0]]",
     );
-    assert_err(&two_groups, &["robots[1].poses[0]", "robots[0]"]);
+    assert_refused(&two_groups, &["robots[1].poses[0]", "robots[0]"]);
 }
 
 #[test]
 fn the_body_holds_its_wheels_and_sensors() {
-    assert_err(
-        &format!("{GOOD}\n[robot]\nwheel_base = 0.05\n"),
-        &["robot.wheel_base", "0.05"],
-    );
-    assert_err(
-        &format!("{GOOD}\n[sensor]\nfootprint_radius = 0.01\n"),
-        &["sensor.footprint_radius", "0.01"],
-    );
-    assert_err(
-        &format!("{GOOD}\n[robot]\nradius = 0.012\nwheel_base = 0.02\n"),
-        &["sensor.footprint_radius"],
-    );
+    assert_all_refused(&[
+        (
+            plus("[robot]\nwheel_base = 0.05"),
+            &["robot.wheel_base", "0.05"],
+        ),
+        (
+            plus("[sensor]\nfootprint_radius = 0.01"),
+            &["sensor.footprint_radius", "0.01"],
+        ),
+        (
+            plus("[robot]\nradius = 0.012\nwheel_base = 0.02"),
+            &["sensor.footprint_radius"],
+        ),
+    ]);
 }
 
 #[test]
 fn durations_must_be_positive_numbers() {
-    assert_err(
-        &GOOD.replace("duration = 1.0", "duration = nan"),
-        &["duration", "NaN"],
-    );
-    assert_err(
-        &GOOD.replace("duration = 1.0", "duration = -1.0"),
-        &["duration", "-1"],
-    );
-    assert_err(
-        &format!("{GOOD}\n[robot]\nmotor_lag = nan\n"),
-        &["robot.motor_lag"],
-    );
+    assert_all_refused(&[
+        (
+            GOOD.replace("duration = 1.0", "duration = nan"),
+            &["duration", "NaN"],
+        ),
+        (
+            GOOD.replace("duration = 1.0", "duration = -1.0"),
+            &["duration", "-1"],
+        ),
+        (plus("[robot]\nmotor_lag = nan"), &["robot.motor_lag"]),
+    ]);
     let sc = check(GOOD, Path::new(".")).unwrap();
     for bad in [f32::NAN, -1.0, 0.0, f32::INFINITY] {
         let e = sc.clone().with_overrides(None, Some(bad)).unwrap_err();
@@ -322,18 +298,12 @@ fn durations_must_be_positive_numbers() {
 
 #[test]
 fn half_a_screen_table_takes_the_defaults() {
-    let only_size = check(
-        &format!("{GOOD}\n[screen]\nsize = [1.0, 0.5]\n"),
-        Path::new("."),
-    )
-    .expect("size alone");
+    let only_size =
+        check(&plus("[screen]\nsize = [1.0, 0.5]"), Path::new(".")).expect("size alone");
     assert_eq!(only_size.spec.screen.resolution, [3840, 2160]);
     assert_eq!(only_size.spec.screen.size, [1.0, 0.5]);
-    let only_resolution = check(
-        &format!("{GOOD}\n[screen]\nresolution = [1920, 1080]\n"),
-        Path::new("."),
-    )
-    .expect("resolution alone");
+    let only_resolution = check(&plus("[screen]\nresolution = [1920, 1080]"), Path::new("."))
+        .expect("resolution alone");
     assert_eq!(only_resolution.spec.screen.resolution, [1920, 1080]);
     assert_eq!(only_resolution.spec.screen.size, [1.439, 0.809]);
 }

@@ -13,7 +13,7 @@ use proptest::prelude::*;
 use proptest::sample::Index;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 use std::cell::Cell;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -110,14 +110,7 @@ fn mutation_batch() {
     if std::env::var_os(CHILD_ENV).is_none() {
         eprintln!("note: running without the child's memory limit");
     }
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let mut files: Vec<PathBuf> = ["scenarios", "env/scenarios"]
-        .iter()
-        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap().flatten())
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
+    let files = colcos_testkit::scenarios::shipped(&["scenarios", "env/scenarios"]);
     assert!(files.len() >= 10, "scenario files: {files:?}");
     for (n, file) in files.iter().enumerate() {
         let text = std::fs::read_to_string(file).unwrap();

@@ -15,12 +15,7 @@ fn sweeps_dir() -> PathBuf {
 }
 
 fn shipped() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(sweeps_dir())
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    files.sort();
+    let files = colcos_testkit::scenarios::shipped(&["scenarios/sweeps"]);
     assert!(files.len() >= 5, "{files:?}");
     files
 }

@@ -22,40 +22,42 @@ fn valid(builder: ScenarioBuilder) -> Scenario {
 /// drawn on the grid (d = 0, steady state e J), six robots following the red one and laying a blue
 /// trail.
 pub fn case_i_like() -> Scenario {
-    valid(
-        ScenarioBuilder::new()
-            .name("case_i_like")
-            .duration(4.0)
-            .seed(3)
-            .screen(PANEL.0, PANEL.1)
-            .cell(0.005)
-            .pheromone(
-                PheromoneSpec::grid("red", [255.0, 0.0, 0.0])
-                    .with_evaporation(5.0)
-                    .with_map(MapSpec::polyline(
-                        vec![[0.2, 0.2], [1.2, 0.2], [1.2, 0.6]],
-                        0.03,
-                        0.2,
-                    )),
-            )
-            .pheromone(
-                PheromoneSpec::grid("green", [0.0, 255.0, 0.0])
-                    .with_evaporation(8.0)
-                    .with_diffusion(1e-6)
-                    .with_map(MapSpec::polyline(
-                        vec![[0.2, 0.6], [0.7, 0.4], [1.2, 0.6]],
-                        0.05,
-                        0.15,
-                    )),
-            )
-            .pheromone(PheromoneSpec::grid("blue", [40.0, 0.0, 255.0]).with_evaporation(3.0))
-            .robots(
-                follower(6, "r")
-                    .with_param("sensitivity", 0.5)
-                    .with_param("threshold", 0.05)
-                    .with_deposit("blue", Kernel::Cone { radius: 0.012 }, 5.0),
-            ),
-    )
+    valid(three_maps(1e-6, 6).name("case_i_like").seed(3).cell(0.005))
+}
+
+/// The load of [`case_i_like`] on the 65-inch panel, 4 s: a red and a green static map (green
+/// diffusing `green_diffusion` m^2/s), a blue pheromone, and `robots` robots following red and laying
+/// blue on a cone. The name, the seed and the grid cell are the caller's.
+pub fn three_maps(green_diffusion: f32, robots: usize) -> ScenarioBuilder {
+    ScenarioBuilder::new()
+        .duration(4.0)
+        .screen(PANEL.0, PANEL.1)
+        .pheromone(
+            PheromoneSpec::grid("red", [255.0, 0.0, 0.0])
+                .with_evaporation(5.0)
+                .with_map(MapSpec::polyline(
+                    vec![[0.2, 0.2], [1.2, 0.2], [1.2, 0.6]],
+                    0.03,
+                    0.2,
+                )),
+        )
+        .pheromone(
+            PheromoneSpec::grid("green", [0.0, 255.0, 0.0])
+                .with_evaporation(8.0)
+                .with_diffusion(green_diffusion)
+                .with_map(MapSpec::polyline(
+                    vec![[0.2, 0.6], [0.7, 0.4], [1.2, 0.6]],
+                    0.05,
+                    0.15,
+                )),
+        )
+        .pheromone(PheromoneSpec::grid("blue", [40.0, 0.0, 255.0]).with_evaporation(3.0))
+        .robots(
+            follower(robots, "r")
+                .with_param("sensitivity", 0.5)
+                .with_param("threshold", 0.05)
+                .with_deposit("blue", Kernel::Cone { radius: 0.012 }, 5.0),
+        )
 }
 
 /// Case II of the paper, shortened (4 s), for comparing backends: a leader followed by an attractive
@@ -242,6 +244,20 @@ pub fn wanderers(speed: f64) -> Scenario {
                     .in_region([0.2, 0.2, 1.2, 0.6]),
             ),
     )
+}
+
+/// The TOML files in the repository's folders `dirs` (e.g. `scenarios`, `scenarios/sweeps`),
+/// sorted: the scenario and sweep files shipped with it.
+pub fn shipped(dirs: &[&str]) -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut files: Vec<PathBuf> = dirs
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap().flatten())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    files
 }
 
 /// The manifest of the policy exported for the on-board tests (`bridge/tests/data/onboard`, written

@@ -58,7 +58,6 @@ impl GpuGrids {
 
     /// The record of deposit `d` (`None`: it lays nothing), as the shader reads it.
     fn deposit_record(&self, d: &Deposit) -> Result<Option<DepRecord>> {
-        let GridSpec { nx, ny, .. } = self.spec;
         if d.field >= self.fields.len() {
             return Err(GpuError::Invalid(format!(
                 "deposit on field {} of {}",
@@ -71,12 +70,7 @@ impl GpuGrids {
             return Ok(None);
         }
         let (a, b) = (d.a, d.b);
-        let (i0, i1) = self
-            .spec
-            .cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
-        let (j0, j1) = self
-            .spec
-            .cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
+        let ((i0, i1), (j0, j1)) = self.spec.segment_cells(a, b, support);
         if i1 <= i0 || j1 <= j0 {
             return Ok(None);
         }

@@ -1,5 +1,6 @@
 //! The field shader, compiled once per device into one compute pipeline per pass kind.
 use super::record::Kind;
+use crate::program::{ComputeProgram, READ, WRITE};
 use crate::{GpuContext, Result};
 use std::sync::Arc;
 
@@ -49,52 +50,14 @@ impl FieldPipelines {
 
     fn new(ctx: &GpuContext) -> FieldPipelines {
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("colcos field.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(field_source(ctx.f64).into()),
-        });
-        let entry =
-            |binding: u32, ty: wgpu::BufferBindingType, dynamic: bool| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty,
-                    has_dynamic_offset: dynamic,
-                    min_binding_size: None,
-                },
-                count: None,
-            };
-        let ro = wgpu::BufferBindingType::Storage { read_only: true };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("colcos field layout"),
-            entries: &[
-                entry(
-                    0,
-                    wgpu::BufferBindingType::Storage { read_only: false },
-                    false,
-                ),
-                entry(1, ro, false),
-                entry(2, wgpu::BufferBindingType::Uniform, true),
-                entry(3, ro, false),
-                entry(4, ro, false),
-                entry(5, ro, false),
-            ],
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("colcos field pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipe = |name: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(name),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(name),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let dynamic_uniform = (wgpu::BufferBindingType::Uniform, true);
+        let program = ComputeProgram::new(
+            device,
+            "field",
+            field_source(ctx.f64),
+            &[WRITE, READ, dynamic_uniform, READ, READ, READ],
+        );
+        let pipe = |name: &str| program.pipeline(device, name);
         FieldPipelines {
             evaporate: pipe("evaporate"),
             explicit: pipe("explicit_step"),
@@ -104,7 +67,7 @@ impl FieldPipelines {
             advect_x: pipe("advect_x"),
             advect_y: pipe("advect_y"),
             deposit: pipe("deposit"),
-            layout,
+            layout: program.into_layout(),
         }
     }
 

@@ -3,7 +3,8 @@
 //! them (`offset + centre`, the f32 sums of the CPU's `ColourSensor::sample_points`), composes the
 //! screen at the points from the grid fields and sums the levels. Sets of offsets are shared by every
 //! sensor with the same footprint (a scenario's sensors, unless randomised).
-use super::{GpuScreen, LayerRec, POINTS_PER_SENSOR, Uni, entry, groups};
+use super::{GpuScreen, LayerRec, POINTS_PER_SENSOR, Uni, groups};
+use crate::program::bind_buffers;
 use crate::{GpuContext, GpuGrids, Result, check_size, storage};
 use colcos_sim::screen::ScreenSpec;
 use glam::Vec2;
@@ -212,23 +213,22 @@ impl GpuScreen {
                 .as_ref()
                 .is_none_or(|(_, g)| *g != footprints.generation)
             {
-                let bind = self
-                    .ctx
-                    .device
-                    .create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("colcos batch sensing"),
-                        layout: &self.layout,
-                        entries: &[
-                            entry(0, grids.values_buffer()),
-                            entry(1, &batch.layers),
-                            entry(2, &self.dummy),
-                            entry(3, &batch.uniform),
-                            entry(4, &batch.out),
-                            entry(5, &batch.centres),
-                            entry(6, &batch.sets),
-                            entry(7, &footprints.buffer),
-                        ],
-                    });
+                let buffers = [
+                    grids.values_buffer(),
+                    &batch.layers,
+                    &self.dummy,
+                    &batch.uniform,
+                    &batch.out,
+                    &batch.centres,
+                    &batch.sets,
+                    &footprints.buffer,
+                ];
+                let bind = bind_buffers(
+                    &self.ctx.device,
+                    &self.layout,
+                    "colcos batch sensing",
+                    &buffers,
+                );
                 batch.bind = Some((bind, footprints.generation));
             }
             let bind = &batch.bind.as_ref().expect("made above").0;

@@ -1,8 +1,9 @@
 //! The screen of eq. (1) composed on the GPU, and the colour sensors' footprint sampling on the GPU.
 //!
 //! A world's screen is a list of [`ScreenLayer`]s (one per pheromone, in the world's order): a grid
-//! field of a [`GpuGrids`] batch, or a set of Gaussian sources. [`GpuScreen::render`] gives the same
-//! 8-bit image as [`colcos_sim::screen::render`]; [`GpuScreen::sense`] gives the same mean levels as
+//! field of a [`GpuGrids`] batch, or a set of Gaussian sources. [`GpuScreen::render_to_buffer`]
+//! composes the same 8-bit image as [`colcos_sim::screen::render`] ([`GpuScreen::read_image`]
+//! reads it back); [`GpuScreen::sense`] gives the same mean levels as
 //! [`colcos_sim::sensors::ColourSensor::screen_levels`] for many sensors of many worlds at once, and only
 //! those readings come back.
 //!
@@ -15,6 +16,7 @@ mod sense;
 pub use batch::{FootprintSets, SensorBatch};
 pub use sense::mean_levels;
 
+use crate::program::{ComputeProgram, READ, UNIFORM, WRITE, bind_buffers};
 use crate::{GpuContext, GpuGrids, Result, storage};
 use bytemuck::{Pod, Zeroable};
 use colcos_sim::field::{FieldModel, GaussianSource, Pheromone};
@@ -225,56 +227,20 @@ impl GpuScreen {
             },
         );
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("colcos screen.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(src.into()),
-        });
-        let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let ro = wgpu::BufferBindingType::Storage { read_only: true };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("colcos screen layout"),
-            entries: &[
-                entry(0, ro),
-                entry(1, ro),
-                entry(2, ro),
-                entry(3, wgpu::BufferBindingType::Uniform),
-                entry(4, wgpu::BufferBindingType::Storage { read_only: false }),
-                entry(5, ro),
-                entry(6, ro),
-                entry(7, ro),
-            ],
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: None,
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipe = |name: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(name),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(name),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let program = ComputeProgram::new(
+            device,
+            "screen",
+            src,
+            &[READ, READ, READ, UNIFORM, WRITE, READ, READ, READ],
+        );
+        let pipe = |name: &str| program.pipeline(device, name);
         let render = pipe("render");
         let sense = pipe("sense");
         let sense_centres = pipe("sense_centres");
         let dummy = storage(&ctx, "colcos dummy", 16, wgpu::BufferUsages::empty());
         GpuScreen {
+            layout: program.into_layout(),
             ctx,
-            layout,
             render,
             sense,
             sense_centres,
@@ -426,23 +392,12 @@ impl GpuScreen {
             .queue
             .write_buffer(&ub, 0, bytemuck::bytes_of(&uni));
         let vals = grids.map_or(&self.dummy, |g| g.values_buffer());
-        let bind = self
-            .ctx
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("colcos screen bind group"),
-                layout: &self.layout,
-                entries: &[
-                    entry(0, vals),
-                    entry(1, &lb),
-                    entry(2, &sb),
-                    entry(3, &ub),
-                    entry(4, out),
-                    entry(5, &pb),
-                    entry(6, &qb),
-                    entry(7, &self.dummy),
-                ],
-            });
+        let bind = bind_buffers(
+            &self.ctx.device,
+            &self.layout,
+            "colcos screen bind group",
+            &[vals, &lb, &sb, &ub, out, &pb, &qb, &self.dummy],
+        );
         let mut enc = self.ctx.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -504,36 +459,21 @@ impl GpuScreen {
         self.image.as_ref().map(|(b, w, h)| (b, *w, *h))
     }
 
-    /// Eq. (1) for world `world` at `width x height`, read back as an image (the same pixels as
-    /// [`colcos_sim::screen::render`]).
-    pub fn render(
-        &mut self,
-        grids: Option<&GpuGrids>,
-        scene: &ScreenScene,
-        world: usize,
-        screen: &ScreenSpec,
-        width: u32,
-        height: u32,
-    ) -> Result<image::RgbImage> {
-        self.render_to_buffer(grids, scene, world, screen, width, height)?;
+    /// The last image of [`GpuScreen::render_to_buffer`] read back (the same pixels as
+    /// [`colcos_sim::screen::render`]); an empty image before the first.
+    pub fn read_image(&self) -> Result<image::RgbImage> {
+        let Some((buf, width, height)) = self.image_buffer() else {
+            return Ok(image::RgbImage::new(0, 0));
+        };
         let mut img = image::RgbImage::new(width, height);
         let pixels = width as u64 * height as u64;
         if pixels == 0 {
             return Ok(img);
         }
-        let buf = &self.image.as_ref().expect("rendered").0;
         let bytes = self.ctx.read_buffer(buf, 0, pixels * 4)?;
         for (o, i) in img.chunks_exact_mut(3).zip(bytes.chunks_exact(4)) {
             o.copy_from_slice(&i[..3]);
         }
         Ok(img)
-    }
-}
-
-/// A bind group entry for a whole buffer (the screen's and the batch's bind groups).
-fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: buffer.as_entire_binding(),
     }
 }

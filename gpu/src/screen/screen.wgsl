@@ -142,6 +142,20 @@ fn pixel_centre(v: f32, size: f32, n: u32) -> f32 {
     return (idx + 0.5) * size;
 }
 
+// The 8-bit levels of the screen pixel under point `p` (m), of the world whose layers start at `first`.
+fn levels_under(first: u32, p: vec2<f32>) -> vec3<u32> {
+    let x = pixel_centre(p.x, u.ps_x, u.res_x);
+    let y = pixel_centre(p.y, u.ps_y, u.res_y);
+    return compose(first, x, y);
+}
+
+// Sensor `s`'s sums of levels, red, green, blue.
+fn put_sums(s: u32, sum: vec3<u32>) {
+    outp[3u * s] = sum.x;
+    outp[3u * s + 1u] = sum.y;
+    outp[3u * s + 2u] = sum.z;
+}
+
 // One sensor per thread: the sum of the 8-bit levels of the pixels under its footprint points.
 @compute @workgroup_size(64)
 fn sense(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -150,14 +164,9 @@ fn sense(@builtin(global_invocation_id) gid: vec3<u32>) {
     let first = qworld[s] * u.nlayers;
     var sum = vec3<u32>(0u, 0u, 0u);
     for (var q = 0u; q < u.width; q = q + 1u) {
-        let p = points[s * u.width + q];
-        let x = pixel_centre(p.x, u.ps_x, u.res_x);
-        let y = pixel_centre(p.y, u.ps_y, u.res_y);
-        sum = sum + compose(first, x, y);
+        sum = sum + levels_under(first, points[s * u.width + q]);
     }
-    outp[3u * s] = sum.x;
-    outp[3u * s + 1u] = sum.y;
-    outp[3u * s + 2u] = sum.z;
+    put_sums(s, sum);
 }
 
 // The footprint offsets of the sensors of `sense_centres`, `u.width` a set.
@@ -175,12 +184,7 @@ fn sense_centres(@builtin(global_invocation_id) gid: vec3<u32>) {
     let fset = qworld[s] * u.width;
     var sum = vec3<u32>(0u, 0u, 0u);
     for (var q = 0u; q < u.width; q = q + 1u) {
-        let p = offsets[fset + q] + c;
-        let x = pixel_centre(p.x, u.ps_x, u.res_x);
-        let y = pixel_centre(p.y, u.ps_y, u.res_y);
-        sum = sum + compose(first, x, y);
+        sum = sum + levels_under(first, offsets[fset + q] + c);
     }
-    outp[3u * s] = sum.x;
-    outp[3u * s + 1u] = sum.y;
-    outp[3u * s + 2u] = sum.z;
+    put_sums(s, sum);
 }

@@ -19,6 +19,8 @@ pub use cells::CellBuffer;
 pub use frozen::FrozenSources;
 pub use gaussian::{FrozenSource, GaussianField, GaussianSource, MAX_GROUP};
 pub(crate) use grid::lerp_index;
+#[cfg(test)]
+pub(crate) use grid::test_segments;
 pub use grid::{
     Bilinear, DiffusionScheme, GridBand, GridField, GridParams, GridSpec, PARALLEL_MIN_CELLS,
     bilinear_mix, thomas_coefficients,

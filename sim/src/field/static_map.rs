@@ -15,8 +15,7 @@ pub fn polyline_map(spec: &GridSpec, points: &[Vec2], width: f32, value: f32) ->
         _ => points.windows(2).map(|w| (w[0], w[1])).collect(),
     };
     for (a, b) in segments {
-        let (i0, i1) = spec.cell_range(a.x.min(b.x) - half, a.x.max(b.x) + half, spec.nx);
-        let (j0, j1) = spec.cell_range(a.y.min(b.y) - half, a.y.max(b.y) + half, spec.ny);
+        let ((i0, i1), (j0, j1)) = spec.segment_cells(a, b, half);
         let ab = b - a;
         let len2 = ab.length_squared();
         for j in j0..j1 {

@@ -130,9 +130,8 @@ pub(super) fn check_polyline(key: &str, map: &MapSpec, grid: &GridSpec) -> Resul
     let visits: f64 = points
         .windows(2)
         .map(|w| {
-            let (a, b) = (w[0], w[1]);
-            let (i0, i1) = grid.cell_range(a[0].min(b[0]) - half, a[0].max(b[0]) + half, grid.nx);
-            let (j0, j1) = grid.cell_range(a[1].min(b[1]) - half, a[1].max(b[1]) + half, grid.ny);
+            let (a, b) = (Vec2::from(w[0]), Vec2::from(w[1]));
+            let ((i0, i1), (j0, j1)) = grid.segment_cells(a, b, half);
             (i1 - i0) as f64 * (j1 - j0) as f64
         })
         .sum();

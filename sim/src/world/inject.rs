@@ -318,29 +318,18 @@ fn deposit_segments(injection: &mut Injection, pheromones: &mut [Pheromone]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::field::{GridField, GridParams};
+    use crate::field::{GridField, GridParams, test_segments};
 
     proptest::proptest! {
         /// Every band that a segment's deposit changes is among the bands it is listed for.
         #[test]
         fn a_segment_is_listed_for_every_band_it_reaches(
-            shape in 0usize..3,
-            size in 0.0005f32..0.05,
-            cell in proptest::sample::select(vec![0.003f32, 0.005, 0.01, 0.0137]),
-            a in (-0.05f32..0.65, -0.05f32..0.45),
-            step in (-0.06f32..0.06, -0.06f32..0.06),
+            (kernel, spec, from, to) in test_segments(),
             bands in 1usize..9,
         ) {
-            let kernel = match shape {
-                0 => Kernel::Disc { radius: size },
-                1 => Kernel::Cone { radius: size },
-                _ => Kernel::Gaussian { sigma: size / 3.0 },
-            };
-            let spec = GridSpec::covering(Vec2::new(0.6, 0.4), cell);
             let rows = spec.ny.div_ceil(bands).max(1);
             let count = spec.ny.div_ceil(rows).max(1);
-            let from = Vec2::new(a.0, a.1);
-            let s = TrailSegment { pheromone: 0, kernel, from, to: from + Vec2::new(step.0, step.1), amount: 1.0 };
+            let s = TrailSegment { pheromone: 0, kernel, from, to, amount: 1.0 };
             let (lo, hi) = bands_reached(&s, &spec, rows, count).expect("a finite segment");
             let mut g = GridField::new(spec, GridParams::default());
             for mut band in g.bands_mut(rows) {

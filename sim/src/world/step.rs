@@ -138,15 +138,7 @@ impl World {
     /// # Panics
     /// If `sums` does not hold four entries per robot.
     pub fn sense_from_sums(&mut self, sums: &[[u32; 3]]) {
-        super::stages::sense_from_sums(
-            &mut self.sensing,
-            &mut self.fields,
-            &self.screen,
-            self.robots.physics.poses(),
-            &mut self.robots.slots,
-            self.time,
-            sums,
-        );
+        self.sense_with(Some(sums));
     }
 
     /// Every robot's observation from the current screen and poses (after building or moving robots).
@@ -157,13 +149,18 @@ impl World {
 
     /// Stage `sense` over this world's sets, at the poses last indexed.
     fn sense(&mut self) {
-        sense(
-            &mut self.sensing,
-            &mut self.fields,
-            &self.screen,
-            self.robots.physics.poses(),
-            &mut self.robots.slots,
-            self.time,
-        );
+        self.sense_with(None);
+    }
+
+    /// Stage `sense`, from the footprint level sums `sums` when given.
+    fn sense_with(&mut self, sums: Option<&[[u32; 3]]>) {
+        let (sensing, fields, screen) = (&mut self.sensing, &mut self.fields, &self.screen);
+        let (poses, slots) = (self.robots.physics.poses(), &mut self.robots.slots);
+        match sums {
+            Some(sums) => super::stages::sense_from_sums(
+                sensing, fields, screen, poses, slots, self.time, sums,
+            ),
+            None => sense(sensing, fields, screen, poses, slots, self.time),
+        }
     }
 }

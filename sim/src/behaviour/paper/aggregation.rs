@@ -72,6 +72,22 @@ impl Default for FollowerParams {
     }
 }
 
+/// The `sensitivity` key, alike for leaders and followers.
+const SENSITIVITY_DOC: ParamDoc = ParamDoc {
+    name: "sensitivity",
+    ty: "float, m/s per rad, >= 0",
+    default: "0.03",
+    meaning: "p of eq. (8)",
+};
+
+/// The `alarm_threshold` key, alike for leaders and followers.
+const ALARM_THRESHOLD_DOC: ParamDoc = ParamDoc {
+    name: "alarm_threshold",
+    ty: "float, 0..1, >= 0",
+    default: "0.05",
+    meaning: "mean red intensity above which the robot senses the ALP and flees it",
+};
+
 /// The shared parameters of both algorithms.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AggregationParams {
@@ -98,18 +114,8 @@ impl LeaderParams {
             default: "0.03",
             meaning: "wandering speed",
         },
-        ParamDoc {
-            name: "sensitivity",
-            ty: "float, m/s per rad, >= 0",
-            default: "0.03",
-            meaning: "p of eq. (8)",
-        },
-        ParamDoc {
-            name: "alarm_threshold",
-            ty: "float, 0..1, >= 0",
-            default: "0.05",
-            meaning: "mean red intensity above which the robot senses the ALP and flees it",
-        },
+        SENSITIVITY_DOC,
+        ALARM_THRESHOLD_DOC,
     ];
 
     pub fn validate(&self, key: &str) -> Result<AggregationParams> {
@@ -142,18 +148,8 @@ impl FollowerParams {
             default: "0.05",
             meaning: "wandering speed",
         },
-        ParamDoc {
-            name: "sensitivity",
-            ty: "float, m/s per rad, >= 0",
-            default: "0.03",
-            meaning: "p of eq. (8)",
-        },
-        ParamDoc {
-            name: "alarm_threshold",
-            ty: "float, 0..1, >= 0",
-            default: "0.05",
-            meaning: "mean red intensity above which the robot senses the ALP and flees it",
-        },
+        SENSITIVITY_DOC,
+        ALARM_THRESHOLD_DOC,
         ParamDoc {
             name: "attract_threshold",
             ty: "float, 0..1, >= 0",
@@ -163,17 +159,18 @@ impl FollowerParams {
     ];
 
     pub fn validate(&self, key: &str) -> Result<AggregationParams> {
-        check(key, "speed", self.speed, 0.0)?;
-        check(key, "wander_speed", self.wander_speed, 0.0)?;
-        check(key, "sensitivity", self.sensitivity, 0.0)?;
-        check(key, "alarm_threshold", self.alarm_threshold, 0.0)?;
-        check(key, "attract_threshold", self.attract_threshold, 0.0)?;
-        Ok(AggregationParams {
+        // The leader's keys, checked as the leader's, then the follower's own.
+        let leader = LeaderParams {
             speed: self.speed,
             wander_speed: self.wander_speed,
             sensitivity: self.sensitivity,
             alarm_threshold: self.alarm_threshold,
+        };
+        let params = leader.validate(key)?;
+        check(key, "attract_threshold", self.attract_threshold, 0.0)?;
+        Ok(AggregationParams {
             attract_threshold: self.attract_threshold,
+            ..params
         })
     }
 }

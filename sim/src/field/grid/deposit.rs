@@ -30,10 +30,9 @@ impl GridField {
     /// bands can run in parallel, and a cell's deposits still arrive in the order they are made
     /// when every band takes every deposit in that order.
     pub fn bands_mut(&mut self, rows: usize) -> impl Iterator<Item = GridBand<'_>> {
-        let spec = self.spec;
-        let rows = rows.max(1);
+        let (spec, rows, cells) = self.band_cells(rows);
         self.values
-            .chunks_mut((rows * spec.nx).max(1))
+            .chunks_mut(cells)
             .enumerate()
             .map(move |(k, values)| GridBand::number(spec, rows, k, values))
     }
@@ -43,12 +42,17 @@ impl GridField {
         &mut self,
         rows: usize,
     ) -> impl IndexedParallelIterator<Item = GridBand<'_>> {
-        let spec = self.spec;
-        let rows = rows.max(1);
+        let (spec, rows, cells) = self.band_cells(rows);
         self.values
-            .par_chunks_mut((rows * spec.nx).max(1))
+            .par_chunks_mut(cells)
             .enumerate()
             .map(move |(k, values)| GridBand::number(spec, rows, k, values))
+    }
+
+    /// The grid, and the rows (at least one) and cells of each band for bands of `rows` rows.
+    fn band_cells(&self, rows: usize) -> (GridSpec, usize, usize) {
+        let rows = rows.max(1);
+        (self.spec, rows, (rows * self.spec.nx).max(1))
     }
 
     /// Adds `amount * kernel.weight(distance to p)` to every cell near `p`.
@@ -149,6 +153,28 @@ fn segment_distance(p: Vec2, a: Vec2, ab: Vec2, len2: f32) -> f32 {
     (p - (a + ab * t)).length()
 }
 
+/// Deposits for the property tests of banded deposits: a disc, cone or Gaussian kernel of any
+/// size up to 5 cm, on a grid over 0.6 x 0.4 m with one of the scenarios' cell sizes (or an odd
+/// one), along a segment of up to 6 cm from anywhere on the grid or just off it: (kernel, grid, a, b).
+#[cfg(test)]
+pub(crate) fn test_segments()
+-> impl proptest::strategy::Strategy<Value = (Kernel, GridSpec, Vec2, Vec2)> {
+    use proptest::strategy::Strategy;
+    let cells = proptest::sample::select(vec![0.003f32, 0.005, 0.01, 0.0137]);
+    let start = (-0.05f32..0.65, -0.05f32..0.45);
+    let step = (-0.06f32..0.06, -0.06f32..0.06);
+    (0usize..3, 0.0005f32..0.05, cells, start, step).prop_map(|(shape, size, cell, a, step)| {
+        let kernel = match shape {
+            0 => Kernel::Disc { radius: size },
+            1 => Kernel::Cone { radius: size },
+            _ => Kernel::Gaussian { sigma: size / 3.0 },
+        };
+        let spec = GridSpec::covering(Vec2::new(0.6, 0.4), cell);
+        let (a, b) = (Vec2::new(a.0, a.1), Vec2::new(a.0 + step.0, a.1 + step.1));
+        (kernel, spec, a, b)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,14 +182,9 @@ mod tests {
 
     /// The deposit as first written: every cell of the bounding box weighed.
     fn deposit_whole_box(g: &mut GridField, kernel: &Kernel, a: Vec2, b: Vec2, amount: f32) {
-        let GridSpec { nx, ny, cell } = *g.spec();
+        let GridSpec { nx, cell, .. } = *g.spec();
         let support = kernel.support();
-        let (i0, i1) = g
-            .spec
-            .cell_range(a.x.min(b.x) - support, a.x.max(b.x) + support, nx);
-        let (j0, j1) = g
-            .spec
-            .cell_range(a.y.min(b.y) - support, a.y.max(b.y) + support, ny);
+        let ((i0, i1), (j0, j1)) = g.spec.segment_cells(a, b, support);
         let (ab, len2) = (b - a, (b - a).length_squared());
         for j in j0..j1 {
             for i in i0..i1 {
@@ -184,21 +205,9 @@ mod tests {
         /// bit for bit as weighing the whole bounding box does.
         #[test]
         fn deposits_equal_the_whole_box(
-            shape in 0usize..3,
-            size in 0.0005f32..0.05,
-            cell in proptest::sample::select(vec![0.003f32, 0.005, 0.01, 0.0137]),
-            a in (-0.05f32..0.65, -0.05f32..0.45),
-            step in (-0.06f32..0.06, -0.06f32..0.06),
+            (kernel, spec, a, b) in test_segments(),
             bands in 1usize..5,
         ) {
-            use crate::field::Kernel;
-            let kernel = match shape {
-                0 => Kernel::Disc { radius: size },
-                1 => Kernel::Cone { radius: size },
-                _ => Kernel::Gaussian { sigma: size / 3.0 },
-            };
-            let spec = GridSpec::covering(Vec2::new(0.6, 0.4), cell);
-            let (a, b) = (Vec2::new(a.0, a.1), Vec2::new(a.0 + step.0, a.1 + step.1));
             let mut want = GridField::new(spec, GridParams::default());
             deposit_whole_box(&mut want, &kernel, a, b, 1.7);
             let mut whole = GridField::new(spec, GridParams::default());

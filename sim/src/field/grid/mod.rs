@@ -26,6 +26,8 @@ mod spec;
 mod strips;
 
 pub use deposit::GridBand;
+#[cfg(test)]
+pub(crate) use deposit::test_segments;
 pub use implicit::thomas_coefficients;
 pub(crate) use sampling::lerp_index;
 pub use sampling::{Bilinear, bilinear_mix};

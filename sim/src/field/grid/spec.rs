@@ -44,6 +44,14 @@ impl GridSpec {
         let hi = (((hi_m / self.cell - 0.5).ceil() + 1.0).max(0.0) as usize).min(n);
         (lo, hi.max(lo))
     }
+    /// [`Self::cell_range`] along x and along y of the bounding box of segment `a`-`b` grown by
+    /// `reach` m: the cells within `reach` of the segment lie in `[i0, i1) x [j0, j1)`.
+    pub fn segment_cells(&self, a: Vec2, b: Vec2, reach: f32) -> ((usize, usize), (usize, usize)) {
+        (
+            self.cell_range(a.x.min(b.x) - reach, a.x.max(b.x) + reach, self.nx),
+            self.cell_range(a.y.min(b.y) - reach, a.y.max(b.y) + reach, self.ny),
+        )
+    }
 }
 
 /// How diffusion is integrated.

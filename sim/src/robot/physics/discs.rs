@@ -1,4 +1,5 @@
 //! The disc solver: move, then Gauss-Seidel passes that separate overlapping equal discs.
+use super::Step;
 use crate::robot::Pose;
 use crate::sensors::NeighbourIndex;
 use glam::Vec2;
@@ -21,17 +22,14 @@ pub(super) struct DiscState {
 }
 
 impl DiscState {
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn step(
         &mut self,
         poses: &mut [Pose],
         velocity: impl Fn(usize) -> (f32, f32),
-        dt: f32,
-        lo: Vec2,
-        hi: Vec2,
-        radius: f32,
+        step: Step,
         size: Vec2,
     ) {
+        let Step { dt, lo, hi, radius } = step;
         // Move: along the heading at the start of the step (as rapier does), then turn.
         self.positions.clear();
         for (i, pose) in poses.iter_mut().enumerate() {

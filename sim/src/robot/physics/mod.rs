@@ -47,6 +47,16 @@ enum Solver {
     Discs(DiscState),
 }
 
+/// One step as the solvers take it: its length `dt`, where the disc centres may be (`lo..hi`, the
+/// last guard of every step) and the discs' radius.
+#[derive(Clone, Copy)]
+struct Step {
+    dt: f32,
+    lo: Vec2,
+    hi: Vec2,
+    radius: f32,
+}
+
 pub struct ArenaPhysics {
     solver: Solver,
     poses: Vec<Pose>,
@@ -137,28 +147,13 @@ impl ArenaPhysics {
             return;
         }
         let velocity = |i: usize| velocity_of(velocities, i);
-        let (lo, hi) = self.bounds();
+        let step = self.step_of(dt);
         match &mut self.solver {
-            Solver::Rapier(state) => state.step(
-                &mut self.poses,
-                velocity,
-                dt,
-                lo,
-                hi,
-                self.radius,
-                &self.obstacles,
-            ),
+            Solver::Rapier(state) => state.step(&mut self.poses, velocity, step, &self.obstacles),
             Solver::Discs(state) => {
-                state.step(
-                    &mut self.poses,
-                    velocity,
-                    dt,
-                    lo,
-                    hi,
-                    self.radius,
-                    self.size,
-                );
-                obstacle_contacts::push_out(&mut self.poses, self.radius, &self.obstacles, lo, hi);
+                state.step(&mut self.poses, velocity, step, self.size);
+                let Step { lo, hi, radius, .. } = step;
+                obstacle_contacts::push_out(&mut self.poses, radius, &self.obstacles, lo, hi);
             }
         }
     }
@@ -187,27 +182,20 @@ impl ArenaPhysics {
         if dt.is_nan() || dt <= 0.0 {
             return;
         }
-        let (lo, hi) = self.bounds();
+        let step = self.step_of(dt);
         let Solver::Rapier(state) = &mut self.solver else {
             return;
         };
-        state.step_in(
-            host,
-            &mut self.poses,
-            |i| velocity_of(velocities, i),
-            dt,
-            lo,
-            hi,
-            self.radius,
-            &self.obstacles,
-        );
+        let velocity = |i: usize| velocity_of(velocities, i);
+        state.step_in(host, &mut self.poses, velocity, step, &self.obstacles);
     }
 
     /// The second half of a step in `host` (after [`RapierHost::step`]).
     pub fn finish_in(&mut self, host: &mut RapierHost) {
-        let (lo, hi) = self.bounds();
+        // Only the step's guard is left to apply: its time was taken in `step_in`.
+        let step = self.step_of(0.0);
         if let Solver::Rapier(state) = &mut self.solver {
-            state.finish_in(host, &mut self.poses, lo, hi);
+            state.finish_in(host, &mut self.poses, step);
         }
     }
 
@@ -248,6 +236,17 @@ impl ArenaPhysics {
             state.set_pose(i, p, heading);
         }
         self.poses[i] = Pose { pos: p, heading };
+    }
+
+    /// A step of `dt` in this arena.
+    fn step_of(&self, dt: f32) -> Step {
+        let (lo, hi) = self.bounds();
+        Step {
+            dt,
+            lo,
+            hi,
+            radius: self.radius,
+        }
     }
 
     /// Where disc centres may be.

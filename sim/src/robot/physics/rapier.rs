@@ -1,5 +1,5 @@
 //! The rapier2d solver: dynamic discs driven by velocity in four thick static wall boxes.
-use super::FRICTION;
+use super::{FRICTION, Step};
 use crate::arena::Obstacles;
 use crate::robot::Pose;
 use glam::Vec2;
@@ -224,33 +224,28 @@ impl RapierState {
 
     /// One step of `dt`: without rapier when no contact is possible (see [`Self::free_of_contacts`]),
     /// else a full rapier step. Bodies leaving `lo..hi` are put back (the last guard).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn step(
         &mut self,
         poses: &mut [Pose],
         velocity: impl Fn(usize) -> (f32, f32),
-        dt: f32,
-        lo: Vec2,
-        hi: Vec2,
-        radius: f32,
+        step: Step,
         obstacles: &Obstacles,
     ) {
         if let Some(hosted) = &mut self.hosted {
             // Stepped alone: the host's copy falls behind.
             hosted.stale = true;
         }
-        if self.free_steps && self.free_of_contacts(radius, lo, hi, obstacles) {
-            self.free_step(velocity, dt);
+        if self.free_steps && self.free_of_contacts(step, obstacles) {
+            self.free_step(velocity, step.dt);
         } else {
-            self.rapier_step(velocity, dt);
+            self.rapier_step(velocity, step.dt);
         }
         let world = &mut self.world;
         settle(
             &mut self.translations,
             &self.rotations,
             poses,
-            lo,
-            hi,
+            step,
             |i, q| put_back(&mut world.bodies[self.bodies[i]], q),
         );
     }
@@ -259,13 +254,8 @@ impl RapierState {
     /// than its prediction distance (plus a margin) from the walls, the obstacles and every other
     /// robot. rapier builds its contacts from the poses at the start of a step only, so such a step
     /// has no constraint and moves every body freely.
-    pub(super) fn free_of_contacts(
-        &self,
-        radius: f32,
-        lo: Vec2,
-        hi: Vec2,
-        obstacles: &Obstacles,
-    ) -> bool {
+    pub(super) fn free_of_contacts(&self, step: Step, obstacles: &Obstacles) -> bool {
+        let Step { lo, hi, radius, .. } = step;
         let n = self.translations.len();
         if n > FREE_MAX_ROBOTS {
             return false;
@@ -407,16 +397,17 @@ pub(super) fn put_back(body: &mut RigidBody, q: Vec2) {
     body.set_linvel(Vec2::ZERO, false);
 }
 
-/// The last guard after a step: every mirrored position outside `lo..hi` (or not finite) is put back
-/// inside (`fix` is told, to put its body back and stop it), and `poses` take the mirror's values.
+/// The last guard after a step: every mirrored position outside `lo..hi` of `step` (or not finite)
+/// is put back inside (`fix` is told, to put its body back and stop it), and `poses` take the
+/// mirror's values.
 pub(super) fn settle(
     translations: &mut [Vec2],
     rotations: &[Rotation],
     poses: &mut [Pose],
-    lo: Vec2,
-    hi: Vec2,
+    step: Step,
     mut fix: impl FnMut(usize, Vec2),
 ) {
+    let Step { lo, hi, .. } = step;
     for (i, pose) in poses.iter_mut().enumerate() {
         let p = translations[i];
         let heading = rotations[i].angle();

@@ -17,6 +17,7 @@
 //!
 //! [`ArenaPhysics::step_in`]: super::ArenaPhysics::step_in
 //! [`ArenaPhysics::finish_in`]: super::ArenaPhysics::finish_in
+use super::Step;
 use super::rapier::{self, HostedArena, RapierState, settle};
 use crate::arena::Obstacles;
 use crate::robot::Pose;
@@ -147,30 +148,26 @@ impl RapierState {
     /// The first half of a step in the host: a free step when no contact is possible (the arena's
     /// bodies sleep in the host), else the velocities written into the host's bodies for its next
     /// step. Without a host (not attached) this is a whole step alone.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn step_in(
         &mut self,
         host: &mut RapierHost,
         poses: &mut [Pose],
         velocity: impl Fn(usize) -> (f32, f32),
-        dt: f32,
-        lo: Vec2,
-        hi: Vec2,
-        radius: f32,
+        step: Step,
         obstacles: &Obstacles,
     ) {
         let Some(hosted) = self.hosted.as_ref() else {
-            return self.step(poses, velocity, dt, lo, hi, radius, obstacles);
+            return self.step(poses, velocity, step, obstacles);
         };
         let slot = &mut host.slots[hosted.slot];
-        if self.free_steps && self.free_of_contacts(radius, lo, hi, obstacles) {
+        if self.free_steps && self.free_of_contacts(step, obstacles) {
             if slot.awake {
                 for &handle in &slot.bodies {
                     host.world.bodies[handle].sleep();
                 }
                 slot.awake = false;
             }
-            self.free_step(velocity, dt);
+            self.free_step(velocity, step.dt);
             if let Some(hosted) = &mut self.hosted {
                 hosted.stale = true;
             }
@@ -178,8 +175,7 @@ impl RapierState {
                 &mut self.translations,
                 &self.rotations,
                 poses,
-                lo,
-                hi,
+                step,
                 |_, _| {},
             );
             return;
@@ -204,13 +200,7 @@ impl RapierState {
 
     /// The second half of a step in the host, after [`RapierHost::step`]: the poses of an arena
     /// that went through rapier are read back (and guarded).
-    pub(super) fn finish_in(
-        &mut self,
-        host: &mut RapierHost,
-        poses: &mut [Pose],
-        lo: Vec2,
-        hi: Vec2,
-    ) {
+    pub(super) fn finish_in(&mut self, host: &mut RapierHost, poses: &mut [Pose], step: Step) {
         let Some(hosted) = self.hosted.as_mut().filter(|h| h.pending) else {
             return;
         };
@@ -222,8 +212,7 @@ impl RapierState {
             &mut self.translations,
             &self.rotations,
             poses,
-            lo,
-            hi,
+            step,
             |i, q| rapier::put_back(&mut bodies[handles[i]], q),
         );
     }

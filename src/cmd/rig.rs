@@ -15,10 +15,10 @@ pub enum RigCommand {
     Check(CheckArgs),
     /// Drive a short, bounded excitation (held wheel commands of random length, inside the shield)
     /// while the bridge records the rig log that `colcos rig identify` fits.
-    Excite(crate::identify::ExciteArgs),
+    Excite(super::identify::ExciteArgs),
     /// Fit each robot's wheel scales, motor lag and command latency from a rig log, each with its
     /// uncertainty, into a file of per-robot values for `[individual] file`.
-    Identify(crate::identify::IdentifyArgs),
+    Identify(super::identify::IdentifyArgs),
 }
 
 #[derive(Args, Debug)]
@@ -56,8 +56,8 @@ pub struct CheckArgs {
 pub fn run(command: RigCommand, text: &mut String) -> Result<()> {
     let args = match command {
         RigCommand::Check(args) => args,
-        RigCommand::Excite(args) => return crate::identify::excite(args, text),
-        RigCommand::Identify(args) => return crate::identify::identify(args, text),
+        RigCommand::Excite(args) => return super::identify::excite(args, text),
+        RigCommand::Identify(args) => return super::identify::identify(args, text),
     };
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
         bail!("--seconds {}: must be in (0, 3600]", args.seconds);

@@ -23,9 +23,8 @@ pub struct SweepArgs {
     /// Output directory [default: runs/sweeps/<sweep name>].
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Worker threads, 1 to 1024 (default: all cores). Results do not depend on it.
-    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub pool: super::ThreadsArg,
     /// Continue the table in the output directory (an error if there is none). A rerun into the same
     /// directory continues it too.
     #[arg(long)]
@@ -72,7 +71,7 @@ pub fn main(args: SweepArgs) -> Result<()> {
         &plan,
         &out,
         SweepOptions {
-            threads: args.threads,
+            threads: args.pool.threads,
             resume: args.resume,
             on_row: Some(&on_row),
             stop: Some(&stop),

@@ -14,7 +14,7 @@ use colcos_sim::screen;
 use rayon::prelude::*;
 
 /// The scenario file of case II, compiled in.
-pub const SCENARIO_TOML: &str = include_str!("../../scenarios/case2_alarm.toml");
+pub const SCENARIO_TOML: &str = include_str!("../../../scenarios/case2_alarm.toml");
 
 #[derive(Clone, Debug)]
 pub struct Case2Config {

@@ -210,17 +210,21 @@ mod tests {
     #[test]
     fn an_axis_with_no_effect_is_not_named_at_its_first_value() {
         let axes = ["e".to_string(), "n".to_string()];
-        let effects = vec![vec![Effect::None], vec![Effect::Changes]];
-        let md = markdown(
-            "t",
-            &table(),
-            &axes,
-            &["s_mean".into()],
-            &effects,
-            8,
-            2,
-            &[],
-        );
+        // The summary of `table()` (8 runs, 2 seeds) with axis `e` found to have `e_effect`.
+        let summary = |e_effect: Effect| {
+            let effects = vec![vec![e_effect], vec![Effect::Changes]];
+            markdown(
+                "t",
+                &table(),
+                &axes,
+                &["s_mean".into()],
+                &effects,
+                8,
+                2,
+                &[],
+            )
+        };
+        let md = summary(Effect::None);
         assert!(md.contains("**`e`: no effect across this axis.**"), "{md}");
         assert!(
             md.contains("| `s_mean` | lower | n = 3 | 0.5 +- 0 (2) | n = 1 | 0.7 +- "),
@@ -229,17 +233,7 @@ mod tests {
         assert!(md.contains("| `e` |"), "{md}");
         assert!(!md.contains("e = 2.5"), "{md}");
         // Untested axes (sampled sweeps) keep their values in the settings.
-        let untested = vec![vec![Effect::Untested], vec![Effect::Changes]];
-        let md = markdown(
-            "t",
-            &table(),
-            &axes,
-            &["s_mean".into()],
-            &untested,
-            8,
-            2,
-            &[],
-        );
+        let md = summary(Effect::Untested);
         assert!(
             md.contains("e = 2.5, n = 3") && !md.contains("no effect across this axis"),
             "{md}"

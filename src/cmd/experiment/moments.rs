@@ -187,7 +187,7 @@ mod tests {
 
     #[test]
     fn the_featured_run_is_the_one_with_the_fullest_story() {
-        let cfg = crate::experiment::case2::Case2Config::paper(1, 1).unwrap();
+        let cfg = crate::cmd::experiment::case2::Case2Config::paper(1, 1).unwrap();
         let r = Case2Result {
             config: cfg,
             runs: vec![run_with(2000, 2000), run_with(889, 900), run_with(400, 600)],

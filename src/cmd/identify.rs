@@ -3,13 +3,11 @@
 //! each robot's wheel scales, motor lag, command latency and colour gain and offset from that log
 //! into a file of per-robot values that a scenario's `[individual] file` (and `colcos twin
 //! --truth`) reads.
+use super::bridge::{display_on, open_rig};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use colcos_bridge::calibrate::RigCalibration;
 use colcos_bridge::identify::{self, Excitation, FitOptions, Param};
 use colcos_bridge::rig::{LiveOptions, LiveSession};
-use colcos_bridge::transport::FrameServer;
-use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;
 use std::fmt::Write as _;
@@ -93,28 +91,9 @@ pub fn excite(args: ExciteArgs, text: &mut String) -> Result<()> {
     let max_speed = args.speed * limit as f64;
     identify::excite::check_room(&sc, max_speed)
         .map_err(|why| anyhow::anyhow!("refused: {why}"))?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating output directory {}", args.out.display()))?;
-    let calibration = RigCalibration::load(&sc)?;
-    let opts = SourceOptions::new(calibration.frame_transform(&sc));
-    let source = open_pose_source(&args.tracker, &opts)
-        .with_context(|| format!("--tracker {}", args.tracker))?;
-    let link =
-        open_robot_link(&args.robots).with_context(|| format!("--robots {}", args.robots))?;
+    let ends = open_rig(&sc, &args.out, &args.tracker, &args.robots, args.frames)?;
     let log = args.out.join("rig.mcap");
-    let frames = match args.frames {
-        Some(addr) => Some(FrameServer::bind(addr).with_context(|| format!("--frames {addr}"))?),
-        None => None,
-    };
-    let display = match args.display {
-        Some(monitor) => Some(std::sync::Mutex::new(crate::rig::open_display(
-            &sc,
-            monitor,
-            args.windowed,
-            960,
-        )?)),
-        None => None,
-    };
+    let display = display_on(&sc, args.display, args.windowed, 960)?;
     let live_opts = LiveOptions {
         duration: Some(args.seconds),
         log: Some(log.clone()),
@@ -127,7 +106,7 @@ pub fn excite(args: ExciteArgs, text: &mut String) -> Result<()> {
     };
     let excitation = Excitation::new(sc.spec.seed, max_speed as f32);
     let n = sc.robot_count();
-    let mut session = LiveSession::new(&sc, source, link, frames, live_opts)?;
+    let mut session = LiveSession::new(&sc, ends.source, ends.link, ends.frames, live_opts)?;
     let mut overrides: Vec<Option<WheelCommand>> = vec![None; n];
     while !session.is_over() {
         let t = session.elapsed();

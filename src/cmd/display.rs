@@ -1,6 +1,8 @@
 //! `colcos display SCENARIO`: the scenario's screen image, eq. (1), in a window at the field's rate (one
 //! world step per frame), full screen on a chosen monitor or windowed; or `--png` headless.
-use anyhow::{Context, Result};
+#[cfg(feature = "display")]
+use anyhow::Context;
+use anyhow::Result;
 use colcos_sim::field::BackendChoice;
 use colcos_sim::prelude::*;
 use colcos_sim::screen;
@@ -57,6 +59,7 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 /// Widest and tallest image `--size` accepts, px.
 const MAX_SIDE: u32 = 8192;
 
+#[cfg(feature = "display")]
 fn rgba(img: image::RgbImage) -> Vec<u8> {
     image::DynamicImage::ImageRgb8(img).to_rgba8().into_raw()
 }
@@ -225,8 +228,10 @@ pub fn main(args: DisplayArgs) -> Result<()> {
             Some(ctx) => {
                 let mut g = GpuFrames::new(ctx.clone(), &world)?;
                 let scene = g.upload(&world)?;
+                let (grids, screen) = (g.grids.as_ref(), world.screen());
                 g.screen
-                    .render(g.grids.as_ref(), &scene, 0, world.screen(), size.0, size.1)?
+                    .render_to_buffer(grids, &scene, 0, screen, size.0, size.1)?;
+                g.screen.read_image()?
             }
             None => screen::render(world.pheromones(), world.screen(), size.0, size.1),
         };

@@ -76,6 +76,15 @@ struct Band {
     first_up: bool,
 }
 
+/// A band at height `y` with `leaves` end points, the first one's branch toward +y if `first_up`.
+const fn band(y: f32, leaves: usize, first_up: bool) -> Band {
+    Band {
+        y,
+        leaves,
+        first_up,
+    }
+}
+
 /// Builds a layout of four bands in a tree of two levels: nest -> A -> (upper, lower) -> two bands
 /// each; in each band a first fork sends one branch to an end point and the other on to a second fork
 /// with two more (or, for a two-leaf band, straight to an end point). `mirror` grows the tree leftward
@@ -131,18 +140,13 @@ fn banded(name: &str, bands: [Band; 4], mirror: bool) -> TrailLayout {
 impl TrailLayout {
     /// The default layout: nest on the left, twelve end points (the paper's food example: 3 and 10).
     pub fn a() -> Self {
-        let b = |y, leaves, first_up| Band {
-            y,
-            leaves,
-            first_up,
-        };
         banded(
             "A",
             [
-                b(0.125, 3, true),
-                b(0.315, 3, true),
-                b(0.505, 3, true),
-                b(0.695, 3, true),
+                band(0.125, 3, true),
+                band(0.315, 3, true),
+                band(0.505, 3, true),
+                band(0.695, 3, true),
             ],
             false,
         )
@@ -150,18 +154,13 @@ impl TrailLayout {
 
     /// The second layout: mirrored (nest on the right), eleven end points, first branches alternating.
     pub fn b() -> Self {
-        let b = |y, leaves, first_up| Band {
-            y,
-            leaves,
-            first_up,
-        };
         banded(
             "B",
             [
-                b(0.13, 3, true),
-                b(0.33, 3, false),
-                b(0.50, 2, true),
-                b(0.70, 3, false),
+                band(0.13, 3, true),
+                band(0.33, 3, false),
+                band(0.50, 2, true),
+                band(0.70, 3, false),
             ],
             true,
         )

@@ -1,10 +1,82 @@
 //! `colcos run`: the run library of `colcos-sim` ([`colcos_sim::run`]) with this crate's field backend
 //! choice (GPU when built with the `gpu` feature) and a progress bar on the terminal.
 use anyhow::Result;
+use clap::Args;
 use colcos_sim::prelude::*;
-use std::path::Path;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
 pub use colcos_sim::run::RunReport;
+
+// (No doc comment: clap would take it for the long help.)
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Scenario file (TOML).
+    scenario: PathBuf,
+    /// Output directory [default: runs/<scenario file name without .toml>].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Override the scenario's seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Override the scenario's duration, s.
+    #[arg(long)]
+    duration: Option<f32>,
+    #[command(flatten)]
+    pool: super::ThreadsArg,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+    /// Field backend: cpu, gpu or auto (overrides the scenario's `field.backend`).
+    #[arg(long)]
+    backend: Option<colcos_sim::field::BackendChoice>,
+}
+
+/// `colcos run`: the scenario run to its end (or to Ctrl-C / SIGTERM), what it wrote listed in `text`.
+pub fn main(args: RunArgs, text: &mut String) -> Result<()> {
+    super::use_threads(args.pool.threads)?;
+    let mut sc = Scenario::from_file(&args.scenario)?.with_overrides(args.seed, args.duration)?;
+    if let Some(b) = args.backend {
+        sc.spec.field.backend = b;
+    }
+    let out = args.out.unwrap_or_else(|| {
+        PathBuf::from("runs").join(args.scenario.file_stem().unwrap_or_default())
+    });
+    // Ctrl-C and SIGTERM end the run after the current step, with every output written.
+    let stop = super::stop_on_signal()?;
+    let report = run(
+        &sc,
+        &out,
+        &RunOptions {
+            progress: !args.quiet,
+            no_gif: false,
+            stop: Some(stop),
+        },
+    )?;
+    if report.interrupted {
+        writeln!(
+            text,
+            "interrupted after {} of {} steps: the outputs hold what ran",
+            report.steps,
+            sc.steps()
+        )?;
+    }
+    writeln!(text, "field backend: {}", report.backend)?;
+    writeln!(
+        text,
+        "{} robots, {} steps ({:.2} s simulated) in {:.2} s: {:.1}x real time",
+        report.robots,
+        report.steps,
+        report.sim_seconds,
+        // The whole run (world build, log, GIF, files): what the user waited for.
+        report.total_wall_seconds,
+        report.overall_real_time_factor()
+    )?;
+    for f in &report.files {
+        writeln!(text, "  wrote {}", f.display())?;
+    }
+    Ok(())
+}
 
 /// Options of one run beyond the scenario.
 #[derive(Debug, Clone, Default)]
@@ -22,11 +94,7 @@ pub struct RunOptions {
 /// asks for.
 pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<RunReport> {
     let choice = scenario.spec.field.backend;
-    let bar = if opts.progress {
-        progress_bar(scenario.steps())
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = super::progress_bar(scenario.steps(), "steps", opts.progress);
     let mut on_step = |done: u64, total: u64| {
         bar.set_position(done);
         if done == total {
@@ -49,16 +117,6 @@ pub fn run(scenario: &Scenario, out_dir: &Path, opts: &RunOptions) -> Result<Run
     // The run error's message already ends with its cause: as an anyhow chain the CLI's `{:#}` would
     // print the cause twice.
     report.map_err(|e| anyhow::anyhow!("{e}"))
-}
-
-fn progress_bar(steps: u64) -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::new(steps);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40.cyan/blue} {pos}/{len} steps ({per_sec}, eta {eta})")
-            .expect("static template")
-            .progress_chars("=> "),
-    );
-    bar
 }
 
 /// Gives libwayland an empty private runtime directory when `XDG_RUNTIME_DIR` is unset or not an

@@ -161,19 +161,6 @@ pub struct Report {
     pub wall_seconds: f64,
 }
 
-fn progress_bar(len: u64, show: bool) -> indicatif::ProgressBar {
-    if !show {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(len);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40.cyan/blue} {pos}/{len} trials ({per_sec}, eta {eta})")
-            .expect("static template")
-            .progress_chars("=> "),
-    );
-    bar
-}
-
 /// Runs the chosen case studies (all their trials in parallel on rayon's pool) and writes every file
 /// under `opts.out`.
 pub fn run(opts: &Options) -> Result<Report> {
@@ -197,7 +184,7 @@ pub fn run(opts: &Options) -> Result<Report> {
     let total = cfg1.as_ref().map_or(0, case1::task_count)
         + cfg2.as_ref().map_or(0, |c| c.runs)
         + random.map_or(0, |n| random_run::task_count(n, opts.trials));
-    let bar = progress_bar(total as u64, opts.progress);
+    let bar = super::progress_bar(total as u64, "trials", opts.progress);
     let tick = || bar.inc(1);
     // Both cases share the pool: case II's few long runs start first, case I's trials fill the gaps.
     let (r2, (r1, rr)) = rayon::join(
@@ -258,81 +245,81 @@ fn csv_text(w: csv::Writer<Vec<u8>>) -> String {
     String::from_utf8(bytes).expect("CSV of UTF-8 fields is UTF-8")
 }
 
+/// A directory an experiment writes its files into, and the files written, in order.
+struct OutDir {
+    dir: PathBuf,
+    files: Vec<PathBuf>,
+}
+
+impl OutDir {
+    fn create(dir: &Path) -> Result<OutDir> {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        Ok(OutDir {
+            dir: dir.to_path_buf(),
+            files: Vec::new(),
+        })
+    }
+
+    /// Writes `text` to the file `name`.
+    fn text(&mut self, name: &str, text: String) -> Result<()> {
+        let path = self.dir.join(name);
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        self.files.push(path);
+        Ok(())
+    }
+
+    /// Has `draw` write the figure `name` (given its path); listed where `draw` says it drew one.
+    fn figure_if(&mut self, name: &str, draw: impl FnOnce(&Path) -> Result<bool>) -> Result<()> {
+        let path = self.dir.join(name);
+        if draw(&path)? {
+            self.files.push(path);
+        }
+        Ok(())
+    }
+
+    /// Has `draw` write the figure `name` (given its path).
+    fn figure(&mut self, name: &str, draw: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+        self.figure_if(name, |path| draw(path).map(|()| true))
+    }
+}
+
 fn write_case1(r: &case1::Case1Result, dir: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut files = Vec::new();
-    let csv = dir.join("arrivals.csv");
-    std::fs::write(&csv, case1::arrivals_csv(r))
-        .with_context(|| format!("writing {}", csv.display()))?;
-    files.push(csv);
-    let trials = dir.join("trials.csv");
-    std::fs::write(&trials, case1::trials_csv(r))
-        .with_context(|| format!("writing {}", trials.display()))?;
-    files.push(trials);
-    let f5 = dir.join("fig5_arrivals.png");
-    plots::fig5_arrivals(r, &f5)?;
-    files.push(f5);
-    let f6 = dir.join("fig6_g3_trajectories.png");
-    fig6::fig6_trajectories(r, 2, &f6)?;
-    files.push(f6);
-    let all = dir.join("trajectories_all_groups.png");
-    fig6::trajectories_all_groups(r, &all)?;
-    files.push(all);
-    Ok(files)
+    let mut out = OutDir::create(dir)?;
+    out.text("arrivals.csv", case1::arrivals_csv(r))?;
+    out.text("trials.csv", case1::trials_csv(r))?;
+    out.figure("fig5_arrivals.png", |p| plots::fig5_arrivals(r, p))?;
+    out.figure("fig6_g3_trajectories.png", |p| {
+        fig6::fig6_trajectories(r, 2, p)
+    })?;
+    out.figure("trajectories_all_groups.png", |p| {
+        fig6::trajectories_all_groups(r, p)
+    })?;
+    Ok(out.files)
 }
 
 fn write_case1_random(r: &random_run::RandomCase1, dir: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut files = Vec::new();
-    for (name, text) in [
-        ("maps.csv", random_run::maps_csv(r)),
-        ("summary.md", random_run::markdown(r)),
-        (
-            "claims.json",
-            serde_json::to_string_pretty(&random_run::claims(r))? + "\n",
-        ),
-    ] {
-        let path = dir.join(name);
-        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
-        files.push(path);
-    }
-    let fail = dir.join("failures.png");
-    if random_plots::failures(r, &fail, 12)? {
-        files.push(fail);
-    }
-    let maps = dir.join("maps.png");
-    random_plots::overview(r, &maps, 6)?;
-    files.push(maps);
-    Ok(files)
+    let mut out = OutDir::create(dir)?;
+    out.text("maps.csv", random_run::maps_csv(r))?;
+    out.text("summary.md", random_run::markdown(r))?;
+    let claims = serde_json::to_string_pretty(&random_run::claims(r))? + "\n";
+    out.text("claims.json", claims)?;
+    out.figure_if("failures.png", |p| random_plots::failures(r, p, 12))?;
+    out.figure("maps.png", |p| random_plots::overview(r, p, 6))?;
+    Ok(out.files)
 }
 
 fn write_case2(r: &case2::Case2Result, dir: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut files = Vec::new();
-    let csv = dir.join("s_t.csv");
-    std::fs::write(&csv, case2::s_t_csv(r))
-        .with_context(|| format!("writing {}", csv.display()))?;
-    files.push(csv);
-    let f8 = dir.join("fig8_s_t.png");
-    fig78::fig8_s_t(r, &f8)?;
-    files.push(f8);
-    let f7 = dir.join("fig7_snapshots.png");
-    fig78::fig7_snapshots(r, &f7)?;
-    files.push(f7);
-    let tr = dir.join("trajectories.png");
-    fig78::case2_trajectories(r, &tr)?;
-    files.push(tr);
-    Ok(files)
+    let mut out = OutDir::create(dir)?;
+    out.text("s_t.csv", case2::s_t_csv(r))?;
+    out.figure("fig8_s_t.png", |p| fig78::fig8_s_t(r, p))?;
+    out.figure("fig7_snapshots.png", |p| fig78::fig7_snapshots(r, p))?;
+    out.figure("trajectories.png", |p| fig78::case2_trajectories(r, p))?;
+    Ok(out.files)
 }
 
 /// Entry point of the command line: sets up the thread pool, runs, prints where the files are.
 pub fn main(args: ExperimentArgs) -> Result<()> {
-    if let Some(n) = args.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("setting up the thread pool")?;
-    }
+    crate::cmd::use_threads(args.threads)?;
     let opts = Options::from_args(&args)?;
     let report = run(&opts)?;
     let mut text = summary::console(&report);
