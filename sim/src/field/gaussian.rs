@@ -166,14 +166,27 @@ impl FrozenSource {
         let (a, b) = (kxx * (dx0 + dx0) - kxy * dy0, kyy * (dy0 + dy0) - kxy * dx0);
         let (ex, ey, exx, eyy, exy) = (&near.ex, &near.ey, &near.exx, &near.eyy, &near.exy);
         let change = |k: usize| a * ex[k] + b * ey[k] + kxx * exx[k] + kyy * eyy[k] - kxy * exy[k];
-        if bound <= 0.1 {
-            for (k, o) in out.iter_mut().enumerate() {
-                *o += base * exp_series5(change(k));
-            }
-        } else {
-            for (k, o) in out.iter_mut().enumerate() {
-                *o += base * exp_series(change(k));
-            }
+        // Uncorrelated (`kxy = 0`, the usual source): the last term is a zero whose subtraction
+        // changes at most the sign of a zero change, after which the series is exactly 1 either way
+        // (`exy` is finite here: a bound within `SERIES_MAX` had `kxy` times it finite).
+        let plain = |k: usize| a * ex[k] + b * ey[k] + kxx * exx[k] + kyy * eyy[k];
+        match (bound <= 0.1, kxy == 0.0) {
+            (true, false) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(k, o)| *o += base * exp_series5(change(k))),
+            (true, true) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(k, o)| *o += base * exp_series5(plain(k))),
+            (false, false) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(k, o)| *o += base * exp_series(change(k))),
+            (false, true) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(k, o)| *o += base * exp_series(plain(k))),
         }
     }
 
