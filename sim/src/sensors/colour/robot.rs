@@ -70,7 +70,8 @@ impl ColourSensor {
         rng: &mut SimRng,
     ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
         use std::arch::x86_64::*;
-        let samples = self.footprint_samples(sensors);
+        // SAFETY: the CPU has AVX2.
+        let samples = unsafe { self.footprint_samples_avx2(sensors) };
         // SAFETY: the CPU has AVX2 (this function's contract).
         let mut levels =
             unsafe { crate::screen::footprint_levels_avx2(pheromones, frozen, screen, &samples) };
@@ -98,6 +99,59 @@ impl ColourSensor {
         let lanes = self.counts_of_spread(&light, 4, rng);
         let counts = std::array::from_fn(|s| std::array::from_fn(|c| lanes[lane(s, c)]));
         (counts, self.intensities_inline(&counts))
+    }
+}
+
+impl ColourSensor {
+    /// [`ColourSensor::footprint_samples`] of four sensors: each lane's sensor coordinate picked from
+    /// the four positions by one permute a vector (`fill`s and shuffles before), plus the offsets.
+    ///
+    /// # Safety
+    /// The CPU has AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    unsafe fn footprint_samples_avx2(&self, sensors: &[Vec2; 4]) -> FootprintSamples {
+        use std::arch::x86_64::*;
+        const { assert!(crate::screen::FOOTPRINT_LANES == 40) };
+        // x0 y0 x1 y1 x2 y2 x3 y3.
+        // SAFETY: four `Vec2` are eight consecutive f32.
+        let xy = unsafe { _mm256_loadu_ps(sensors.as_ptr().cast()) };
+        // Lane j of the samples is sensor j / 9's (padding lanes: sensor 0's).
+        let sensor = |j: i32| if j < 36 { j / 9 } else { 0 };
+        let (ox, oy) = &self.offset_lanes;
+        let mut samples = FootprintSamples {
+            xs: [0.0; 40],
+            ys: [0.0; 40],
+        };
+        for k in 0..5 {
+            let j = 8 * k as i32;
+            let index = |odd: i32| {
+                _mm256_setr_epi32(
+                    2 * sensor(j) + odd,
+                    2 * sensor(j + 1) + odd,
+                    2 * sensor(j + 2) + odd,
+                    2 * sensor(j + 3) + odd,
+                    2 * sensor(j + 4) + odd,
+                    2 * sensor(j + 5) + odd,
+                    2 * sensor(j + 6) + odd,
+                    2 * sensor(j + 7) + odd,
+                )
+            };
+            let (px, py) = (
+                _mm256_permutevar8x32_ps(xy, index(0)),
+                _mm256_permutevar8x32_ps(xy, index(1)),
+            );
+            // SAFETY: lanes `8 k .. 8 k + 8` of 40.
+            unsafe {
+                let at = 8 * k;
+                let x = _mm256_add_ps(_mm256_loadu_ps(ox.as_ptr().add(at)), px);
+                let y = _mm256_add_ps(_mm256_loadu_ps(oy.as_ptr().add(at)), py);
+                _mm256_storeu_ps(samples.xs.as_mut_ptr().add(at), x);
+                _mm256_storeu_ps(samples.ys.as_mut_ptr().add(at), y);
+            }
+        }
+        samples
     }
 }
 
@@ -199,6 +253,10 @@ mod tests {
                 heading: k as f32 * 0.3,
             };
             let sensors = crate::sensors::sensor_positions(&pose, 0.015);
+            // SAFETY: the CPU has AVX2 (checked above).
+            let lanes = unsafe { s.footprint_samples_avx2(&sensors) };
+            let want = s.footprint_samples(&sensors);
+            assert_eq!((lanes.xs, lanes.ys), (want.xs, want.ys));
             // SAFETY: the CPU has AVX2 (checked above).
             let got = unsafe { s.read_robot_avx2(&ph, &frozen, &screen, None, &sensors, &mut a) };
             let want = s.read_robot_portable(&ph, &frozen, &screen, None, &sensors, &mut b);
