@@ -191,8 +191,11 @@ impl FrozenSource {
     }
 
     /// One group of points around `centroid` with a per-point check: the series where a point's own
-    /// change of the exponent is small, its own f64 `exp` elsewhere (narrow sources).
-    #[inline(always)]
+    /// change of the exponent is small, its own f64 `exp` elsewhere (narrow sources). Out of line:
+    /// inlined, its offsets from the centroid were hoisted to the start of every footprint
+    /// evaluation, narrow source or not.
+    #[cold]
+    #[inline(never)]
     fn add_values_group(&self, centroid: (f32, f32), xs: &[f32], ys: &[f32], out: &mut [f32]) {
         let (cx, cy) = centroid;
         let base = (self.amplitude * self.exponent_xy(cx, cy).exp()) as f32;
