@@ -167,8 +167,9 @@ impl FrozenSource {
         let (ex, ey, exx, eyy, exy) = (&near.ex, &near.ey, &near.exx, &near.eyy, &near.exy);
         let change = |k: usize| a * ex[k] + b * ey[k] + kxx * exx[k] + kyy * eyy[k] - kxy * exy[k];
         // Uncorrelated (`kxy = 0`, the usual source): the last term is a zero whose subtraction
-        // changes at most the sign of a zero change, after which the series is exactly 1 either way
-        // (`exy` is finite here: a bound within `SERIES_MAX` had `kxy` times it finite).
+        // changes at most the sign of a zero change, after which the series is exactly 1 either way.
+        // (Every `exy` is finite here: with `kxy = 0` the bound is finite only if the largest
+        // offsets' product, which bounds them, is.)
         let plain = |k: usize| a * ex[k] + b * ey[k] + kxx * exx[k] + kyy * eyy[k];
         match (bound <= 0.1, kxy == 0.0) {
             (true, false) => out
