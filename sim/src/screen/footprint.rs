@@ -46,6 +46,7 @@ pub fn footprint_levels(
 /// The CPU has AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
+#[inline]
 pub unsafe fn footprint_levels_avx2(
     pheromones: &[Pheromone],
     frozen: &FrozenSources,
