@@ -83,7 +83,12 @@ pub fn normal_with(z: &Ziggurat, rng: &mut SimRng) -> f32 {
     if hz.unsigned_abs() < z.k[layer] {
         return hz as f32 * z.w[layer];
     }
-    z.slow(rng, hz, layer)
+    // The rare path on a copy: a caller's stream never has its address taken, so it can stay in
+    // registers over a run of draws.
+    let mut copy = rng.clone();
+    let v = z.slow(&mut copy, hz, layer);
+    *rng = copy;
+    v
 }
 
 /// Tables of the 128-layer ziggurat for the standard normal (Marsaglia & Tsang 2000, "The ziggurat

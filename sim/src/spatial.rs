@@ -44,7 +44,11 @@ impl NeighbourIndex {
             .max(arena.y / max_cells_per_axis);
         self.cell = cell;
         if positions.len() <= SCAN_ALL_BELOW {
-            // One cell (its bounds still clamp a query): the robots in index order, no sort.
+            // One cell (its bounds still clamp a query): the robots in index order, no sort. Already
+            // so for as many robots (the usual step of a small world): nothing to rebuild.
+            if self.dims == [1, 1] && self.items.len() == positions.len() {
+                return;
+            }
             self.dims = [1, 1];
             self.starts.clear();
             self.starts.extend([0, positions.len() as u32]);
@@ -97,7 +101,14 @@ impl NeighbourIndex {
     /// robots as [`Self::near`], without the iterator overhead).
     #[inline]
     pub fn for_each_near(&self, p: Vec2, reach: f32, mut f: impl FnMut(usize)) {
-        let (x0, x1, y0, y1) = self.cell_range(p, reach);
+        // One cell (a small world): every finite query covers it, and the cell range's clamped
+        // conversions cost more than the handful of robots it holds.
+        let (x0, x1, y0, y1) = if self.dims == [1, 1] {
+            let n = usize::from(p.is_finite() && reach.is_finite());
+            (0, n, 0, n)
+        } else {
+            self.cell_range(p, reach)
+        };
         let nx = self.dims[0];
         for y in y0..y1 {
             let a = self.starts[y * nx + x0] as usize;

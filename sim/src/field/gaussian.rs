@@ -166,20 +166,37 @@ impl FrozenSource {
         let (a, b) = (kxx * (dx0 + dx0) - kxy * dy0, kyy * (dy0 + dy0) - kxy * dx0);
         let (ex, ey, exx, eyy, exy) = (&near.ex, &near.ey, &near.exx, &near.eyy, &near.exy);
         let change = |k: usize| a * ex[k] + b * ey[k] + kxx * exx[k] + kyy * eyy[k] - kxy * exy[k];
-        if bound <= 0.1 {
-            for (k, o) in out.iter_mut().enumerate() {
-                *o += base * exp_series5(change(k));
-            }
-        } else {
-            for (k, o) in out.iter_mut().enumerate() {
-                *o += base * exp_series(change(k));
-            }
+        // Uncorrelated (`kxy = 0`, the usual source): the last term is a zero whose subtraction
+        // changes at most the sign of a zero change, after which the series is exactly 1 either way.
+        // (Every `exy` is finite here: with `kxy = 0` the bound is finite only if the largest
+        // offsets' product, which bounds them, is.)
+        let plain = |k: usize| a * ex[k] + b * ey[k] + kxx * exx[k] + kyy * eyy[k];
+        match (bound <= 0.1, kxy == 0.0) {
+            (true, false) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(k, o)| *o += base * exp_series5(change(k))),
+            (true, true) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(k, o)| *o += base * exp_series5(plain(k))),
+            (false, false) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(k, o)| *o += base * exp_series(change(k))),
+            (false, true) => out
+                .iter_mut()
+                .enumerate()
+                .for_each(|(k, o)| *o += base * exp_series(plain(k))),
         }
     }
 
     /// One group of points around `centroid` with a per-point check: the series where a point's own
-    /// change of the exponent is small, its own f64 `exp` elsewhere (narrow sources).
-    #[inline(always)]
+    /// change of the exponent is small, its own f64 `exp` elsewhere (narrow sources). Out of line:
+    /// inlined, its offsets from the centroid were hoisted to the start of every footprint
+    /// evaluation, narrow source or not.
+    #[cold]
+    #[inline(never)]
     fn add_values_group(&self, centroid: (f32, f32), xs: &[f32], ys: &[f32], out: &mut [f32]) {
         let (cx, cy) = centroid;
         let base = (self.amplitude * self.exponent_xy(cx, cy).exp()) as f32;

@@ -91,10 +91,25 @@ impl<const G: usize> NearbyPoints<G> {
         // SAFETY: the CPU has AVX2 (this function's contract), `G` is a multiple of eight (checked
         // above) and `n <= G`.
         let (sx, sy) = unsafe { (interleaved_sum_avx2(xs, n), interleaved_sum_avx2(ys, n)) };
-        let (cx, cy) = (
-            sx.iter().sum::<f32>() * inv_n,
-            sy.iter().sum::<f32>() * inv_n,
-        );
+        // `new` adds the eight lane sums in order (`sum()` starts from -0, which adds nothing): x and
+        // y side by side in the two low lanes, one addition per lane sum.
+        let (lo, hi) = (_mm256_unpacklo_ps(sx, sy), _mm256_unpackhi_ps(sx, sy));
+        // Per 128-bit half, `lo` holds lanes (0, 1) and (4, 5) of x and y interleaved, `hi` (2, 3)
+        // and (6, 7).
+        let quads = [
+            _mm256_castps256_ps128(lo),
+            _mm256_castps256_ps128(hi),
+            _mm256_extractf128_ps::<1>(lo),
+            _mm256_extractf128_ps::<1>(hi),
+        ];
+        let mut sum = quads[0];
+        sum = _mm_add_ps(sum, _mm_movehl_ps(sum, sum));
+        for q in &quads[1..] {
+            sum = _mm_add_ps(sum, *q);
+            sum = _mm_add_ps(sum, _mm_movehl_ps(*q, *q));
+        }
+        let c = _mm_mul_ps(sum, _mm_set1_ps(inv_n));
+        let (cx, cy) = (_mm_cvtss_f32(c), _mm_cvtss_f32(_mm_movehdup_ps(c)));
         let mut near = Self::about(n, (cx, cy));
         let (vcx, vcy) = (_mm256_set1_ps(cx), _mm256_set1_ps(cy));
         let sign = _mm256_set1_ps(-0.0);
@@ -114,12 +129,17 @@ impl<const G: usize> NearbyPoints<G> {
                 my = _mm256_max_epu32(my, _mm256_castps_si256(_mm256_andnot_ps(sign, ey)));
             }
         }
-        let largest = |m: __m256i| {
-            // SAFETY: a 256-bit vector is eight u32.
-            let lanes: [u32; 8] = unsafe { std::mem::transmute(m) };
-            f32::from_bits(lanes.into_iter().max().unwrap_or(0))
-        };
-        near.max_offset = (largest(mx), largest(my));
+        // Both maxima reduced together: x in the low 128-bit half, y in the high one.
+        let m = _mm256_max_epu32(
+            _mm256_permute2x128_si256::<0x20>(mx, my),
+            _mm256_permute2x128_si256::<0x31>(mx, my),
+        );
+        let m = _mm256_max_epu32(m, _mm256_shuffle_epi32::<0b01_00_11_10>(m));
+        let m = _mm256_max_epu32(m, _mm256_shuffle_epi32::<0b10_11_00_01>(m));
+        near.max_offset = (
+            f32::from_bits(_mm256_extract_epi32::<0>(m) as u32),
+            f32::from_bits(_mm256_extract_epi32::<4>(m) as u32),
+        );
         near
     }
 }
@@ -133,7 +153,10 @@ impl<const G: usize> NearbyPoints<G> {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-unsafe fn interleaved_sum_avx2<const G: usize>(v: &[f32; G], n: usize) -> [f32; 8] {
+unsafe fn interleaved_sum_avx2<const G: usize>(
+    v: &[f32; G],
+    n: usize,
+) -> std::arch::x86_64::__m256 {
     use std::arch::x86_64::*;
     let mut sum = _mm256_setzero_ps();
     let mut from = 0;
@@ -145,6 +168,5 @@ unsafe fn interleaved_sum_avx2<const G: usize>(v: &[f32; G], n: usize) -> [f32; 
         sum = _mm256_add_ps(sum, _mm256_and_ps(chunk, _mm256_castsi256_ps(inside)));
         from += 8;
     }
-    // SAFETY: a 256-bit vector is eight f32.
-    unsafe { std::mem::transmute(sum) }
+    sum
 }

@@ -46,16 +46,65 @@ pub fn footprint_levels(
 /// The CPU has AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
+#[inline]
 pub unsafe fn footprint_levels_avx2(
     pheromones: &[Pheromone],
     frozen: &FrozenSources,
     screen: &ScreenSpec,
     samples: &FootprintSamples,
 ) -> FootprintLevels {
-    footprint_levels_with(pheromones, frozen, screen, samples, |xs, ys| {
+    footprint_levels_with(
+        pheromones,
+        frozen,
         // SAFETY: the CPU has AVX2 (this function's contract).
-        unsafe { NearbyPoints::of_padded_avx2(xs, ys, SAMPLES) }
-    })
+        || unsafe { pixel_centres_avx2(screen, samples) },
+        |xs, ys| {
+            // SAFETY: the CPU has AVX2 (this function's contract).
+            unsafe { NearbyPoints::of_padded_avx2(xs, ys, SAMPLES) }
+        },
+    )
+}
+
+/// The samples' pixel centres ([`pixel_centre_coord`] lane for lane) in AVX2 registers: the plain
+/// conversion of `f.min(last)` kept the NaN handling of `min` (a compare and a blend a vector more),
+/// which `f > 0` already excludes.
+///
+/// # Safety
+/// The CPU has AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn pixel_centres_avx2(
+    screen: &ScreenSpec,
+    samples: &FootprintSamples,
+) -> ([f32; LANES], [f32; LANES]) {
+    use std::arch::x86_64::*;
+    const { assert!(LANES.is_multiple_of(8)) };
+    let pixel = screen.pixel_size();
+    let last = |n: u32| (n.max(1) - 1).min(1 << 30) as f32;
+    let axis = |v: &[f32; LANES], size: f32, n: u32| {
+        let (size, last) = (_mm256_set1_ps(size), _mm256_set1_ps(last(n)));
+        let mut out = [0f32; LANES];
+        for k in (0..LANES).step_by(8) {
+            // SAFETY: `k + 8 <= LANES`.
+            unsafe {
+                let f = _mm256_div_ps(_mm256_loadu_ps(v.as_ptr().add(k)), size);
+                // `f > 0` (false for NaN), then `min(f, last)` of a number: `minps` gives it.
+                let inside = _mm256_cmp_ps::<_CMP_GT_OQ>(f, _mm256_setzero_ps());
+                let f = _mm256_and_ps(inside, _mm256_min_ps(f, last));
+                // Truncation of a value in [0, 2^30]: what the integer conversion gives.
+                let t = _mm256_round_ps::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(f);
+                let centre = _mm256_mul_ps(_mm256_add_ps(t, _mm256_set1_ps(0.5)), size);
+                _mm256_storeu_ps(out.as_mut_ptr().add(k), centre);
+            }
+        }
+        out
+    };
+    let [nx, ny] = screen.resolution;
+    (
+        axis(&samples.xs, pixel.x, nx),
+        axis(&samples.ys, pixel.y, ny),
+    )
 }
 
 /// [`footprint_levels`] for any processor.
@@ -65,35 +114,37 @@ fn footprint_levels_portable(
     screen: &ScreenSpec,
     samples: &FootprintSamples,
 ) -> FootprintLevels {
-    footprint_levels_with(pheromones, frozen, screen, samples, |xs, ys| {
+    let centres = || {
+        let pixel = screen.pixel_size();
+        let [nx, ny] = screen.resolution;
+        (
+            std::array::from_fn(|k| pixel_centre_coord(samples.xs[k], pixel.x, nx)),
+            std::array::from_fn(|k| pixel_centre_coord(samples.ys[k], pixel.y, ny)),
+        )
+    };
+    footprint_levels_with(pheromones, frozen, centres, |xs, ys| {
         NearbyPoints::new(&xs[..SAMPLES], &ys[..SAMPLES])
     })
 }
 
-/// The operations of [`super::levels_at_portable`] for one group of [`SAMPLES`] points, lane for lane.
-/// `near` gives the samples' [`NearbyPoints`] from their pixel centres (the same offsets in the first
-/// [`SAMPLES`] lanes either way).
+/// The operations of [`super::levels_at_portable`] for one group of [`SAMPLES`] points, lane for lane,
+/// but for products with a colour weight of zero, which add nothing to a level (see
+/// [`Channels`]). `centres` gives the samples' pixel centres, `near` their [`NearbyPoints`] (the
+/// same offsets in the first [`SAMPLES`] lanes either way).
 #[inline(always)]
 fn footprint_levels_with(
     pheromones: &[Pheromone],
     frozen: &FrozenSources,
-    screen: &ScreenSpec,
-    samples: &FootprintSamples,
+    centres: impl FnOnce() -> ([f32; LANES], [f32; LANES]),
     near: impl FnOnce(&[f32; LANES], &[f32; LANES]) -> NearbyPoints<LANES>,
 ) -> FootprintLevels {
-    let pixel = screen.pixel_size();
-    let [nx, ny] = screen.resolution;
-    let (mut xs, mut ys) = ([0f32; LANES], [0f32; LANES]);
-    for k in 0..LANES {
-        xs[k] = pixel_centre_coord(samples.xs[k], pixel.x, nx);
-        ys[k] = pixel_centre_coord(samples.ys[k], pixel.y, ny);
-    }
+    let (xs, ys) = centres();
     let near = if frozen.is_empty() {
         None
     } else {
         Some(near(&xs, &ys))
     };
-    let mut acc = [[0f32; LANES]; 3];
+    let mut channels = Channels::default();
     // Made at the first grid pheromone: zeroing its arrays cost a tenth of a Gaussian-only call.
     let mut grid: Option<GridSampler<LANES>> = None;
     let mut values = [0f32; LANES];
@@ -115,19 +166,78 @@ fn footprint_levels_with(
                 }
             }
         }
-        for (a, &k) in acc.iter_mut().zip(&ph.colour) {
-            for (a, &v) in a.iter_mut().zip(&values) {
-                *a += k * v;
+        channels.add(&ph.colour, &values);
+    }
+    channels.levels()
+}
+
+/// Eq. (1)'s sums `sum_j k_j Phi_j` of the three channels. A product with `k = 0` is a zero (the level
+/// is the same whatever its sign) or, where `Phi_j` is not finite, NaN, which makes the level 0:
+/// zero weights are only added up (as `0 * Phi_j`, in `spoilt`) when their values are not all
+/// finite, and a channel no pheromone colours reads 0 throughout.
+struct Channels {
+    sums: [[f32; LANES]; 3],
+    coloured: [bool; 3],
+    spoilt: Option<[[f32; LANES]; 3]>,
+}
+
+impl Default for Channels {
+    fn default() -> Self {
+        Channels {
+            sums: [[0.0; LANES]; 3],
+            coloured: [false; 3],
+            spoilt: None,
+        }
+    }
+}
+
+impl Channels {
+    #[inline(always)]
+    fn add(&mut self, colour: &[f32; 3], values: &[f32; LANES]) {
+        // The largest magnitude's bits (an integer maximum, which vectorises) below infinity's.
+        let finite = || {
+            let largest = values
+                .iter()
+                .fold(0u32, |m, v| m.max(v.to_bits() & !(1 << 31)));
+            largest < f32::INFINITY.to_bits()
+        };
+        let mut checked = None;
+        for c in 0..3 {
+            let k = colour[c];
+            if k != 0.0 {
+                self.coloured[c] = true;
+                for (a, &v) in self.sums[c].iter_mut().zip(values) {
+                    *a += k * v;
+                }
+            } else if !*checked.get_or_insert_with(finite) {
+                let spoilt = self.spoilt.get_or_insert([[0.0; LANES]; 3]);
+                for (a, &v) in spoilt[c].iter_mut().zip(values) {
+                    *a += k * v;
+                }
             }
         }
     }
-    let mut out = [[0u32; LANES]; 3];
-    for (o, a) in out.iter_mut().zip(&acc) {
-        for (o, &a) in o.iter_mut().zip(a) {
-            *o = to_level_u32(a);
+
+    /// The 8-bit levels: the sums and, where zero weights met values that are not finite, their NaN.
+    #[inline(always)]
+    fn levels(self) -> FootprintLevels {
+        let mut out = [[0u32; LANES]; 3];
+        for c in 0..3 {
+            if !self.coloured[c] {
+                continue;
+            }
+            let mut sum = self.sums[c];
+            if let Some(spoilt) = &self.spoilt {
+                for (a, &z) in sum.iter_mut().zip(&spoilt[c]) {
+                    *a += z;
+                }
+            }
+            for (o, &a) in out[c].iter_mut().zip(&sum) {
+                *o = to_level_u32(a);
+            }
         }
+        out
     }
-    out
 }
 
 #[cfg(test)]

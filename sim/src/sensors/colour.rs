@@ -14,11 +14,10 @@ use lanes::round_count;
 use lanes::{LANES, matrix_lanes};
 
 mod lanes;
+mod robot;
 use crate::arena::Printed;
 use crate::field::{FrozenSources, Pheromone};
 use crate::rng::SimRng;
-#[cfg(target_arch = "x86_64")]
-use crate::screen::footprint_levels_avx2;
 use crate::screen::{
     FOOTPRINT_LANES, FootprintLevels, FootprintSamples, ScreenSpec, footprint_levels,
 };
@@ -249,38 +248,10 @@ impl ColourSensor {
         const BATCH: usize = 4;
         let mut sums = [[0u32; 3]; S];
         for (sensors, sums) in sensors.chunks(BATCH).zip(sums.chunks_mut(BATCH)) {
-            // Missing sensors of a short batch repeat the first: the batch stays one compact group of
-            // points (Gaussian sources take one `exp` per group, at its centroid). The padding lanes
-            // past the 36 samples repeat the first sample (see `FootprintSamples`).
-            // Each lane's sensor position (`fill` stores whole vectors), then `sample_points`' sum
-            // `offset + p` over whole vectors.
-            let (mut px, mut py) = (
-                [sensors[0].x; FOOTPRINT_LANES],
-                [sensors[0].y; FOOTPRINT_LANES],
-            );
-            for (s, p) in sensors.iter().enumerate().skip(1) {
-                px[s * FOOTPRINT_POINTS..(s + 1) * FOOTPRINT_POINTS].fill(p.x);
-                py[s * FOOTPRINT_POINTS..(s + 1) * FOOTPRINT_POINTS].fill(p.y);
-            }
-            let (ox, oy) = &self.offset_lanes;
-            let samples = FootprintSamples {
-                xs: std::array::from_fn(|j| ox[j] + px[j]),
-                ys: std::array::from_fn(|j| oy[j] + py[j]),
-            };
+            let samples = self.footprint_samples(sensors);
             let mut levels = levels(&samples);
             if let Some(printed) = printed {
-                let points = samples
-                    .xs
-                    .iter()
-                    .zip(&samples.ys)
-                    .take(BATCH * FOOTPRINT_POINTS);
-                for (k, (&x, &y)) in points.enumerate() {
-                    if let Some(c) = printed.colour_at(screen, Vec2::new(x, y)) {
-                        for (ch, v) in c.iter().enumerate() {
-                            levels[ch][k] = *v as u32;
-                        }
-                    }
-                }
+                paint_printed(screen, printed, &samples, &mut levels);
             }
             // A footprint's nine levels as eight (one vector reduction) and one.
             for (c, levels) in levels.iter().enumerate() {
@@ -292,6 +263,29 @@ impl ColourSensor {
             }
         }
         sums
+    }
+
+    /// The screen samples of up to four sensors' footprints. Missing sensors of a short batch repeat
+    /// the first: the batch stays one compact group of points (Gaussian sources take one `exp` per
+    /// group, at its centroid). The padding lanes past the 36 samples repeat the first sample (see
+    /// `FootprintSamples`).
+    #[inline(always)]
+    pub(super) fn footprint_samples(&self, sensors: &[Vec2]) -> FootprintSamples {
+        // Each lane's sensor position (`fill` stores whole vectors), then `sample_points`' sum
+        // `offset + p` over whole vectors.
+        let (mut px, mut py) = (
+            [sensors[0].x; FOOTPRINT_LANES],
+            [sensors[0].y; FOOTPRINT_LANES],
+        );
+        for (s, p) in sensors.iter().enumerate().skip(1).take(3) {
+            px[s * FOOTPRINT_POINTS..(s + 1) * FOOTPRINT_POINTS].fill(p.x);
+            py[s * FOOTPRINT_POINTS..(s + 1) * FOOTPRINT_POINTS].fill(p.y);
+        }
+        let (ox, oy) = &self.offset_lanes;
+        FootprintSamples {
+            xs: std::array::from_fn(|j| ox[j] + px[j]),
+            ys: std::array::from_fn(|j| oy[j] + py[j]),
+        }
     }
 
     /// Mean 8-bit screen level (r, g, b) over the footprint around `p`, each in [0, 255].
@@ -348,70 +342,6 @@ impl ColourSensor {
         self.counts_for_lights(&light, rng)
     }
 
-    /// A robot's four sensors read as [`ColourSensor::read_all_printed`] does (the same random draws
-    /// and counts), with their calibrated [`ColourSensor::intensities`]: the whole read compiled for
-    /// AVX2 where the processor has it (no fused multiply-add, so the same bits), its twelve channels
-    /// in wider registers.
-    pub fn read_robot(
-        &self,
-        pheromones: &[Pheromone],
-        frozen: &FrozenSources,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
-        sensors: &[Vec2; 4],
-        rng: &mut SimRng,
-    ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2.
-            return unsafe {
-                self.read_robot_avx2(pheromones, frozen, screen, printed, sensors, rng)
-            };
-        }
-        let levels =
-            |samples: &FootprintSamples| footprint_levels(pheromones, frozen, screen, samples);
-        self.read_robot_inline(screen, printed, sensors, rng, levels)
-    }
-
-    /// [`ColourSensor::read_robot`] for AVX2.
-    ///
-    /// # Safety
-    /// The CPU has AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn read_robot_avx2(
-        &self,
-        pheromones: &[Pheromone],
-        frozen: &FrozenSources,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
-        sensors: &[Vec2; 4],
-        rng: &mut SimRng,
-    ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
-        let levels = |samples: &FootprintSamples| {
-            // SAFETY: the CPU has AVX2 (this function's contract).
-            unsafe { footprint_levels_avx2(pheromones, frozen, screen, samples) }
-        };
-        self.read_robot_inline(screen, printed, sensors, rng, levels)
-    }
-
-    /// [`ColourSensor::read_robot`] with the screen's levels from `levels`.
-    #[inline(always)]
-    fn read_robot_inline(
-        &self,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
-        sensors: &[Vec2; 4],
-        rng: &mut SimRng,
-        levels: impl Fn(&FootprintSamples) -> FootprintLevels,
-    ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
-        let sums = self.footprint_sums_with(screen, printed, sensors, levels);
-        let lut = &self.light_by_sum;
-        let light = sums.map(|sum| sum.map(|s| lut[s as usize]));
-        let counts = self.counts_for_lights(&light, rng);
-        (counts, self.intensities_inline(&counts))
-    }
-
     /// Counts of one sensor whose footprint level sum is `sum` (one of
     /// [`ColourSensor::footprint_sums_printed`]'s), drawing what `read_all_printed` of that sensor
     /// draws: sensors with models of their own share one batched footprint pass.
@@ -429,6 +359,27 @@ impl ColourSensor {
     /// saturation at 65535.
     pub fn counts(&self, levels: [f32; 3], rng: &mut SimRng) -> [u16; 3] {
         self.counts_for_lights(&[self.light(levels)], rng)[0]
+    }
+}
+
+/// Printed obstacles drawn over the pheromones at the footprints' 36 samples.
+fn paint_printed(
+    screen: &ScreenSpec,
+    printed: &Printed,
+    samples: &FootprintSamples,
+    levels: &mut FootprintLevels,
+) {
+    let points = samples
+        .xs
+        .iter()
+        .zip(&samples.ys)
+        .take(4 * FOOTPRINT_POINTS);
+    for (k, (&x, &y)) in points.enumerate() {
+        if let Some(c) = printed.colour_at(screen, Vec2::new(x, y)) {
+            for (ch, v) in c.iter().enumerate() {
+                levels[ch][k] = *v as u32;
+            }
+        }
     }
 }
 

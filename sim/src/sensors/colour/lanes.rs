@@ -13,35 +13,47 @@ impl ColourSensor {
         light: &[[f32; 3]; S],
         rng: &mut SimRng,
     ) -> [[u16; 3]; S] {
-        let p = &self.params;
-        let scale = p.gain * p.integration_ms;
         let mut out = [[0u16; 3]; S];
         for (light, out) in light.chunks(LANE_SENSORS).zip(out.chunks_mut(LANE_SENSORS)) {
-            let mut noise = [0.0f32; LANES];
-            if p.noise > 0.0 {
-                // The stream's state in a local copy for the draws, so that it can stay in registers
-                // (the same draws in the same order).
-                let (z, mut local) = (crate::rng::ziggurat(), rng.clone());
-                for s in 0..light.len() {
-                    for c in 0..3 {
-                        noise[lane(s, c)] = p.noise * crate::rng::normal_with(z, &mut local);
-                    }
-                }
-                *rng = local;
-            }
-            let [r, g, b] = spread(light);
-            let m = &self.crosstalk_lanes;
-            let mut counts = [0u16; LANES];
-            for i in 0..LANES {
-                let signal = m[0][i] * r[i] + m[1][i] * g[i] + m[2][i] * b[i];
-                let dark = self.dark[i / LANE_SENSORS];
-                counts[i] = round_count(dark + scale * signal + noise[i]);
-            }
+            let counts = self.counts_of_spread(&spread(light), light.len(), rng);
             for (s, out) in out.iter_mut().enumerate() {
                 *out = std::array::from_fn(|c| counts[lane(s, c)]);
             }
         }
         out
+    }
+
+    /// Counts of up to four sensors (`sensors`) from their light as [`spread`] lays it out, in lanes
+    /// (`lane(s, c)`): [`ColourSensor::counts_for_lights`]' draws and arithmetic.
+    #[inline(always)]
+    pub(super) fn counts_of_spread(
+        &self,
+        [r, g, b]: &[[f32; LANES]; 3],
+        sensors: usize,
+        rng: &mut SimRng,
+    ) -> [u16; LANES] {
+        let p = &self.params;
+        let scale = p.gain * p.integration_ms;
+        let mut noise = [0.0f32; LANES];
+        if p.noise > 0.0 {
+            // The stream's state in a local copy for the draws, so that it can stay in registers
+            // (the same draws in the same order).
+            let (z, mut local) = (crate::rng::ziggurat(), rng.clone());
+            for s in 0..sensors.min(LANE_SENSORS) {
+                for c in 0..3 {
+                    noise[lane(s, c)] = p.noise * crate::rng::normal_with(z, &mut local);
+                }
+            }
+            *rng = local;
+        }
+        let m = &self.crosstalk_lanes;
+        let mut counts = [0u16; LANES];
+        for i in 0..LANES {
+            let signal = m[0][i] * r[i] + m[1][i] * g[i] + m[2][i] * b[i];
+            let dark = self.dark[i / LANE_SENSORS];
+            counts[i] = round_count(dark + scale * signal + noise[i]);
+        }
+        counts
     }
 
     /// A robot's four sensors read from their footprints' level sums (as
@@ -125,7 +137,7 @@ pub(super) const LANE_SENSORS: usize = 4;
 pub(super) const LANES: usize = 3 * LANE_SENSORS;
 
 #[inline(always)]
-fn lane(sensor: usize, channel: usize) -> usize {
+pub(super) fn lane(sensor: usize, channel: usize) -> usize {
     LANE_SENSORS * channel + sensor
 }
 
