@@ -239,10 +239,10 @@ class Trainer:
                 self.opt.step()
 
 
-def evaluate(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict, worlds: int,
-             steps: int, seed: int) -> float:  # fmt: skip
-    """Mean undiscounted return per agent over `worlds` seeded episodes of `steps` steps; `policy(env)`
-    gives the function from observations to actions (a `Baseline` needs the env it acts in)."""
+def episode_returns(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict,
+                    worlds: int, steps: int, seed: int) -> list[float]:  # fmt: skip
+    """Each world's undiscounted return per agent over `worlds` seeded episodes of `steps` steps;
+    `policy(env)` gives the function from observations to actions (a `Baseline` needs its env)."""
     v = VecEnv(num_envs=worlds, max_cycles=steps, **env_kwargs)
     act = policy(v)
     obs, _ = v.reset(seed=seed)
@@ -250,4 +250,10 @@ def evaluate(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env
     for _ in range(steps):
         obs, rew, _, _, _ = v.step(act(obs))
         total += rew
-    return float(total.mean())
+    return total.mean(axis=1).tolist()
+
+
+def evaluate(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict, worlds: int,
+             steps: int, seed: int) -> float:  # fmt: skip
+    """The mean of `episode_returns`: the mean return per agent over the seeded episodes."""
+    return float(np.mean(episode_returns(policy, env_kwargs, worlds, steps, seed)))

@@ -32,6 +32,7 @@ from colcos.baselines import Baseline
 from colcos.vector import VecEnv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ppo import episode_returns  # noqa: E402
 from train_aggregation import ActorCritic  # noqa: E402
 
 TWIN_LATENCY = 0.15
@@ -59,14 +60,7 @@ def load(path: str, d: int, c: int) -> ActorCritic:
 
 def sim_returns(act, scenario: str, worlds: int, steps: int, seed: int) -> list[float]:
     """Each world's mean return per follower over `worlds` seeded episodes on the simulator."""
-    v = VecEnv("aggregation", num_envs=worlds, max_cycles=steps, scenario=scenario)
-    policy = act(v)
-    obs, _ = v.reset(seed=seed)
-    total = np.zeros((worlds, v.num_agents))
-    for _ in range(steps):
-        obs, rew, _, _, _ = v.step(policy(obs))
-        total += rew
-    return total.mean(axis=1).tolist()
+    return episode_returns(act, {"task": "aggregation", "scenario": scenario}, worlds, steps, seed)
 
 
 def on_sim(act, scenario: str, worlds: int, steps: int, seed: int) -> float:
