@@ -104,15 +104,8 @@ def evaluate(task: str, act, args: argparse.Namespace) -> list[float]:
     """Return per agent of each of `args.eval_worlds` seeded episodes (every
     world's first episode after `reset(seed=args.eval_seed)`); `act(venv)` gives the policy
     (observations -> actions)."""
-    steps = episode_steps(task, args)
-    v = VecEnv(task, num_envs=args.eval_worlds, max_cycles=steps, num_threads=args.threads)
-    policy = act(v)
-    obs, _ = v.reset(seed=args.eval_seed)
-    total = np.zeros((v.num_envs, v.num_agents))
-    for _ in range(steps):
-        obs, rew, _, _, _ = v.step(policy(obs))
-        total += rew
-    return [float(x) for x in total.mean(axis=1)]
+    env_kwargs = {"task": task, "num_threads": args.threads}
+    return ppo.episode_returns(act, env_kwargs, args.eval_worlds, episode_steps(task, args), args.eval_seed)
 
 
 def _dump(path: pathlib.Path, obj: dict) -> None:
