@@ -32,8 +32,7 @@ from colcos.baselines import Baseline
 from colcos.vector import VecEnv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from ppo import episode_returns  # noqa: E402
-from train_aggregation import ActorCritic  # noqa: E402
+from ppo import ActorCritic, episode_returns  # noqa: E402
 
 TWIN_LATENCY = 0.15
 RANDOMIZE = """

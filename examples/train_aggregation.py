@@ -34,7 +34,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import ppo
 from colcos.baselines import Baseline, RandomPolicy
 from colcos.vector import VecEnv
-from ppo import ActorCritic, RunningNorm, critic_input  # noqa: F401  (the network other examples load from here)
 
 # The default budget: about 2 minutes of training on an idle 2-core x86 machine (97 s for 600 updates,
 # docs/python.md).

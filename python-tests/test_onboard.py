@@ -15,6 +15,7 @@ import pytest
 
 import colcos
 from colcos.onboard import Encoding, ExportError, encode_counts, export_c
+from example_modules import load_ppo
 
 CC = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
 pytestmark = pytest.mark.skipif(CC is None, reason="no C compiler (cc, gcc or clang) on PATH")
@@ -79,20 +80,12 @@ class CPolicy:
         return wheels
 
 
-def load_example():
-    """examples/train_aggregation.py as a module (its ActorCritic is the network the robots run)."""
-    spec = importlib.util.spec_from_file_location("train_aggregation", REPO / "examples" / "train_aggregation.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory):
     """The example's actor with wide output weights, and 10,000 observations of a parallel_env rollout it
     drove (with exploration noise); its input normaliser fitted to them, as training leaves it."""
     torch = pytest.importorskip("torch")
-    example = load_example()
+    example = load_ppo()
     torch.manual_seed(0)
     model = example.ActorCritic(17, 18)
     with torch.no_grad():  # the example starts near "stand still"; a trained actor drives
@@ -255,7 +248,7 @@ def _bad_policies(torch):
     return [
         ("policy.pt", "builtins.str"),
         ({"pi.0.weight": z((64, 17))}, "builtins.dict"),
-        (load_example().ActorCritic(17, 18), r"ActorCritic, not an nn.Sequential \(pass its actor, e.g. model.pi"),
+        (load_ppo().ActorCritic(17, 18), r"ActorCritic, not an nn.Sequential \(pass its actor, e.g. model.pi"),
         (nn.Sequential(nn.Linear(17, 8), nn.Dropout(), nn.Linear(8, 2)), r"policy\[1\] is Dropout"),
         (nn.Sequential(nn.Tanh(), nn.Linear(17, 2)), r"policy\[0\] is Tanh before any Linear"),
         (nn.Sequential(nn.Linear(17, 8), nn.Tanh(), nn.ReLU(), nn.Linear(8, 2)), "right after another activation"),

@@ -419,7 +419,7 @@ mod tests {
     }
 
     /// An `nx x ny` grid of `cell` whose k-th value (row-major) is `value(k)`.
-    fn patterned_grid(
+    pub(super) fn patterned_grid(
         nx: usize,
         ny: usize,
         cell: f32,
@@ -465,12 +465,10 @@ mod tests {
         assert!(lit > 100, "only {lit} readings see the field");
     }
 
-    /// A robot's four sensors read together give what four single reads give, random draws included,
-    /// on a grid field and Gaussian sources (one narrow enough that footprints take their own `exp`).
-    #[test]
-    fn read_all_equals_single_reads_in_order() {
+    /// A grid field and two Gaussian sources, one narrow enough that footprints take their own `exp`:
+    /// the fields the batched reads are checked on (here and in `robot`).
+    pub(super) fn grid_and_gaussians(g: crate::field::GridField) -> [Pheromone; 2] {
         use crate::field::{FieldModel, GaussianField, GaussianSource};
-        let g = patterned_grid(60, 30, 0.02, |k| (k as f32 * 0.61).cos().abs());
         let source = |sigma: f32, centre: Vec2| GaussianSource {
             k: 0.3,
             sigma_x: sigma,
@@ -487,7 +485,7 @@ mod tests {
             ],
             time: 1.0,
         };
-        let ph = [
+        [
             Pheromone {
                 name: "grid".into(),
                 colour: [200.0, 0.0, 60.0],
@@ -498,7 +496,16 @@ mod tests {
                 colour: [0.0, 255.0, 90.0],
                 model: FieldModel::Gaussian(gaussian),
             },
-        ];
+        ]
+    }
+
+    /// A robot's four sensors read together give what four single reads give, random draws included,
+    /// on a grid field and Gaussian sources (one narrow enough that footprints take their own `exp`).
+    #[test]
+    fn read_all_equals_single_reads_in_order() {
+        let ph = grid_and_gaussians(patterned_grid(60, 30, 0.02, |k| {
+            (k as f32 * 0.61).cos().abs()
+        }));
         let screen = ScreenSpec {
             resolution: [1200, 600],
             size: [1.2, 0.6],

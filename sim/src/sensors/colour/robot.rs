@@ -189,9 +189,6 @@ unsafe fn footprint_sums_avx2(levels: &FootprintLevels) -> [std::arch::x86_64::_
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::field::{
-        FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec,
-    };
 
     /// The AVX2 read gives the portable read's counts, intensities and random draws, on grid and
     /// Gaussian fields, near and beyond the panel's edges.
@@ -200,42 +197,12 @@ mod tests {
         if !std::is_x86_feature_detected!("avx2") {
             return;
         }
-        let spec = GridSpec {
-            nx: 60,
-            ny: 34,
-            cell: 0.024,
-        };
-        let mut g = GridField::new(spec, GridParams::default());
-        for (k, v) in g.values_mut().iter_mut().enumerate() {
-            *v = (k as f32 * 0.37).sin().abs() * 1.2;
-        }
-        let source = |sigma: f32, centre: Vec2| GaussianSource {
-            k: 0.5,
-            sigma_x: sigma,
-            sigma_y: sigma * 1.2,
-            rho: 0.2,
-            evaporation: 4.0,
-            centre,
-            start: 0.0,
-        };
-        let ph = [
-            Pheromone {
-                name: "grid".into(),
-                colour: [200.0, 0.0, 60.0],
-                model: FieldModel::Grid(g),
-            },
-            Pheromone {
-                name: "gauss".into(),
-                colour: [0.0, 255.0, 90.0],
-                model: FieldModel::Gaussian(GaussianField {
-                    sources: vec![
-                        source(0.3, Vec2::new(0.4, 0.3)),
-                        source(0.004, Vec2::new(0.8, 0.2)),
-                    ],
-                    time: 1.0,
-                }),
-            },
-        ];
+        let ph = super::super::tests::grid_and_gaussians(super::super::tests::patterned_grid(
+            60,
+            34,
+            0.024,
+            |k| (k as f32 * 0.37).sin().abs() * 1.2,
+        ));
         let screen = ScreenSpec::default();
         let frozen = FrozenSources::new(&ph);
         let s = ColourSensor::new(super::super::ColourSensorParams {

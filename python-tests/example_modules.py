@@ -1,0 +1,20 @@
+"""The examples' shared modules, loaded by path for the tests (examples/ is no package)."""
+
+from __future__ import annotations
+
+import importlib.util
+import pathlib
+import sys
+import types
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+
+
+def load_ppo() -> types.ModuleType:
+    """examples/ppo.py: the PPO trainer and its ActorCritic, the network the robots run."""
+    spec = importlib.util.spec_from_file_location("ppo", REPO / "examples" / "ppo.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["ppo"] = module  # its dataclass looks its module up while the class is made
+    spec.loader.exec_module(module)
+    return module
