@@ -34,13 +34,13 @@ struct Rig {
 /// Runs the twin and the bridge side by side for `seconds`; `during` runs on the test thread
 /// meanwhile (to switch faults). The twin keeps running a little after the bridge ends.
 fn run_rig(
+    sc: Scenario,
     channel: Box<dyn ByteChannel>,
     link_url: String,
     seconds: f64,
     during: impl FnOnce(&Arc<Mutex<TrackerFaults>>, &Arc<Mutex<RobotFaults>>),
 ) -> Rig {
     let _turn = one_at_a_time();
-    let sc = scenario();
     let mut twin = LoopbackTwin::over(&sc, channel, link_url, true);
     let faults = twin.twin.tracker().faults();
     let robot_faults = twin.twin.robots().faults.clone();
@@ -126,7 +126,7 @@ fn run_rig(
 fn run_with_tracker_fault(fault: impl FnOnce(&mut TrackerFaults)) -> (Rig, Instant) {
     let (channel, url) = udp_channel();
     let mut at = None;
-    let rig = run_rig(channel, url, 3.0, |faults, _| {
+    let rig = run_rig(scenario(), channel, url, 3.0, |faults, _| {
         std::thread::sleep(Duration::from_millis(1500));
         fault(&mut faults.lock().unwrap());
         at = Some(Instant::now());
@@ -152,7 +152,7 @@ fn case_two_drives_the_twin_over_udp() {
         let sc = scenario();
         colcos_sim::world::World::new(&sc).unwrap().poses().to_vec()
     };
-    let rig = run_rig(channel, url, 4.0, |_, _| {});
+    let rig = run_rig(scenario(), channel, url, 4.0, |_, _| {});
     let twin = rig.twin.join();
     let r = &rig.report;
     assert!(r.ticks >= 150, "{r:?}");
@@ -251,7 +251,7 @@ fn the_serial_link_drives_the_twin_over_a_pty() {
     let _alone = one_rig_at_a_time();
     let channel = PtyChannel::open().unwrap();
     let url = format!("serial://{}?baud=115200", channel.peer_path());
-    let rig = run_rig(Box::new(channel), url, 2.0, |_, _| {});
+    let rig = run_rig(scenario(), Box::new(channel), url, 2.0, |_, _| {});
     let twin = rig.twin.join();
     let driven = twin
         .received()
@@ -311,7 +311,12 @@ fn tracker_silence_stops_every_robot_in_time() {
 fn stream_faults_do_not_stop_the_loop() {
     let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
-    let rig = run_rig(channel, url, 3.0, |faults, _| {
+    // Two blocks per write leave gaps of two tracker frames by design, plus the 7-byte writes' own
+    // delay: the default silence limit (0.1 s) would stop a slowed machine for a gap this test makes on
+    // purpose. `tracker_silence_stops_every_robot_in_time` tests the limit itself.
+    let mut sc = scenario();
+    sc.spec.rig.tracker_silence = 0.3;
+    let rig = run_rig(sc, channel, url, 3.0, |faults, _| {
         let mut f = faults.lock().unwrap();
         f.split = 7;
         f.merge = 2;
@@ -413,7 +418,7 @@ fn events_of(log: &[colcos_bridge::rig::recorder::Recorded]) -> Vec<String> {
 fn a_robot_that_stops_answering_is_reported() {
     let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
-    let rig = run_rig(channel, url, 3.0, |_, robots| {
+    let rig = run_rig(scenario(), channel, url, 3.0, |_, robots| {
         std::thread::sleep(Duration::from_millis(1000));
         robots.lock().unwrap().deaf = vec![4];
     });
@@ -433,7 +438,7 @@ fn a_robot_that_never_answers_is_reported() {
     let _alone = one_rig_at_a_time();
     let (channel, url) = udp_channel();
     // The last robot is asked last: deaf before the loop's first request reaches it.
-    let rig = run_rig(channel, url, 2.5, |_, robots| {
+    let rig = run_rig(scenario(), channel, url, 2.5, |_, robots| {
         robots.lock().unwrap().deaf = vec![5];
     });
     let _twin = rig.twin.join();
