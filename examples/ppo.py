@@ -84,6 +84,15 @@ class ActorCritic(nn.Module):
         a = self.pi(self.obs_norm(o)).clamp(-1, 1)
         return a.numpy().reshape(*obs.shape[:-1], -1).astype(np.float32)
 
+    @torch.no_grad()
+    def sample(self, obs: np.ndarray, generator: torch.Generator) -> np.ndarray:
+        """Stochastic action, as in training: the mean plus Gaussian noise of sd `exp(log_std)` drawn
+        from `generator`, unclipped (the env's action map clips it)."""
+        o = torch.from_numpy(np.array(obs, dtype=np.float32).reshape(-1, obs.shape[-1]))
+        mu = self.pi(self.obs_norm(o))
+        a = mu + torch.exp(self.log_std) * torch.randn(mu.shape, generator=generator)
+        return a.numpy().reshape(*obs.shape[:-1], -1).astype(np.float32)
+
 
 def critic_input(obs: np.ndarray, state: np.ndarray) -> np.ndarray:
     """(E, N, obs) and (E, S) -> (E * N, obs + S + N): own observation, global state, one-hot agent id."""

@@ -26,7 +26,13 @@ trained again, so an interrupted study resumes, and several processes may share 
 twin (`parallel_env(plant="twin")`, real time at 50 Hz) for K episodes and on the simulator's
 `parallel_env` with the same seeds, and reports both returns.
 
-Needs torch. The rewards are the tasks' own (docs/tasks.md); nothing is added here.
+`--param KEY=VALUE` sets a task parameter for training and evaluation (`'food=[[0.75, 0.65], [0.75, 0.16]]'`),
+`--shaping KEY=VALUE` one for training only (`pickup_reward=1`: both arms get the same extra reward, every
+policy is evaluated on the task's own), `--scenario FILE` another scenario.
+
+    python examples/stigmergy.py --tasks colony --shaping pickup_reward=1 --out runs/stigmergy/shaped
+
+Needs torch. Without `--shaping` the rewards are the tasks' own (docs/tasks.md).
 """
 
 from __future__ import annotations
@@ -50,7 +56,11 @@ from torch import nn
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import ppo
 
-TASKS = ("colony", "coverage", "alarm")
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "tasks"))
+from rally import Rally, RallyCall
+
+TASKS = ("colony", "coverage", "alarm", "rally")
+PYTHON_TASKS = {"rally": (Rally, RallyCall)}  # written in Python: the task's class and its hand-written policy
 MODES = ("with", "without")
 
 
@@ -66,7 +76,11 @@ def episode_steps(task: str, args: argparse.Namespace) -> int:
     """Steps per episode: `--episode`, or with 0 the task's scenario's own duration."""
     if args.episode:
         return args.episode
-    scenario = tomllib.loads(colcos.default_scenario(task))
+    if args.scenario:
+        text = pathlib.Path(args.scenario).read_text()
+    else:
+        text = PYTHON_TASKS[task][0].scenario if task in PYTHON_TASKS else colcos.default_scenario(task)
+    scenario = tomllib.loads(text)
     return int(round(scenario["duration"] / scenario["dt"]))
 
 
@@ -75,16 +89,35 @@ def updates_for(args: argparse.Namespace, num_agents: int) -> int:
     return max(1, math.ceil(args.steps / (args.horizon * args.num_envs * num_agents)))
 
 
+def task_kwargs(task: str, args: argparse.Namespace, training: bool) -> dict:
+    """The env's task, scenario and task parameters: `--scenario` and `--param` everywhere, `--shaping`
+    (extra reward terms such as `pickup_reward=1`) only while training, so that every policy is
+    evaluated on the task's own reward. A task written in Python takes its parameters itself, and a
+    fresh instance per env (it keeps per-world state)."""
+    params: dict = dict(args.param)
+    if training:
+        params.update(args.shaping)
+    kw: dict = {"task": PYTHON_TASKS[task][0](**params)} if task in PYTHON_TASKS else {"task": task, **params}
+    if args.scenario:
+        kw["scenario"] = args.scenario
+    return kw
+
+
 def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn.Module, dict]:
     """PPO on `task` for the budget's updates; the model and its log: the learning curve (per update:
     agent-steps, mean reward per agent-step of the rollout; per finished batch of training episodes:
     agent-steps, their mean return), the updates, agent-steps and wall time."""
-    env = VecEnv(task, num_envs=args.num_envs, seed=seed, max_cycles=episode_steps(task, args), num_threads=args.threads)
-    cfg = ppo.Config(horizon=args.horizon, epochs=4, minibatches=4, lr=args.lr)
+    env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=episode_steps(task, args), num_threads=args.threads,
+                 **task_kwargs(task, args, training=True))
+    updates = updates_for(args, env.num_agents)
+    cfg = ppo.Config(horizon=args.horizon, epochs=4, minibatches=4, lr=args.lr, gamma=args.gamma,
+                     anneal=updates if args.anneal else 0)
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
+    with torch.no_grad():  # the exploration prior: both wheels' mean output starts at --start-forward
+        trainer.model.pi[-1].bias[:2] = args.start_forward
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
-    updates, start = updates_for(args, env.num_agents), time.time()
+    start = time.time()
     for update in range(updates):
         ended = len(trainer.finished)
         rate_curve.append((trainer.agent_steps + cfg.horizon * trainer.b, trainer.iterate()))
@@ -104,8 +137,21 @@ def evaluate(task: str, act, args: argparse.Namespace) -> list[float]:
     """Return per agent of each of `args.eval_worlds` seeded episodes (every
     world's first episode after `reset(seed=args.eval_seed)`); `act(venv)` gives the policy
     (observations -> actions)."""
-    env_kwargs = {"task": task, "num_threads": args.threads}
+    env_kwargs = {"num_threads": args.threads, **task_kwargs(task, args, training=False)}
     return ppo.episode_returns(act, env_kwargs, args.eval_worlds, episode_steps(task, args), args.eval_seed)
+
+
+def acting(model: nn.Module, lay: bool, args: argparse.Namespace):
+    """The evaluation's policy of a trained model: its mean action (`--eval-policy mean`), or actions
+    sampled as in training (`sample`), the noise seeded by `--eval-seed`, the same for every model."""
+    if args.eval_policy == "mean":
+        return lambda v: lambda o: to_env(model.act(o), lay)
+
+    def make(v):
+        g = torch.Generator().manual_seed(args.eval_seed)
+        return lambda o: to_env(model.sample(o, g), lay)
+
+    return make
 
 
 def _dump(path: pathlib.Path, obj: dict) -> None:
@@ -122,7 +168,7 @@ def run(task: str, mode: str, seed: int, args: argparse.Namespace) -> dict:
     path = folder / f"{mode}_seed{seed}.json"
     if path.exists():
         saved = json.loads(path.read_text())
-        if saved["config"] == config(args):
+        if same_config(saved["config"], config(args), args):
             return saved
         print(f"{path}: made with another configuration, trained again", flush=True)
     lay = mode == "with"
@@ -130,9 +176,9 @@ def run(task: str, mode: str, seed: int, args: argparse.Namespace) -> dict:
     torch.save(model.state_dict(), folder / f"{mode}_seed{seed}.pt")
     t0 = time.time()
     rec = {"task": task, "mode": mode, "seed": seed, "config": config(args), **log,
-           "eval": evaluate(task, lambda v: lambda o: to_env(model.act(o), lay), args)}
+           "eval": evaluate(task, acting(model, lay, args), args)}
     if lay:
-        rec["eval_rates_off"] = evaluate(task, lambda v: lambda o: to_env(model.act(o), False), args)
+        rec["eval_rates_off"] = evaluate(task, acting(model, False, args), args)
     rec["eval_seconds"] = round(time.time() - t0, 1)
     _dump(path, rec)
     return rec
@@ -143,14 +189,17 @@ def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
     folder = pathlib.Path(args.out) / task
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{name}.json"
-    cfg = {k: v for k, v in config(args).items() if k in ("episode", "eval_worlds", "eval_seed")}
+    cfg = {k: v for k, v in config(args).items() if k in ("episode", "eval_worlds", "eval_seed", "param", "scenario")}
     if path.exists():
         saved = json.loads(path.read_text())
-        if saved["config"] == cfg:
+        if same_config(saved["config"], cfg, args):
             return saved["eval"]
     if name == "baseline":
-        policy = {t: p for p, (t, _) in colcos.task_policies().items()}[task]
-        returns = evaluate(task, lambda v: Baseline(v, policy).act, args)
+        if task in PYTHON_TASKS:
+            returns = evaluate(task, lambda v: PYTHON_TASKS[task][1](seed=1).act, args)
+        else:
+            policy = {t: p for p, (t, _) in colcos.task_policies().items()}[task]
+            returns = evaluate(task, lambda v: Baseline(v, policy).act, args)
     else:
         returns = evaluate(task, lambda v: RandomPolicy(v, seed=1).act, args)
     _dump(path, {"config": cfg, "eval": returns})
@@ -159,15 +208,23 @@ def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
 
 def config(args: argparse.Namespace) -> dict:
     """What a saved run must share with this call to be reused."""
-    keys = ("steps", "num_envs", "horizon", "episode", "lr", "eval_worlds", "eval_seed")
+    keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "eval_worlds", "eval_seed", "param", "shaping", "scenario",
+            "start_forward", "eval_policy", "anneal")
     return {k: getattr(args, k) for k in keys}
+
+
+def same_config(saved: dict, current: dict, args: argparse.Namespace) -> bool:
+    """Whether a saved run's configuration is `current`; a setting the saved file lacks (one added to
+    the script since) counts as its default."""
+    return all(saved.get(k, args.defaults.get(k)) == v for k, v in current.items())
 
 
 def twin(task: str, seed: int, args: argparse.Namespace) -> dict:
     """The learned-with policy of `seed` on the digital twin and on the simulator's `parallel_env`, the
     same episode seeds; mean return per agent of each episode."""
     folder = pathlib.Path(args.out) / task
-    probe = VecEnv(task, num_envs=1, max_cycles=episode_steps(task, args), num_threads=args.threads)
+    probe = VecEnv(num_envs=1, max_cycles=episode_steps(task, args), num_threads=args.threads,
+                   **task_kwargs(task, args, training=False))
     d, w = probe.single_observation_space.shape[0], probe.single_action_space.shape[0]
     n = probe.num_agents
     model = ppo.ActorCritic(d, d + probe.state_space.shape[0] + n, act_dim=w)
@@ -175,12 +232,13 @@ def twin(task: str, seed: int, args: argparse.Namespace) -> dict:
     out: dict = {"seed": seed, "episodes": args.twin_episodes, "episode_steps": args.twin_steps or episode_steps(task, args)}
     for plant in ("sim", "twin"):
         returns, t0 = [], time.time()
-        with colcos.parallel_env(task=task, plant=plant, max_cycles=out["episode_steps"]) as env:
+        with colcos.parallel_env(plant=plant, max_cycles=out["episode_steps"], **task_kwargs(task, args, False)) as env:
+            act = acting(model, True, args)(env)  # sampled noise: the same seed on both plants
             for k in range(args.twin_episodes):
                 obs, _ = env.reset(seed=args.eval_seed + k)
                 total = 0.0
                 while env.agents:
-                    acts = {a: to_env(model.act(obs[a]), True) for a in env.agents}
+                    acts = {a: act(obs[a]) for a in env.agents}
                     obs, rew, _, _, _ = env.step(acts)
                     total += sum(rew.values())
                 returns.append(total / n)
@@ -247,6 +305,17 @@ def plot(task: str, row: dict, args: argparse.Namespace) -> None:
     plt.close(fig)
 
 
+def parse_param(p: argparse.ArgumentParser, flag: str, kv: str) -> tuple[str, object]:
+    """`KEY=VALUE` with VALUE in JSON (`5`, `[[0.7, 0.6]]`, `"agent"`); a bare word is taken as a string."""
+    key, sep, value = kv.partition("=")
+    if not sep or not key:
+        p.error(f"{flag} {kv!r}: expected KEY=VALUE")
+    try:
+        return key, json.loads(value)
+    except json.JSONDecodeError:
+        return key, value
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--tasks", nargs="+", default=list(TASKS), choices=TASKS)
@@ -258,16 +327,32 @@ def main() -> None:
     p.add_argument("--episode", type=int, default=0, help="steps per episode, training and evaluation (0: the scenario's duration)")
     p.add_argument("--threads", type=int, default=1, help="env worker threads (1: reproducible, and fair on a shared machine)")
     p.add_argument("--lr", type=float, default=1e-3)
+    p.add_argument("--anneal", action="store_true", help="the learning rate falls linearly to 0 over the budget")
+    p.add_argument("--gamma", type=float, default=0.98, help="discount per step (0.98: about a second ahead)")
     p.add_argument("--eval-worlds", type=int, default=32)
     p.add_argument("--eval-seed", type=int, default=12345)
+    p.add_argument("--eval-policy", choices=("mean", "sample"), default="mean",
+                   help="evaluate the learned policies' mean action, or sample them as in training (an on/off call "
+                        "whose mean stays below 0.5 never sounds in the mean action)")
     p.add_argument("--out", default="runs/stigmergy")
     p.add_argument("--verbose", type=int, default=0, metavar="K", help="print progress every K updates")
     p.add_argument("--twin-episodes", type=int, default=0, help="then run the first task's learned-with policy on the twin")
     p.add_argument("--twin-steps", type=int, default=0, help="steps per twin episode (0: as --episode)")
+    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                   help="task parameter for training and evaluation, the value in JSON: food_amount=5, "
+                        "'food=[[0.75, 0.65], [0.75, 0.16]]' (repeatable)")
+    p.add_argument("--shaping", action="append", default=[], metavar="KEY=VALUE",
+                   help="task parameter for training only (evaluation keeps the task's own reward): pickup_reward=1")
+    p.add_argument("--start-forward", type=float, default=0.0, metavar="F",
+                   help="the untrained policy drives forward at F (both wheels' mean output), not standing still")
+    p.add_argument("--scenario", default=None, help="scenario file instead of the task's own (training and evaluation)")
     args = p.parse_args()
+    args.defaults = {k: p.get_default(k) for k in vars(args)} | {"param": {}, "shaping": {}}
+    for name in ("param", "shaping"):
+        setattr(args, name, dict(parse_param(p, f"--{name}", kv) for kv in getattr(args, name)))
     torch.set_num_threads(1)
     os.makedirs(args.out, exist_ok=True)
-    results: dict = {"args": vars(args), "tasks": {}}
+    results: dict = {"args": {k: v for k, v in vars(args).items() if k != "defaults"}, "tasks": {}}
     start = time.time()
     for task in args.tasks:
         row: dict = {"runs": {m: {} for m in args.modes}}

@@ -18,3 +18,15 @@ def load_ppo() -> types.ModuleType:
     sys.modules["ppo"] = module  # its dataclass looks its module up while the class is made
     spec.loader.exec_module(module)
     return module
+
+
+def load_task(name: str) -> types.ModuleType:
+    """examples/tasks/<name>.py (a task written in Python), importing its `_common` as the script does."""
+    folder = REPO / "examples" / "tasks"
+    if str(folder) not in sys.path:
+        sys.path.insert(0, str(folder))
+    spec = importlib.util.spec_from_file_location(f"colcos_example_{name}", folder / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module

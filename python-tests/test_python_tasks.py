@@ -4,28 +4,11 @@ the whole batch at once; a hook that raises or returns the wrong shape is named.
 
 from __future__ import annotations
 
-import importlib.util
-import pathlib
-import sys
-
 import numpy as np
 import pytest
+from example_modules import load_task as _load
 
 import colcos
-
-EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples" / "tasks"
-
-
-def _load(name: str):
-    # The re-writes import their shared `_common` as a script next to them does.
-    if str(EXAMPLES) not in sys.path:
-        sys.path.insert(0, str(EXAMPLES))
-    spec = importlib.util.spec_from_file_location(f"colcos_example_{name}", EXAMPLES / f"{name}.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
 
 # Parameters given alike to the Rust task and its Python re-write: the colony's food lies near the
 # nest so that pickups and deliveries happen within the run; captures cost something.

@@ -25,3 +25,33 @@ def test_tiny_study_runs(tmp_path):
     # 6 agents, 30 steps, a safe fraction in [0, 1] each step.
     for value in (*row["with"], *row["without"], row["baseline"], row["random"]):
         assert 0.0 <= value <= 30.0
+
+
+def _study(tmp_path, *extra: str) -> subprocess.CompletedProcess:
+    args = ["--steps", "1500", "--seeds", "0", "--episode", "30", "--num-envs", "2", "--horizon", "16",
+            "--eval-worlds", "2", "--threads", "1", "--out", str(tmp_path), *extra]
+    return subprocess.run([sys.executable, str(REPO / "examples" / "stigmergy.py"), *args],
+                          capture_output=True, text=True, timeout=600, check=False)
+
+
+def test_a_python_task_with_sampled_evaluation_and_training_only_shaping(tmp_path):
+    pytest.importorskip("torch")
+    run = _study(tmp_path, "--tasks", "rally", "--eval-policy", "sample", "--start-forward", "0.5", "--gamma", "0.99",
+                 "--param", "spot_radius=0.3", "--shaping", "margin=0.2")
+    assert run.returncode == 0, run.stderr
+    saved = json.loads((tmp_path / "rally" / "with_seed0.json").read_text())
+    assert saved["config"]["param"] == {"spot_radius": 0.3} and saved["config"]["shaping"] == {"margin": 0.2}
+    assert saved["config"]["eval_policy"] == "sample" and saved["config"]["gamma"] == 0.99
+    # At most 30 steps on the spot per episode; the sampled evaluation is seeded: the same again.
+    assert all(0.0 <= r <= 30.0 for r in saved["eval"])
+    _study(tmp_path / "again", "--tasks", "rally", "--eval-policy", "sample", "--start-forward", "0.5",
+                   "--gamma", "0.99", "--param", "spot_radius=0.3", "--shaping", "margin=0.2")
+    assert json.loads((tmp_path / "again" / "rally" / "with_seed0.json").read_text())["eval"] == saved["eval"]
+
+
+def test_a_bad_task_parameter_is_refused_by_name(tmp_path):
+    pytest.importorskip("torch")
+    run = _study(tmp_path, "--tasks", "colony", "--param", "bogus=1")
+    assert run.returncode != 0 and "colony.bogus" in run.stderr, run.stderr[-2000:]
+    run = _study(tmp_path, "--tasks", "colony", "--param", "no_equals_sign")
+    assert run.returncode != 0 and "--param 'no_equals_sign': expected KEY=VALUE" in run.stderr, run.stderr[-2000:]
