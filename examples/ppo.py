@@ -94,12 +94,23 @@ class ActorCritic(nn.Module):
         return a.numpy().reshape(*obs.shape[:-1], -1).astype(np.float32)
 
 
-def critic_input(obs: np.ndarray, state: np.ndarray) -> np.ndarray:
-    """(E, N, obs) and (E, S) -> (E * N, obs + S + N): own observation, global state, one-hot agent id."""
-    e, n, _ = obs.shape
+def critic_input(obs: np.ndarray, state: np.ndarray, team: bool = False) -> np.ndarray:
+    """(E, N, obs) and (E, S) -> (E * N, obs + S + N): own observation, global state, one-hot agent id;
+    with `team`, then every agent's observation too (+ N * obs: what the whole team senses, such as
+    who stands where a task pays, which the poses alone do not say)."""
+    e, n, d = obs.shape
     s = np.broadcast_to(state[:, None, :], (e, n, state.shape[-1]))
     ids = np.broadcast_to(np.eye(n, dtype=np.float32)[None], (e, n, n))
-    return np.concatenate([obs, s, ids], axis=-1, dtype=np.float32).reshape(e * n, -1)
+    parts = [obs, s, ids]
+    if team:
+        parts.append(np.broadcast_to(obs.reshape(e, 1, n * d), (e, n, n * d)))
+    return np.concatenate(parts, axis=-1, dtype=np.float32).reshape(e * n, -1)
+
+
+def critic_dim(env: VecEnv, team: bool = False) -> int:
+    """The width of `critic_input` for `env`'s observations and state."""
+    n, d = env.num_agents, env.single_observation_space.shape[0]
+    return d + env.state_space.shape[0] + n + (n * d if team else 0)
 
 
 @dataclasses.dataclass
@@ -116,6 +127,7 @@ class Config:
     ent_coef: float = 0.0
     hidden: int = 64
     anneal: int = 0  # with N > 0, the learning rate falls linearly to 0 over N updates (the budget)
+    team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
 
 
 def clip_wheels(a: np.ndarray) -> np.ndarray:
@@ -136,7 +148,7 @@ class Trainer:
         e, n, d = env.num_envs, env.num_agents, env.single_observation_space.shape[0]
         self.e, self.n, self.d, self.b = e, n, d, e * n
         self.w = env.single_action_space.shape[0]
-        self.c = d + env.state_space.shape[0] + n
+        self.c = critic_dim(env, cfg.team_critic)
         self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden)
         self.opt = torch.optim.Adam(self.model.parameters(), lr=cfg.lr, eps=1e-5)
         # Rewards are divided by a running std of the discounted return, so that the critic's targets
@@ -166,7 +178,7 @@ class Trainer:
         for t in range(T):
             t0 = time.perf_counter()
             obs_buf[t] = self.obs.reshape(b, d)
-            cri_buf[t] = critic_input(self.obs, self.state)
+            cri_buf[t] = critic_input(self.obs, self.state, self.cfg.team_critic)
             with torch.no_grad():
                 noise = torch.randn(b, self.w)
                 act_buf[t] = model.pi(model.obs_norm(torch.from_numpy(obs_buf[t]))) + noise * model.log_std.exp()
@@ -192,7 +204,7 @@ class Trainer:
             self.prev_done = done
             self.agent_steps += b
         t0 = time.perf_counter()
-        cri_buf[T] = critic_input(self.obs, self.state)
+        cri_buf[T] = critic_input(self.obs, self.state, self.cfg.team_critic)
         self._learn(obs_buf, cri_buf, act_buf, logp_buf, rew_buf, done_buf, valid_buf)
         self.seconds["learn"] += time.perf_counter() - t0
         self.updates += 1

@@ -111,7 +111,7 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
                  **task_kwargs(task, args, training=True))
     updates = updates_for(args, env.num_agents)
     cfg = ppo.Config(horizon=args.horizon, epochs=4, minibatches=4, lr=args.lr, gamma=args.gamma,
-                     anneal=updates if args.anneal else 0)
+                     anneal=updates if args.anneal else 0, team_critic=args.team_critic)
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
     with torch.no_grad():  # the exploration prior: both wheels' mean output starts at --start-forward
         trainer.model.pi[-1].bias[:2] = args.start_forward
@@ -209,7 +209,8 @@ def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
 def config(args: argparse.Namespace) -> dict:
     """What a saved run must share with this call to be reused."""
     keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "eval_worlds", "eval_seed", "param", "shaping", "scenario",
-            "start_forward", "eval_policy", "anneal")
+            "start_forward", "eval_policy", "anneal",
+            "team_critic")
     return {k: getattr(args, k) for k in keys}
 
 
@@ -227,7 +228,7 @@ def twin(task: str, seed: int, args: argparse.Namespace) -> dict:
                    **task_kwargs(task, args, training=False))
     d, w = probe.single_observation_space.shape[0], probe.single_action_space.shape[0]
     n = probe.num_agents
-    model = ppo.ActorCritic(d, d + probe.state_space.shape[0] + n, act_dim=w)
+    model = ppo.ActorCritic(d, ppo.critic_dim(probe, args.team_critic), act_dim=w)
     model.load_state_dict(torch.load(folder / f"with_seed{seed}.pt"))
     out: dict = {"seed": seed, "episodes": args.twin_episodes, "episode_steps": args.twin_steps or episode_steps(task, args)}
     for plant in ("sim", "twin"):
@@ -327,6 +328,7 @@ def main() -> None:
     p.add_argument("--episode", type=int, default=0, help="steps per episode, training and evaluation (0: the scenario's duration)")
     p.add_argument("--threads", type=int, default=1, help="env worker threads (1: reproducible, and fair on a shared machine)")
     p.add_argument("--lr", type=float, default=1e-3)
+    p.add_argument("--team-critic", action="store_true", help="the critic sees every agent's observation")
     p.add_argument("--anneal", action="store_true", help="the learning rate falls linearly to 0 over the budget")
     p.add_argument("--gamma", type=float, default=0.98, help="discount per step (0.98: about a second ahead)")
     p.add_argument("--eval-worlds", type=int, default=32)

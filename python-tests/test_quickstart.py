@@ -44,6 +44,25 @@ def test_trainer_counts_updates_and_samples():
     assert any(not np.array_equal(a.numpy(), p.detach().numpy()) for a, p in zip(before, trainer.model.pi.parameters()))
 
 
+def test_the_team_critic_sees_every_agents_observation():
+    pytest.importorskip("torch")
+    ppo = load_ppo()
+    rng = np.random.default_rng(0)
+    obs, state = rng.normal(size=(2, 3, 5)).astype(np.float32), rng.normal(size=(2, 4)).astype(np.float32)
+    plain, team = ppo.critic_input(obs, state), ppo.critic_input(obs, state, team=True)
+    assert plain.shape == (6, 5 + 4 + 3) and team.shape == (6, 5 + 4 + 3 + 3 * 5)
+    np.testing.assert_array_equal(team[:, :12], plain)
+    for world in range(2):
+        for agent in range(3):  # each agent's row holds its world's whole team, in agent order
+            np.testing.assert_array_equal(team[3 * world + agent, 12:], obs[world].reshape(-1))
+    from colcos.vector import VecEnv
+
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=20, num_threads=1)
+    trainer = ppo.Trainer(env, ppo.Config(horizon=4, epochs=1, minibatches=1, team_critic=True), seed=0)
+    trainer.iterate()
+    assert trainer.c == ppo.critic_dim(env, team=True) == ppo.critic_dim(env) + env.num_agents * 17
+
+
 def test_quickstart_runs_and_reports(tmp_path):
     pytest.importorskip("torch")
     args = ["--updates", "4", "--eval-every", "2", "--seeds", "0", "1", "--num-envs", "2", "--horizon", "8",

@@ -37,15 +37,16 @@ def _study(tmp_path, *extra: str) -> subprocess.CompletedProcess:
 def test_a_python_task_with_sampled_evaluation_and_training_only_shaping(tmp_path):
     pytest.importorskip("torch")
     run = _study(tmp_path, "--tasks", "rally", "--eval-policy", "sample", "--start-forward", "0.5", "--gamma", "0.99",
-                 "--param", "spot_radius=0.3", "--shaping", "margin=0.2")
+                 "--team-critic", "--anneal", "--param", "spot_radius=0.3", "--shaping", "margin=0.2")
     assert run.returncode == 0, run.stderr
     saved = json.loads((tmp_path / "rally" / "with_seed0.json").read_text())
     assert saved["config"]["param"] == {"spot_radius": 0.3} and saved["config"]["shaping"] == {"margin": 0.2}
     assert saved["config"]["eval_policy"] == "sample" and saved["config"]["gamma"] == 0.99
+    assert saved["config"]["team_critic"] and saved["config"]["anneal"]
     # At most 30 steps on the spot per episode; the sampled evaluation is seeded: the same again.
     assert all(0.0 <= r <= 30.0 for r in saved["eval"])
     _study(tmp_path / "again", "--tasks", "rally", "--eval-policy", "sample", "--start-forward", "0.5",
-                   "--gamma", "0.99", "--param", "spot_radius=0.3", "--shaping", "margin=0.2")
+                   "--gamma", "0.99", "--team-critic", "--anneal", "--param", "spot_radius=0.3", "--shaping", "margin=0.2")
     assert json.loads((tmp_path / "again" / "rally" / "with_seed0.json").read_text())["eval"] == saved["eval"]
 
 
