@@ -48,6 +48,13 @@ def test_a_python_task_with_sampled_evaluation_and_training_only_shaping(tmp_pat
     _study(tmp_path / "again", "--tasks", "rally", "--eval-policy", "sample", "--start-forward", "0.5",
                    "--gamma", "0.99", "--team-critic", "--anneal", "--param", "spot_radius=0.3", "--shaping", "margin=0.2")
     assert json.loads((tmp_path / "again" / "rally" / "with_seed0.json").read_text())["eval"] == saved["eval"]
+    # What the learned agents lay, and when: shares in [0, 1], split by the task's flag.
+    probe = subprocess.run([sys.executable, str(REPO / "examples" / "stigmergy_probe.py"), "--out", str(tmp_path),
+                            "--task", "rally", "--worlds", "2"], capture_output=True, text=True, timeout=600, check=False)
+    assert probe.returncode == 0, probe.stderr
+    (row,) = json.loads((tmp_path / "rally" / "probe.json").read_text())
+    assert row["seed"] == 0 and sum(row["agent_steps"]) == 2 * 6 * 30
+    assert all(0.0 <= x <= 1.0 for x in (*row["lay_with_flag"], *row["lay_without_flag"], row["speed_without_flag"]))
 
 
 def test_a_bad_task_parameter_is_refused_by_name(tmp_path):
