@@ -73,7 +73,7 @@ def main() -> None:
         r = probe(folder, seed, args.task, args.worlds)
         rows.append(r)
         share = r["agent_steps"][1] / sum(r["agent_steps"])
-        fmt = lambda xs: ", ".join(f"{x:.2f}" for x in xs)  # noqa: E731
+        fmt = lambda xs: ", ".join(f"{x:.2f}" for x in xs)
         print(f"| {seed} | {share:.3f} | {fmt(r['lay_without_flag'])} | {fmt(r['lay_with_flag'])} "
               f"| {r['speed_without_flag']:.2f} | {r['speed_with_flag']:.2f} |", flush=True)
     (folder / "probe.json").write_text(json.dumps(rows, indent=1))
