@@ -15,43 +15,15 @@ where one is sensed; else a correlated random walk that turns away from bumps.
 
 from __future__ import annotations
 
+import pathlib
+
 import numpy as np
 
 import colcos
 
 F32 = np.float32
 
-SCENARIO = """
-# Task `rally` (examples/tasks/rally.py): a hidden spot, and a call each agent may switch on.
-name = "rally"
-duration = 30.0
-dt = 0.02
-seed = 0
-physics = "rapier"
-
-[screen]
-resolution = [3840, 2160]
-size = [1.439, 0.809]
-
-[field]
-cell = 0.01
-
-# The call: a Gaussian source (sigma 25 cm) at each agent that switches it on, about half the
-# screen's full green at the caller; it fades within a second of being switched off.
-[[pheromones]]
-name = "call"
-colour = [0, 255, 0]
-model = "gaussian"
-evaporation = 1.0
-
-[[robots]]
-count = 6
-role = "agent"
-behaviour = "wander"
-params = { speed = 0.1 }
-placement = "random"
-emits = [{ pheromone = "call", k = 0.2, sigma = [0.25, 0.25], evaporation = 1.0, when = "action" }]
-"""
+SCENARIO = (pathlib.Path(__file__).parent / "rally.toml").read_text()  # six agents, each with a call
 
 
 class Rally(colcos.Task):
