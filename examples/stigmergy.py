@@ -208,9 +208,8 @@ def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
 
 def config(args: argparse.Namespace) -> dict:
     """What a saved run must share with this call to be reused."""
-    keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "eval_worlds", "eval_seed", "param", "shaping", "scenario",
-            "start_forward", "eval_policy", "anneal",
-            "team_critic")
+    keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "anneal", "team_critic", "start_forward",
+            "param", "shaping", "scenario", "eval_worlds", "eval_seed", "eval_policy")
     return {k: getattr(args, k) for k in keys}
 
 
