@@ -81,7 +81,7 @@ def episode_steps(task: str, args: argparse.Namespace) -> int:
     else:
         text = PYTHON_TASKS[task][0].scenario if task in PYTHON_TASKS else colcos.default_scenario(task)
     scenario = tomllib.loads(text)
-    return int(round(scenario["duration"] / scenario["dt"]))
+    return round(scenario["duration"] / scenario["dt"])
 
 
 def updates_for(args: argparse.Namespace, num_agents: int) -> int:
@@ -111,10 +111,9 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
                  **task_kwargs(task, args, training=True))
     updates = updates_for(args, env.num_agents)
     cfg = ppo.Config(horizon=args.horizon, epochs=4, minibatches=4, lr=args.lr, gamma=args.gamma,
-                     anneal=updates if args.anneal else 0, team_critic=args.team_critic)
+                     anneal=updates if args.anneal else 0, team_critic=args.team_critic,
+                     start_forward=args.start_forward)
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
-    with torch.no_grad():  # the exploration prior: both wheels' mean output starts at --start-forward
-        trainer.model.pi[-1].bias[:2] = args.start_forward
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
     start = time.time()
@@ -316,7 +315,9 @@ def parse_param(p: argparse.ArgumentParser, flag: str, kv: str) -> tuple[str, ob
         return key, value
 
 
-def main() -> None:
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    """The study's settings from `argv` (the command line if None; `[]`: every default), `--param`
+    and `--shaping` as dicts, `defaults` holding what a saved run that lacks a setting counts it as."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--tasks", nargs="+", default=list(TASKS), choices=TASKS)
     p.add_argument("--modes", nargs="+", default=list(MODES), choices=MODES, help="train only these (a share of the work)")
@@ -347,10 +348,15 @@ def main() -> None:
     p.add_argument("--start-forward", type=float, default=0.0, metavar="F",
                    help="the untrained policy drives forward at F (both wheels' mean output), not standing still")
     p.add_argument("--scenario", default=None, help="scenario file instead of the task's own (training and evaluation)")
-    args = p.parse_args()
+    args = p.parse_args(argv)
     args.defaults = {k: p.get_default(k) for k in vars(args)} | {"param": {}, "shaping": {}}
     for name in ("param", "shaping"):
         setattr(args, name, dict(parse_param(p, f"--{name}", kv) for kv in getattr(args, name)))
+    return args
+
+
+def main() -> None:
+    args = parse_args()
     torch.set_num_threads(1)
     os.makedirs(args.out, exist_ok=True)
     results: dict = {"args": {k: v for k, v in vars(args).items() if k != "defaults"}, "tasks": {}}

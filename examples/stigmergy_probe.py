@@ -25,10 +25,8 @@ import stigmergy
 
 def probe(folder: pathlib.Path, seed: int, task: str, worlds: int) -> dict:
     saved = json.loads((folder / f"with_seed{seed}.json").read_text())
-    cfg = argparse.Namespace(**{**saved["config"], "threads": 1})
-    defaults = {"param": {}, "shaping": {}, "scenario": None, "team_critic": False, "eval_policy": "mean"}
-    for key, value in defaults.items():  # runs saved by an older stigmergy.py lack some settings
-        setattr(cfg, key, saved["config"].get(key, value))
+    cfg = stigmergy.parse_args([])  # every default, for the settings an older run's file lacks
+    vars(cfg).update(saved["config"], threads=1)
     steps = stigmergy.episode_steps(task, cfg)
     env = VecEnv(num_envs=worlds, max_cycles=steps, num_threads=1, **stigmergy.task_kwargs(task, cfg, training=False))
     d, w = env.single_observation_space.shape[0], env.single_action_space.shape[0]
