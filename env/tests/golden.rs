@@ -145,9 +145,9 @@ fn every_task_under_fixed_actions() {
     fixed_actions(
         None,
         [
-            ("aggregation", 0x3776c14bee7d36a5, 0x57f49b90ceccec90),
+            ("aggregation", 0x3776c14bee7d36a5, 0xcaec0c8436a51332),
             ("foraging", 0x44a08f13ea024f94, 0x44a08f13ea024f94),
-            ("trail", 0xc4f22a3d0cc98d4b, 0x454368c6991fa6d3),
+            ("trail", 0xc4f22a3d0cc98d4b, 0x66a9459e8ecf3087),
         ],
     );
 }
@@ -157,9 +157,9 @@ fn every_task_under_fixed_actions_discs() {
     fixed_actions(
         Some(PhysicsBackend::Discs),
         [
-            ("aggregation", 0x6c90e24c4bc67b1a, 0x2edff8da8381b2fe),
+            ("aggregation", 0x6c90e24c4bc67b1a, 0x8654bbb86b0ec21d),
             ("foraging", 0xe84fe0d65f7cb0d5, 0xe84fe0d65f7cb0d5),
-            ("trail", 0x673dabe31bf0b339, 0x3143367b5283c4a6),
+            ("trail", 0x673dabe31bf0b339, 0xca1859e673d199be),
         ],
     );
 }
@@ -169,9 +169,9 @@ fn baselines_rapier() {
     baselines(
         None,
         [
-            (0xd79355c2a3ff1fe6, 0x7d9bc44a8caa50dc),
+            (0xd79355c2a3ff1fe6, 0xdf0b28a4460102bf),
             (0xb32eb24480774581, 0xb32eb24480774581),
-            (0xb51d54da9c6d30e4, 0x65abd118bdcbbebf),
+            (0xb51d54da9c6d30e4, 0x2b3944c75b4a06c9),
         ],
     );
 }
@@ -181,9 +181,9 @@ fn baselines_discs() {
     baselines(
         Some(PhysicsBackend::Discs),
         [
-            (0xc00d1dd233e303a8, 0x2b443b8b884dea0d),
+            (0xc00d1dd233e303a8, 0x974aa2e14e4c100b),
             (0xa43155483782abb3, 0xa43155483782abb3),
-            (0x137cf18b419c7b0f, 0x74607472e76cbfa4),
+            (0x137cf18b419c7b0f, 0xd5407ffcbae572eb),
         ],
     );
 }
@@ -201,7 +201,7 @@ fn the_pheromone_laying_tasks() {
                 0xa19175c4e2f4c3d3,
                 0xa19175c4e2f4c3d3,
                 0xe3e94bb67c44bf91,
-                0x96d6a91e08185246,
+                0x6b3844f12bf0c8a4,
             ],
         ),
         (
@@ -209,9 +209,9 @@ fn the_pheromone_laying_tasks() {
             "coverage_walk",
             [
                 0x01886a2c1929c08f,
-                0x9639b1833e1fe670,
+                0x8bb8313c19fa22da,
                 0x31233c6cdf874b7f,
-                0x40056bc330303893,
+                0x486f8b4772dd8c8c,
             ],
         ),
         (
@@ -219,9 +219,9 @@ fn the_pheromone_laying_tasks() {
             "alarm_flee",
             [
                 0xf92d3342a7318b8e,
-                0x0acf8fd6161b401c,
+                0x112846da77e510cd,
                 0xb07caec582be7ce8,
-                0x242a09afedc6794c,
+                0x1b1a9051c25920c9,
             ],
         ),
     ];

@@ -90,14 +90,33 @@ impl Shield {
         let ahead = pose.pos + Vec2::from_angle(pose.heading) * forward * self.params.horizon;
         let m = self.params.margin.max(0.0);
         let (lo, hi) = (Vec2::splat(m), self.arena - Vec2::splat(m));
-        let outward = |now: f32, then: f32, lo: f32, hi: f32| {
-            (then < lo && then < now) || (then > hi && then > now)
+        // Which way is inside, per axis, when the command heads out past a virtual wall.
+        let inward = |now: f32, then: f32, lo: f32, hi: f32| {
+            if then < lo && then < now {
+                1.0
+            } else if then > hi && then > now {
+                -1.0
+            } else {
+                0.0
+            }
         };
-        if outward(pose.pos.x, ahead.x, lo.x, hi.x) || outward(pose.pos.y, ahead.y, lo.y, hi.y) {
+        let inside = Vec2::new(
+            inward(pose.pos.x, ahead.x, lo.x, hi.x),
+            inward(pose.pos.y, ahead.y, lo.y, hi.y),
+        );
+        if inside != Vec2::ZERO {
             out.walled = true;
-            // Keep the turn, drop the forward part; a pure forward command turns left in place.
+            // Keep the turn, drop the forward part. A turn slower than a quarter of the cap (a
+            // behaviour steering by noise) could hold a robot facing the wall for seconds: it is
+            // replaced by that speed toward the inside.
             let turn = 0.5 * (right - left);
-            let turn = if turn.abs() < 1e-6 { 0.5 * cap } else { turn };
+            let least = 0.25 * cap;
+            let turn = if turn.abs() >= least {
+                turn
+            } else {
+                let motion = Vec2::from_angle(pose.heading) * forward.signum();
+                least.copysign(motion.perp_dot(inside))
+            };
             return (
                 WheelCommand {
                     left: -turn,
@@ -187,5 +206,41 @@ mod tests {
             },
         );
         assert!(i.walled);
+    }
+
+    /// A behaviour steering by noise at a wall turns toward the inside at a quarter of the cap, and
+    /// keeps turning that way until it may drive again.
+    #[test]
+    fn a_robot_facing_a_wall_with_a_faint_turn_turns_away_at_the_least_speed() {
+        let s = shield();
+        let least = 0.25 * ShieldParams::default().max_wheel_speed;
+        // Near the bottom wall, heading down and a little to the right of straight (-x side): the
+        // short way to the inside is clockwise, whatever the sign of the faint turn.
+        let pose = Pose::new(0.5, 0.04, -std::f32::consts::FRAC_PI_2 - 0.2);
+        for faint in [0.004, -0.004, 0.0] {
+            let (c, i) = s.apply(&pose, WheelCommand::new(0.12 - faint, 0.12 + faint));
+            assert!(i.walled);
+            assert_eq!(c, WheelCommand::new(least, -least), "{faint}");
+        }
+        // Mirrored, counter-clockwise.
+        let pose = Pose::new(0.5, 0.04, -std::f32::consts::FRAC_PI_2 + 0.2);
+        let (c, _) = s.apply(&pose, WheelCommand::new(0.12, 0.12));
+        assert_eq!(c, WheelCommand::new(-least, least));
+        // Reversing into the wall: the back is what must turn away.
+        let pose = Pose::new(0.5, 0.04, std::f32::consts::FRAC_PI_2 + 0.2);
+        let (c, _) = s.apply(&pose, WheelCommand::new(-0.12, -0.12));
+        assert_eq!(c, WheelCommand::new(-least, least));
+        // A decisive turn is kept.
+        let (c, _) = s.apply(&pose, WheelCommand::new(-0.3, 0.1));
+        assert_eq!(c, WheelCommand::new(-0.2, 0.2));
+        // Turned by the shield step by step, the robot leaves the wall within a second.
+        let mut p = Pose::new(0.5, 0.04, -std::f32::consts::FRAC_PI_2 - 0.05);
+        let mut ticks = 0;
+        while s.apply(&p, WheelCommand::new(0.12, 0.121)).1.walled {
+            let (c, _) = s.apply(&p, WheelCommand::new(0.12, 0.121));
+            p.heading += (c.right - c.left) / 0.026 * 0.02;
+            ticks += 1;
+            assert!(ticks < 50, "{p:?}");
+        }
     }
 }

@@ -289,14 +289,16 @@ impl LoopCore {
             if let Some(Some(o)) = input.overrides.get(i) {
                 cmd = *o;
             }
-            let (cmd, intervention) = self.shield.apply(&self.host.poses()[i], cmd);
+            // A held robot is sent a stop, which the shield has nothing to change: counting its
+            // turned command would charge the behaviour for a robot that did not drive.
+            let held = stopped || !self.host.tracked()[i].seen || self.silent[i];
+            let (cmd, intervention) = if held {
+                (WheelCommand::STOP, Intervention::default())
+            } else {
+                self.shield.apply(&self.host.poses()[i], cmd)
+            };
             self.interventions[i] = intervention;
             self.counters.shield.add(intervention);
-            let cmd = if stopped || !self.host.tracked()[i].seen || self.silent[i] {
-                WheelCommand::STOP
-            } else {
-                cmd
-            };
             self.sent[i] = cmd;
             let (prev, at) = self.last_sent[i];
             if cmd != prev || t - at >= self.keepalive {
@@ -324,5 +326,46 @@ impl LoopCore {
             self.next_telemetry = t + self.telemetry_every;
         }
         self.counters.commands_sent += self.packets.len() as u64;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A robot driving at a wall is shielded while it drives, and not while it is held stopped (the
+    /// stop goes out unchanged and counts as no intervention).
+    #[test]
+    fn a_held_robot_at_a_wall_is_sent_a_stop_and_not_counted_as_shielded() {
+        let text = "duration = 5.0\n[screen]\nresolution = [640, 640]\nsize = [0.5, 0.5]\n\
+                    [[robots]]\ncount = 1\nbehaviour = \"wander\"\n";
+        let sc = Scenario::from_toml_str(text, ".").unwrap();
+        let mut core = LoopCore::new(&sc, LegacyDrive::default()).unwrap();
+        let pose = PoseIn {
+            id: sc.spec.rig.tracker_id(0) as u32,
+            pose: Pose::new(0.04, 0.25, std::f32::consts::PI),
+            age: 0.0,
+            fresh: true,
+        };
+        let forward = [Some(WheelCommand::new(0.2, 0.2))];
+        let mut tick = |t: f64, held: bool| {
+            core.tick(&TickInput {
+                t,
+                step: 0.02,
+                poses: std::slice::from_ref(&pose),
+                telemetry: &[],
+                stopped: &[held],
+                overrides: &forward,
+            });
+            (core.sent()[0], core.interventions()[0])
+        };
+        let (sent, shield) = tick(0.02, true);
+        assert_eq!(
+            (sent, shield),
+            (WheelCommand::STOP, Intervention::default())
+        );
+        let (sent, shield) = tick(0.04, false);
+        assert!(shield.walled && sent.left == -sent.right, "{sent:?}");
+        assert_eq!(core.counters().shield.walled, 1);
     }
 }
