@@ -129,6 +129,7 @@ class Config:
     anneal: int = 0  # with N > 0, the learning rate falls linearly to 0 over N updates (the budget)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     start_forward: float = 0.0  # the untrained actor's mean for both wheels: > 0 drives forward, an exploration prior
+    start_lay: float = 0.0  # the untrained actor's mean for the outputs after the wheels (deposit rates): < 0 lays rarely
 
 
 def clip_wheels(a: np.ndarray) -> np.ndarray:
@@ -153,6 +154,7 @@ class Trainer:
         self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden)
         with torch.no_grad():
             self.model.pi[-1].bias[:2] = cfg.start_forward
+            self.model.pi[-1].bias[2:] = cfg.start_lay
         self.opt = torch.optim.Adam(self.model.parameters(), lr=cfg.lr, eps=1e-5)
         # Rewards are divided by a running std of the discounted return, so that the critic's targets
         # stay O(1) whatever the reward's scale.

@@ -112,7 +112,7 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
     updates = updates_for(args, env.num_agents)
     cfg = ppo.Config(horizon=args.horizon, epochs=4, minibatches=4, lr=args.lr, gamma=args.gamma,
                      anneal=updates if args.anneal else 0, team_critic=args.team_critic,
-                     start_forward=args.start_forward)
+                     start_forward=args.start_forward, start_lay=args.start_lay)
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
@@ -207,7 +207,7 @@ def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
 
 def config(args: argparse.Namespace) -> dict:
     """What a saved run must share with this call to be reused."""
-    keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "anneal", "team_critic", "start_forward",
+    keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "anneal", "team_critic", "start_forward", "start_lay",
             "param", "shaping", "scenario", "eval_worlds", "eval_seed", "eval_policy")
     return {k: getattr(args, k) for k in keys}
 
@@ -347,6 +347,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                    help="task parameter for training only (evaluation keeps the task's own reward): pickup_reward=1")
     p.add_argument("--start-forward", type=float, default=0.0, metavar="F",
                    help="the untrained policy drives forward at F (both wheels' mean output), not standing still")
+    p.add_argument("--start-lay", type=float, default=0.0, metavar="F",
+                   help="the untrained policy's mean deposit output (before clipping to [0, 1]): below 0 it lays rarely")
     p.add_argument("--scenario", default=None, help="scenario file instead of the task's own (training and evaluation)")
     args = p.parse_args(argv)
     args.defaults = {k: p.get_default(k) for k in vars(args)} | {"param": {}, "shaping": {}}

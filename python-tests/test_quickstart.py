@@ -63,16 +63,22 @@ def test_the_team_critic_sees_every_agents_observation():
     assert trainer.c == ppo.critic_dim(env, team=True) == ppo.critic_dim(env) + env.num_agents * 17
 
 
-def test_start_forward_sets_the_untrained_wheels_mean_only():
+def test_start_forward_and_start_lay_set_the_untrained_means_of_their_outputs():
     torch = pytest.importorskip("torch")
     from colcos.vector import VecEnv
 
     ppo = load_ppo()
     env = VecEnv(task="alarm", num_envs=2, max_cycles=20, num_threads=1)  # wheels and one deposit rate
-    trainer = ppo.Trainer(env, ppo.Config(horizon=4, start_forward=0.5), seed=0)
-    with torch.no_grad():
-        mean = trainer.model.pi(torch.zeros(1, env.single_observation_space.shape[0]))[0]
+
+    def untrained_mean(**kw: float) -> "torch.Tensor":
+        trainer = ppo.Trainer(env, ppo.Config(horizon=4, **kw), seed=0)
+        with torch.no_grad():
+            return trainer.model.pi(torch.zeros(1, env.single_observation_space.shape[0]))[0]
+
+    mean = untrained_mean(start_forward=0.5)
     assert torch.allclose(mean[:2], torch.tensor(0.5), atol=0.05) and abs(float(mean[2])) < 0.05
+    mean = untrained_mean(start_lay=-0.5)
+    assert torch.allclose(mean[:2], torch.tensor(0.0), atol=0.05) and abs(float(mean[2]) + 0.5) < 0.05
 
 
 def test_quickstart_runs_and_reports(tmp_path):
