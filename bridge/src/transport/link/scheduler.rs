@@ -1,7 +1,9 @@
 //! Shares a slow serial channel between robots: at most what the line can carry is sent, only the
 //! newest command per robot waits (a newer one replaces it), and robots take turns. Parameter writes
 //! are the exception: each carries its own values, so they wait in order, ahead of the robot's
-//! newest command (a policy is started only after its parameters are in).
+//! newest command (a policy is started only after its parameters are in). A telemetry request waits
+//! in a slot of its own, ahead of the robot's drive command: on a saturated line a drive command
+//! replacing it would leave the robot unasked, and then reported silent.
 
 use crate::protocol::colias::{
     COMMAND_FRAME_LEN, CommandPacket, HostCommand, TELEMETRY_FRAME_LEN, airtime_s,
@@ -27,6 +29,8 @@ pub struct SchedulerCounters {
 #[derive(Debug)]
 pub struct AirtimeScheduler {
     slots: Box<[Option<CommandPacket>; 256]>,
+    /// Per robot id, the newest telemetry request.
+    requests: Box<[Option<CommandPacket>; 256]>,
     /// Per robot id, parameter writes in order.
     writes: Vec<VecDeque<CommandPacket>>,
     pending: usize,
@@ -45,6 +49,7 @@ impl AirtimeScheduler {
     pub fn new(baud: u32) -> Self {
         AirtimeScheduler {
             slots: Box::new([None; 256]),
+            requests: Box::new([None; 256]),
             writes: vec![VecDeque::new(); 256],
             pending: 0,
             cursor: 0,
@@ -76,7 +81,7 @@ impl AirtimeScheduler {
 
     /// Drops every queued command (a safety stop goes out ahead of them, and none may follow it).
     pub fn clear(&mut self) {
-        for slot in self.slots.iter_mut() {
+        for slot in self.slots.iter_mut().chain(self.requests.iter_mut()) {
             *slot = None;
         }
         self.writes.iter_mut().for_each(VecDeque::clear);
@@ -99,7 +104,11 @@ impl AirtimeScheduler {
             self.pending += 1;
             return;
         }
-        if self.slots[p.id as usize].replace(p).is_some() {
+        let slots = match p.command {
+            HostCommand::RequestTelemetry(_) => &mut self.requests,
+            _ => &mut self.slots,
+        };
+        if slots[p.id as usize].replace(p).is_some() {
             self.counters.superseded += 1;
         } else {
             self.pending += 1;
@@ -126,12 +135,12 @@ impl AirtimeScheduler {
         if free_at > now {
             return None;
         }
-        let id = (0..256)
-            .map(|k| (self.cursor + k) % 256)
-            .find(|&i| self.slots[i].is_some() || !self.writes[i].is_empty())?;
+        let id = (0..256).map(|k| (self.cursor + k) % 256).find(|&i| {
+            self.slots[i].is_some() || self.requests[i].is_some() || !self.writes[i].is_empty()
+        })?;
         let p = match self.writes[id].pop_front() {
             Some(w) => w,
-            None => self.slots[id].take()?,
+            None => self.requests[id].take().or_else(|| self.slots[id].take())?,
         };
         self.pending -= 1;
         self.cursor = (id + 1) % 256;
@@ -257,5 +266,32 @@ mod tests {
         assert_eq!(s.drain_due(t0).len(), 1);
         assert!(s.next_due(t0 + Duration::from_millis(20)).is_none());
         assert!(s.next_due(t0 + Duration::from_millis(21)).is_some());
+    }
+
+    /// On a line that cannot carry every robot's drive command each tick, a telemetry request is
+    /// neither replaced by the robot's next drive command nor replaces it: both go out.
+    #[test]
+    fn a_telemetry_request_survives_a_saturated_line() {
+        let mut s = AirtimeScheduler::new(115_200);
+        let t0 = Instant::now();
+        let request = CommandPacket::new(15, 0, HostCommand::RequestTelemetry(1));
+        let mut sent = Vec::new();
+        for tick in 0..10u64 {
+            for id in 0..20 {
+                s.submit(cmd(id, tick as f32));
+            }
+            if tick == 0 {
+                s.submit(request);
+            }
+            sent.extend(s.drain_due(t0 + Duration::from_millis(20 * tick)));
+        }
+        assert!(s.counters().superseded > 50, "{:?}", s.counters());
+        let to_15: Vec<_> = sent.iter().filter(|p| p.id == 15).collect();
+        assert_eq!(to_15.iter().filter(|p| **p == &request).count(), 1);
+        assert!(
+            to_15
+                .iter()
+                .any(|p| matches!(p.command, HostCommand::Motion { .. }))
+        );
     }
 }
