@@ -16,6 +16,7 @@ where one is sensed; else a correlated random walk that turns away from bumps.
 from __future__ import annotations
 
 import pathlib
+import tomllib
 
 import numpy as np
 
@@ -110,7 +111,8 @@ class RallyCall:
 
 
 if __name__ == "__main__":
-    steps = round(30.0 / 0.02)
+    spec = tomllib.loads(SCENARIO)
+    steps = round(spec["duration"] / spec["dt"])
     for label in ("random", "rally_call", "rally_call, call forced off"):
         env = colcos.vector.VecEnv(Rally(), num_envs=64, max_cycles=steps)
         obs, _ = env.reset(seed=0)
@@ -121,7 +123,7 @@ if __name__ == "__main__":
                 act = rng.uniform([-1, -1, 0], [1, 1, 1], (64, env.num_agents, 3)).astype(F32)
             else:
                 act = policy.act(obs)
-                if label != "rally_call":
+                if label.endswith("forced off"):
                     act[..., 2] = 0.0
             obs, rew, *_ = env.step(act)
             total += rew.mean(axis=1)

@@ -214,8 +214,8 @@ mod tests {
     fn a_robot_facing_a_wall_with_a_faint_turn_turns_away_at_the_least_speed() {
         let s = shield();
         let least = 0.25 * ShieldParams::default().max_wheel_speed;
-        // Near the bottom wall, heading down and a little to the right of straight (-x side): the
-        // short way to the inside is clockwise, whatever the sign of the faint turn.
+        // Near the bottom wall, heading down and 0.2 rad toward -x: the short way to the inside is
+        // clockwise, whatever the sign of the faint turn.
         let pose = Pose::new(0.5, 0.04, -std::f32::consts::FRAC_PI_2 - 0.2);
         for faint in [0.004, -0.004, 0.0] {
             let (c, i) = s.apply(&pose, WheelCommand::new(0.12 - faint, 0.12 + faint));
@@ -233,14 +233,17 @@ mod tests {
         // A decisive turn is kept.
         let (c, _) = s.apply(&pose, WheelCommand::new(-0.3, 0.1));
         assert_eq!(c, WheelCommand::new(-0.2, 0.2));
-        // Turned by the shield step by step, the robot leaves the wall within a second.
+        // Turned by the shield tick by tick (20 ms, the Colias wheel base), the robot leaves the
+        // wall within a second.
+        let wheel_base = crate::robot::ColiasParams::default().wheel_base;
         let mut p = Pose::new(0.5, 0.04, -std::f32::consts::FRAC_PI_2 - 0.05);
-        let mut ticks = 0;
-        while s.apply(&p, WheelCommand::new(0.12, 0.121)).1.walled {
-            let (c, _) = s.apply(&p, WheelCommand::new(0.12, 0.121));
-            p.heading += (c.right - c.left) / 0.026 * 0.02;
-            ticks += 1;
-            assert!(ticks < 50, "{p:?}");
+        for tick in 0.. {
+            let (c, i) = s.apply(&p, WheelCommand::new(0.12, 0.121));
+            if !i.walled {
+                break;
+            }
+            assert!(tick < 50, "{p:?}");
+            p.heading += (c.right - c.left) / wheel_base * 0.02;
         }
     }
 }
