@@ -1,16 +1,17 @@
 """The transfer study: does a follower trained on identified robot values hold on robots that differ?
 
-Trains three PPO aggregation followers with examples/train_aggregation.py, the same wall-clock budget
-each: (a) on the nominal values, (b) with generic per-robot `[randomize]` ranges (wheel scales, motor
-lags, command latencies, sensor gains), (c) on the identified values (`[individual] file = FIT`) with
-narrow randomisation around them. Evaluates each, the hand-written follower and standing still on
-(i) the simulator with the nominal values (`--eval-worlds` seeded worlds) and (ii) the digital twin
-started here whose robots drive and sense with the hidden values of `--truth` while the host assumes
-the nominal ones and reads the robots' own sensors (`--twin-episodes` real-time episodes each).
+Trains three PPO aggregation followers with examples/train_aggregation.py, the same budget each
+(`--updates` PPO updates, or wall-clock `--minutes`): (a) on the nominal values, (b) with generic
+per-robot `[randomize]` ranges (wheel scales, motor lags, command latencies, sensor gains), (c) on the
+identified values (`[individual] file = FIT`) with narrow randomisation around them. Evaluates each,
+the hand-written follower and standing still on (i) the simulator with the nominal values
+(`--eval-worlds` seeded worlds) and (ii) the digital twin started here whose robots drive and sense
+with the hidden values of `--truth` while the host assumes the nominal ones and reads the robots' own
+sensors (`--twin-episodes` real-time episodes each).
 Transfer ratio = (twin return - twin floor) / (sim return - sim floor), standing still the floor.
 Writes `OUT/table.md` and `OUT/result.json` (every episode's return).
 
-    python examples/transfer.py --minutes 3 --twin-episodes 8 --out runs/transfer
+    python examples/transfer.py --updates 2400 --twin-episodes 20 --out runs/transfer
 
 The fit comes from `colcos rig excite` on a twin with the truth and `colcos rig identify`
 (docs/transfer.md gives the commands; `examples/data/transfer/` holds the truth and the fit). Needs
@@ -78,15 +79,18 @@ def write_scenarios(out: str, fit: str, truth: str) -> dict[str, str]:
     return paths
 
 
-def train(paths: dict[str, str], out: str, minutes: float, episode: int, seeds: list[int]) -> None:
-    """Trains each variant and seed with train_aggregation.py unless its policy.pt exists."""
-    for seed in seeds:
+def train(paths: dict[str, str], args: argparse.Namespace) -> None:
+    """Trains each variant and seed with train_aggregation.py unless its policy.pt exists: `--updates`
+    PPO updates each (the same samples for every variant, whatever the machine's load), or `--minutes`."""
+    budget = ["--updates", str(args.updates)] if args.updates else ["--minutes", str(args.minutes)]
+    threads = ["--threads", str(args.threads)] if args.threads else []
+    for seed in args.seeds:
         for name in VARIANTS:
-            d = os.path.join(out, f"{name}-s{seed}")
+            d = os.path.join(args.out, f"{name}-s{seed}")
             if os.path.exists(os.path.join(d, "policy.pt")):
                 continue
-            subprocess.run([sys.executable, os.path.join(HERE, "train_aggregation.py"), "--minutes", str(minutes),
-                            "--episode", str(episode), "--scenario", paths[name], "--seed", str(seed), "--out", d],
+            subprocess.run([sys.executable, os.path.join(HERE, "train_aggregation.py"), *budget, *threads,
+                            "--episode", str(args.episode), "--scenario", paths[name], "--seed", str(seed), "--out", d],
                            check=True)
 
 
@@ -205,7 +209,9 @@ def figure(result: dict, path: str) -> None:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--minutes", type=float, default=3.0, help="training budget of each policy")
+    p.add_argument("--minutes", type=float, default=3.0, help="training budget of each policy, wall-clock")
+    p.add_argument("--updates", type=int, default=None, help="training budget of each policy in PPO updates (instead of --minutes)")
+    p.add_argument("--threads", type=int, default=None, help="env worker threads of each training run")
     p.add_argument("--episode", type=int, default=500, help="steps per episode (10 s)")
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
     p.add_argument("--eval-worlds", type=int, default=32)
@@ -217,7 +223,9 @@ def main() -> None:
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
     paths = write_scenarios(args.out, args.fit, args.truth)
-    train(paths, args.out, args.minutes, args.episode, args.seeds)
+    if args.updates is not None and args.updates < 1:
+        p.error(f"--updates ({args.updates}) must be at least 1")
+    train(paths, args)
     if args.train_only:
         return
     t0 = time.time()
@@ -225,7 +233,8 @@ def main() -> None:
     result = evaluate(paths, args)
     table = report(result, args)
     print(table)
-    print(f"evaluation {time.time() - t0:.0f} s; training {args.minutes} min each; twin {result['twin_stats']}")
+    budget = f"{args.updates} updates" if args.updates else f"{args.minutes} min"
+    print(f"evaluation {time.time() - t0:.0f} s; training {budget} each; twin {result['twin_stats']}")
     with open(os.path.join(args.out, "table.md"), "w") as f:
         f.write(table + "\n")
     trained = {}
@@ -233,7 +242,7 @@ def main() -> None:
         rj = os.path.join(args.out, k, "result.json")
         if os.path.exists(rj):
             with open(rj) as f:
-                trained[k] = json.load(f)["result"]
+                trained[k] = json.load(f)
     with open(os.path.join(args.out, "result.json"), "w") as f:
         json.dump({**result, "trained": trained, "args": vars(args)}, f, indent=1, default=str)
     try:

@@ -4,8 +4,7 @@
 //! pheromones (5 mm cells). Target: at most 5 ms, a quarter of the 20 ms tick. Prints medians of each
 //! part and of the whole against the 5 ms bar and the 20 ms tick, for the screen drawn three ways in
 //! the same run: into a kept image (`ScreenRenderer::render_into`), as a new image (`HostWorld::render`,
-//! `screen::render`), and by the per-pixel renderer the simulator had before (kept below as the
-//! reference; every frame is checked to be byte-identical to it).
+//! `screen::render`), and by the per-pixel renderer the simulator had before (`colcos_testkit::screen::reference_render`; every frame is checked to be byte-identical to it).
 //!
 //! ```text
 //! cargo bench -p colcos-bridge --bench live_tick
@@ -15,11 +14,10 @@ use colcos_bridge::protocol::swarmcon::{
 };
 use colcos_bridge::rig::HostWorld;
 use colcos_bridge::transport::frame_to_poses;
-use colcos_sim::Vec2;
-use colcos_sim::field::{FieldModel, Pheromone};
 use colcos_sim::scenario::SensorSource;
-use colcos_sim::screen::{ScreenRenderer, ScreenSpec, to_level};
+use colcos_sim::screen::ScreenRenderer;
 use colcos_testkit::scenarios::three_grids_panel;
+use colcos_testkit::screen::reference_render;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -30,75 +28,6 @@ const BAR_MS: f64 = 5.0;
 fn median(mut xs: Vec<f64>) -> f64 {
     xs.sort_by(f64::total_cmp);
     xs[xs.len() / 2]
-}
-
-/// The sampler's clamped interpolation index, as the reference renderer used it.
-fn lerp_index(f: f32, n: usize) -> (usize, usize, f32) {
-    if n <= 1 || f.is_nan() || f <= 0.0 {
-        return (0, 0, 0.0);
-    }
-    if f >= (n - 1) as f32 {
-        return (n - 1, n - 1, 0.0);
-    }
-    let i0 = (f as usize).min(n - 2);
-    (i0, i0 + 1, f - i0 as f32)
-}
-
-/// The screen renderer before the lookup tables and vector kernels: every pixel interpolated on its
-/// own, rows in parallel (there on rayon, here on one scoped thread per core).
-fn reference_render(ps: &[Pheromone], screen: &ScreenSpec, w: usize, h: usize) -> Vec<u8> {
-    let mut img = vec![0u8; 3 * w * h];
-    let (px, py) = (screen.size[0] / w as f32, screen.size[1] / h as f32);
-    let xs: Vec<f32> = (0..w).map(|i| (i as f32 + 0.5) * px).collect();
-    let per_thread = h.div_ceil(threads());
-    let draw_row = |row: usize, out: &mut [u8]| {
-        let y = (h - 1 - row) as f32 * py + 0.5 * py;
-        let mut acc = vec![[0f32; 3]; w];
-        let mut vals = vec![0f32; w];
-        for ph in ps {
-            match &ph.model {
-                FieldModel::Grid(g) => {
-                    let s = g.spec();
-                    let (j0, j1, ty) = lerp_index(y / s.cell - 0.5, s.ny);
-                    let v = g.values();
-                    let (lo, hi) = (&v[j0 * s.nx..][..s.nx], &v[j1 * s.nx..][..s.nx]);
-                    for (o, &x) in vals.iter_mut().zip(&xs) {
-                        let (i0, i1, tx) = lerp_index(x / s.cell - 0.5, s.nx);
-                        let a = lo[i0] + (lo[i1] - lo[i0]) * tx;
-                        let b = hi[i0] + (hi[i1] - hi[i0]) * tx;
-                        *o = a + (b - a) * ty;
-                    }
-                }
-                FieldModel::Gaussian(_) => {
-                    for (o, &x) in vals.iter_mut().zip(&xs) {
-                        *o = ph.value_at(Vec2::new(x, y));
-                    }
-                }
-            }
-            for (a, &v) in acc.iter_mut().zip(&vals) {
-                for (a, k) in a.iter_mut().zip(ph.colour) {
-                    *a += k * v;
-                }
-            }
-        }
-        for (o, a) in out.chunks_exact_mut(3).zip(&acc) {
-            o.copy_from_slice(&a.map(to_level));
-        }
-    };
-    std::thread::scope(|scope| {
-        for (k, band) in img.chunks_mut(3 * w * per_thread).enumerate() {
-            scope.spawn(move || {
-                for (r, out) in band.chunks_mut(3 * w).enumerate() {
-                    draw_row(k * per_thread + r, out);
-                }
-            });
-        }
-    });
-    img
-}
-
-fn threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 fn main() {
@@ -192,7 +121,7 @@ fn main() {
         )
     };
     let (all, all_new, all_old) = (whole(&render), whole(&render_new), whole(&render_old));
-    let threads = threads();
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
         "live tick, 100 robots, three 5 mm grids, 65-inch panel, {threads} threads (medians of {} ticks):",
         parse.len()

@@ -8,6 +8,7 @@
 //! Coordinates: the arena spans `x in [0, width]`, `y in [0, height]` with `y` up. A robot's heading is
 //! measured counter-clockwise from `+x`; in the robot frame `X+` is forward and `Y+` is left.
 
+pub mod angle;
 pub mod arena;
 pub mod behaviour;
 pub mod channel;

@@ -175,7 +175,8 @@ impl Tracker {
                         q.pos.y += pos_sd * crate::rng::normal(rng);
                     }
                     if head_sd > 0.0 {
-                        q.heading = wrap_pi(q.heading + head_sd * crate::rng::normal(rng));
+                        q.heading =
+                            crate::angle::wrap_pi(q.heading + head_sd * crate::rng::normal(rng));
                     }
                     poses.push(Some(q));
                 }
@@ -208,13 +209,6 @@ impl Tracker {
         }
         &self.tracked
     }
-}
-
-/// `a` wrapped to (-pi, pi] (noise can carry a heading near +-pi across it).
-fn wrap_pi(a: f32) -> f32 {
-    use std::f32::consts::{PI, TAU};
-    let w = a.rem_euclid(TAU);
-    if w > PI { w - TAU } else { w }
 }
 
 #[cfg(test)]
@@ -287,14 +281,5 @@ mod tests {
             crossed > 100,
             "noise carried headings across pi {crossed} times"
         );
-    }
-
-    #[test]
-    fn wrapping_keeps_the_half_open_range() {
-        assert_eq!(wrap_pi(PI), PI);
-        assert_eq!(wrap_pi(-PI), PI);
-        assert!((wrap_pi(3.0 * PI / 2.0) + PI / 2.0).abs() < 1e-6);
-        assert!((wrap_pi(-7.0) - (-7.0 + 2.0 * PI)).abs() < 1e-6);
-        assert_eq!(wrap_pi(0.25), 0.25);
     }
 }

@@ -1,71 +1,14 @@
 //! The screen renderer (`render`, `render_into`, `ScreenRenderer`) gives, byte for byte, the image of
-//! the straightforward per-pixel evaluation of eq. (1) kept below as the reference, for grid and
+//! the straightforward per-pixel evaluation of eq. (1) (`colcos_testkit::screen::reference_render`), for grid and
 //! Gaussian fields, random values, sizes and colour maps.
 use colcos_sim::Vec2;
 use colcos_sim::field::{
     FieldModel, GaussianField, GaussianSource, GridField, GridParams, GridSpec, Pheromone,
 };
 use colcos_sim::screen::{Instructions, ScreenRenderer, ScreenSpec, render, render_into, to_level};
+use colcos_testkit::screen::reference_render;
 use rand::rngs::SmallRng;
 use rand::{RngExt, SeedableRng};
-
-/// `lerp_index` of the grid sampler, as it was when the reference was written.
-#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN goes to the first cell, as in the sampler
-fn lerp_index(f: f32, n: usize) -> (usize, usize, f32) {
-    if n <= 1 || !(f > 0.0) {
-        return (0, 0, 0.0);
-    }
-    let max = (n - 1) as f32;
-    if f >= max {
-        return (n - 1, n - 1, 0.0);
-    }
-    let i0 = (f as usize).min(n - 2);
-    (i0, i0 + 1, f - i0 as f32)
-}
-
-/// The renderer as it was before the lookup tables: every pixel interpolated on its own.
-fn reference(pheromones: &[Pheromone], screen: &ScreenSpec, w: usize, h: usize) -> Vec<u8> {
-    let mut img = vec![0u8; 3 * w * h];
-    let px = screen.size[0] / w as f32;
-    let py = screen.size[1] / h as f32;
-    let xs: Vec<f32> = (0..w).map(|i| (i as f32 + 0.5) * px).collect();
-    for (row, out) in img.chunks_mut(3 * w).enumerate() {
-        let y = (h - 1 - row) as f32 * py + 0.5 * py;
-        let mut acc = vec![[0f32; 3]; w];
-        let mut vals = vec![0f32; w];
-        for ph in pheromones {
-            match &ph.model {
-                FieldModel::Grid(g) => {
-                    let s = g.spec();
-                    let (j0, j1, ty) = lerp_index(y / s.cell - 0.5, s.ny);
-                    let v = g.values();
-                    let lo = &v[j0 * s.nx..(j0 + 1) * s.nx];
-                    let hi = &v[j1 * s.nx..(j1 + 1) * s.nx];
-                    for (o, &x) in vals.iter_mut().zip(&xs) {
-                        let (i0, i1, tx) = lerp_index(x / s.cell - 0.5, s.nx);
-                        let a = lo[i0] + (lo[i1] - lo[i0]) * tx;
-                        let b = hi[i0] + (hi[i1] - hi[i0]) * tx;
-                        *o = a + (b - a) * ty;
-                    }
-                }
-                FieldModel::Gaussian(_) => {
-                    for (o, &x) in vals.iter_mut().zip(&xs) {
-                        *o = ph.value_at(Vec2::new(x, y));
-                    }
-                }
-            }
-            for (a, &v) in acc.iter_mut().zip(&vals) {
-                for (a, k) in a.iter_mut().zip(ph.colour) {
-                    *a += k * v;
-                }
-            }
-        }
-        for (o, a) in out.chunks_exact_mut(3).zip(&acc) {
-            o.copy_from_slice(&a.map(to_level));
-        }
-    }
-    img
-}
 
 fn grid(spec: GridSpec, colour: [f32; 3], mut value: impl FnMut(usize) -> f32) -> Pheromone {
     let mut g = GridField::new(spec, GridParams::default());
@@ -160,7 +103,7 @@ fn random_world(rng: &mut SmallRng) -> (Vec<Pheromone>, ScreenSpec, u32, u32) {
 
 /// Every instruction set the renderer has gives the reference's bytes (`render` takes the best).
 fn assert_same(pheromones: &[Pheromone], screen: &ScreenSpec, w: u32, h: u32, what: &str) {
-    let want = reference(pheromones, screen, w as usize, h as usize);
+    let want = reference_render(pheromones, screen, w as usize, h as usize);
     let got = render(pheromones, screen, w, h);
     assert_eq!(got.dimensions(), (w, h));
     check(&want, got.as_raw(), w, h, &format!("{what}, render"));
@@ -183,7 +126,7 @@ fn check(want: &[u8], got: &[u8], w: u32, h: u32, what: &str) {
 }
 
 #[test]
-fn random_worlds_render_as_the_reference() {
+fn random_worlds_render_as_the_reference_render() {
     let mut rng = SmallRng::seed_from_u64(0x5c4ee);
     for case in 0..300 {
         let (pheromones, screen, w, h) = random_world(&mut rng);
@@ -194,7 +137,7 @@ fn random_worlds_render_as_the_reference() {
 /// Large images (the parallel path), at the panel's 4K with three 5 mm grids and at sizes that do not
 /// fill whole blocks of pixels, with a Gaussian field among the grids.
 #[test]
-fn large_images_render_as_the_reference() {
+fn large_images_render_as_the_reference_render() {
     let screen = ScreenSpec::default();
     let spec = GridSpec::covering(Vec2::new(screen.size[0], screen.size[1]), 0.005);
     let mut rng = SmallRng::seed_from_u64(7);
@@ -209,7 +152,7 @@ fn large_images_render_as_the_reference() {
 
 /// Values no scenario makes (NaN, infinities, huge) still give the reference's bytes.
 #[test]
-fn non_finite_values_render_as_the_reference() {
+fn non_finite_values_render_as_the_reference_render() {
     let spec = GridSpec {
         nx: 13,
         ny: 7,
@@ -304,7 +247,7 @@ fn kept_renderers_follow_changing_fields_and_sizes() {
             grid(spec, [200.0, 10.0, 0.0], |_| rng.random_range(0.0..1.5)),
             random_gaussian(&mut rng, screen.size),
         ];
-        let want = reference(&ps, &screen, w, h);
+        let want = reference_render(&ps, &screen, w, h);
         let mut img = image::RgbImage::new(w as u32, h as u32);
         renderer.render_into(&ps, &screen, &mut img);
         assert_eq!(img.as_raw(), &want, "kept renderer, frame {frame}");

@@ -12,7 +12,8 @@
 //!
 //! Directions come from eq. (6) ([`Observation::gradient_direction`]); see the parent module for the
 //! sign of eq. (8).
-use super::{GREEN, RED, check, eq8, wrap_angle};
+use super::{GREEN, RED, check, eq8};
+use crate::angle::wrap_pi;
 use crate::behaviour::param_doc::ParamDoc;
 use crate::behaviour::{Avoid, Behaviour, Observation, Wander, WheelCommand};
 use crate::error::Result;
@@ -211,7 +212,7 @@ impl Core {
         if obs.strength(RED) > self.params.alarm_threshold {
             let theta_r = obs.gradient_direction(RED);
             return AggregationDecision::Flee {
-                direction: wrap_angle(theta_r + std::f32::consts::PI),
+                direction: wrap_pi(theta_r + std::f32::consts::PI),
             };
         }
         if obs.strength(GREEN) > self.params.attract_threshold {

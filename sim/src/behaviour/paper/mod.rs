@@ -57,21 +57,8 @@ pub fn eq7(phi_left: f32, phi_right: f32, p: f32, v_b: f32) -> WheelCommand {
 /// Eq. (8): wheel speeds that turn the robot toward the egocentric `direction` (rad, counter-clockwise
 /// from forward, wrapped into `(-pi, pi]`), with sensitivity `p` (m/s per rad) and base speed `v_b`.
 pub fn eq8(direction: f32, p: f32, v_b: f32) -> WheelCommand {
-    let d = wrap_angle(direction);
+    let d = crate::angle::wrap_pi(direction);
     WheelCommand::new(v_b - p * d, v_b + p * d)
-}
-
-/// `a` wrapped into `(-pi, pi]` (NaN gives 0).
-pub fn wrap_angle(a: f32) -> f32 {
-    use std::f32::consts::{PI, TAU};
-    if !a.is_finite() {
-        return 0.0;
-    }
-    let mut w = a.rem_euclid(TAU);
-    if w > PI {
-        w -= TAU;
-    }
-    w
 }
 
 /// Checks that a parameter is finite and at least `min`.

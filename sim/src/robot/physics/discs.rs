@@ -112,6 +112,6 @@ fn wrap_angle(a: f32) -> f32 {
     if !a.is_finite() {
         return 0.0;
     }
-    let w = (a + PI).rem_euclid(TAU) - PI;
+    let w = crate::angle::rem_tau(a + PI) - PI;
     if w <= -PI { w + TAU } else { w }
 }
