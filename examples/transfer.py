@@ -84,12 +84,13 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     PPO updates each (the same samples for every variant, whatever the machine's load), or `--minutes`."""
     budget = ["--updates", str(args.updates)] if args.updates else ["--minutes", str(args.minutes)]
     threads = ["--threads", str(args.threads)] if args.threads else []
+    anneal = ["--anneal"] if args.anneal and args.updates else []
     for seed in args.seeds:
         for name in VARIANTS:
             d = os.path.join(args.out, f"{name}-s{seed}")
             if os.path.exists(os.path.join(d, "policy.pt")):
                 continue
-            subprocess.run([sys.executable, os.path.join(HERE, "train_aggregation.py"), *budget, *threads,
+            subprocess.run([sys.executable, os.path.join(HERE, "train_aggregation.py"), *budget, *anneal, *threads,
                             "--episode", str(args.episode), "--scenario", paths[name], "--seed", str(seed), "--out", d],
                            check=True)
 
@@ -211,6 +212,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--minutes", type=float, default=3.0, help="training budget of each policy, wall-clock")
     p.add_argument("--updates", type=int, default=None, help="training budget of each policy in PPO updates (instead of --minutes)")
+    p.add_argument("--anneal", action="store_true", help="with --updates: the learning rate falls linearly to 0 over the budget")
     p.add_argument("--threads", type=int, default=None, help="env worker threads of each training run")
     p.add_argument("--episode", type=int, default=500, help="steps per episode (10 s)")
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
@@ -233,7 +235,7 @@ def main() -> None:
     result = evaluate(paths, args)
     table = report(result, args)
     print(table)
-    budget = f"{args.updates} updates" if args.updates else f"{args.minutes} min"
+    budget = f"{args.updates} updates{' (annealed)' if args.anneal else ''}" if args.updates else f"{args.minutes} min"
     print(f"evaluation {time.time() - t0:.0f} s; training {budget} each; twin {result['twin_stats']}")
     with open(os.path.join(args.out, "table.md"), "w") as f:
         f.write(table + "\n")

@@ -44,6 +44,9 @@ impl WorldSlot {
         let mut world = World::with_index(scenario, index)?;
         backend.install(&mut world)?;
         let agents = task.agents();
+        if !task.reads_other_robots_colour() {
+            world.skip_unread_colour(agents);
+        }
         let robots = world.robot_count();
         let mut overrides = vec![None; robots];
         for &i in agents {

@@ -67,6 +67,12 @@ pub trait Task: Send + Sync {
     fn observe(&self, _world: &dyn ArenaView, _state: &[u32], _k: usize, _out: &mut [f32]) {}
     /// Writes the step's [`Outcome`] in `world`; `state` is this episode's memory.
     fn evaluate(&self, world: &dyn ArenaView, state: &mut TaskState, out: Outcome<'_>);
+    /// Whether [`Self::observe`] or [`Self::evaluate`] read the colour sensors of robots that are
+    /// not agents. By default they do not, and the environment skips evaluating the colour of
+    /// scripted robots whose behaviour does not read it (`World::skip_unread_colour`): those read 0.
+    fn reads_other_robots_colour(&self) -> bool {
+        false
+    }
 }
 
 /// What a task hands out after a step: a reward per agent, and which agents have reached a terminal

@@ -57,4 +57,7 @@ impl<B: Behaviour> Behaviour for Avoid<B> {
         }
         self.inner.act(obs, rng)
     }
+    fn reads_colour(&self) -> bool {
+        self.inner.reads_colour()
+    }
 }

@@ -25,4 +25,9 @@ pub trait Behaviour: Send {
     fn name(&self) -> &str;
     /// Decide the wheel command. `rng` is this robot's own random stream.
     fn act(&mut self, obs: &Observation, rng: &mut SimRng) -> WheelCommand;
+    /// Whether `act` reads the colour sensors (counts or intensities). A behaviour that does not
+    /// lets a batched environment skip evaluating them ([`crate::world::World::skip_unread_colour`]).
+    fn reads_colour(&self) -> bool {
+        true
+    }
 }

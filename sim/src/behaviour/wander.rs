@@ -63,4 +63,7 @@ impl Behaviour for Wander {
             self.speed * (1.0 + self.turn),
         )
     }
+    fn reads_colour(&self) -> bool {
+        false
+    }
 }

@@ -155,9 +155,21 @@ impl World {
     pub fn field_backend(&self) -> Option<String> {
         self.fields.backend_description()
     }
-    /// Replaces the behaviour of robot `i` (e.g. with a learned policy).
+    /// Replaces the behaviour of robot `i` (e.g. with a learned policy); its colour is read from now
+    /// on, whatever [`World::skip_unread_colour`] said.
     pub fn set_behaviour(&mut self, i: usize, behaviour: Box<dyn crate::behaviour::Behaviour>) {
         self.robots.slots[i].behaviour = behaviour;
+        self.sensing.keep_colour_read(i);
+    }
+    /// Stops evaluating the colour sensors of robots that are not in `observers` and whose behaviour
+    /// does not read colour ([`crate::behaviour::Behaviour::reads_colour`]): for a caller that reads
+    /// no other robot's colour (an RL environment whose observers are its agents). Their readings are
+    /// then 0, and everything else, every random stream included, stays as it was.
+    pub fn skip_unread_colour(&mut self, observers: &[usize]) {
+        let unread = (self.robots.slots.iter().enumerate())
+            .map(|(i, slot)| !observers.contains(&i) && !slot.behaviour.reads_colour())
+            .collect();
+        self.sensing.set_colour_unread(unread);
     }
     /// Steps until the scenario's duration is reached.
     pub fn is_finished(&self) -> bool {

@@ -38,6 +38,9 @@ pub struct Sensing {
     /// Every robot's heading vector at the indexed poses (one `sin_cos` for its colour sensors and
     /// bumpers).
     forwards: Vec<Vec2>,
+    /// Robots whose colour nobody reads ([`Sensing::set_colour_unread`]): their four sensors are not
+    /// evaluated, only their noise drawn. Empty: every robot's are read.
+    colour_unread: Vec<bool>,
     observations: Vec<Observation>,
 }
 
@@ -62,6 +65,7 @@ impl Sensing {
             positions: Vec::new(),
             sensor_points: Vec::new(),
             forwards: Vec::new(),
+            colour_unread: Vec::new(),
             observations: vec![Observation::default(); robots],
         }
     }
@@ -109,6 +113,19 @@ impl Sensing {
             .get(i)
             .map_or(&self.sensor, |own| &own.truth[0]);
         sampler.sample_points(Vec2::ZERO)
+    }
+    /// Marks the robots whose colour readings nobody reads (one entry per robot; empty: none). Their
+    /// sensors are not evaluated and read 0, but their sensor noise is still drawn, so every random
+    /// stream, and so every other reading and every pose, stays as if they had been read. A robot
+    /// with its own sensor models (`[sensor] per_robot`) is always read.
+    pub fn set_colour_unread(&mut self, unread: Vec<bool>) {
+        self.colour_unread = unread;
+    }
+    /// Robot `i`'s colour is read again (no effect if it was).
+    pub fn keep_colour_read(&mut self, i: usize) {
+        if let Some(u) = self.colour_unread.get_mut(i) {
+            *u = false;
+        }
     }
     /// What each robot sensed last.
     pub fn observations(&self) -> &[Observation] {
@@ -193,6 +210,7 @@ fn sense_with(
     let (sensor, neighbours, bumper) = (&sensing.sensor, &sensing.neighbours, &sensing.bumper_rays);
     let robot_sensors = &sensing.robot_sensors;
     let sensor_gains = &sensing.sensor_gains;
+    let colour_unread = &sensing.colour_unread;
     let (radius, arena) = (sensing.radius, sensing.arena);
     let obstacles = &*sensing.obstacles;
     let printed = obstacles.printed();
@@ -209,6 +227,8 @@ fn sense_with(
             ..Observation::default()
         };
         let given = given.map(|g| [g[4 * i], g[4 * i + 1], g[4 * i + 2], g[4 * i + 3]]);
+        let unread =
+            robot_sensors.get(i).is_none() && colour_unread.get(i).copied().unwrap_or(false);
         match robot_sensors.get(i) {
             Some(own) => {
                 // The four footprints in one batched pass (they are all the drawn `[sensor]`
@@ -228,6 +248,7 @@ fn sense_with(
                     o.intensity[k] = own.inverse[k].intensity(c);
                 }
             }
+            None if unread => sensor.draw_read_noise(&mut slot.rng),
             None => {
                 (o.counts, o.intensity) = match &given {
                     Some(sums) => sensor.read_robot_from_sums(sums, &mut slot.rng),
@@ -244,7 +265,7 @@ fn sense_with(
         }
         // A robot's own gain and offset act on the counts its sensors deliver; its intensities
         // then read them through the calibrated (nominal) inverse, as the rig's robot would.
-        if let Some(&(gain, offset)) = sensor_gains.get(i) {
+        if let Some(&(gain, offset)) = sensor_gains.get(i).filter(|_| !unread) {
             crate::scenario::individual::apply_sensor_gain(&mut o.counts, gain, offset);
             o.intensity = match robot_sensors.get(i) {
                 Some(own) => std::array::from_fn(|k| own.inverse[k].intensity(o.counts[k])),

@@ -56,6 +56,18 @@ impl ColourSensor {
         counts
     }
 
+    /// The random draws of a robot's read ([`ColourSensor::read_robot`]) without the read: for a
+    /// robot whose colour nobody reads, whose stream must go on as if it had been read.
+    pub fn draw_read_noise(&self, rng: &mut SimRng) {
+        if self.params.noise > 0.0 {
+            let (z, mut local) = (crate::rng::ziggurat(), rng.clone());
+            for _ in 0..LANES {
+                crate::rng::normal_with(z, &mut local);
+            }
+            *rng = local;
+        }
+    }
+
     /// A robot's four sensors read from their footprints' level sums (as
     /// [`ColourSensor::footprint_sums_printed`] gives them, or a GPU's sensing pass): the same counts,
     /// random draws and intensities as [`ColourSensor::read_robot`] at those footprints. A sum above
