@@ -115,7 +115,7 @@ fn bumper_pass(
     let (index, poses) = (&*index, world.poses());
     (0..poses.len())
         .into_par_iter()
-        .map(|i| index.bumpers_with(i, poses, r, arena, &rays, obstacles))
+        .map(|i| index.bumpers_facing(i, poses, poses[i].forward(), r, arena, &rays, obstacles))
         .collect_into_vec(out);
     t.elapsed().as_secs_f64()
 }

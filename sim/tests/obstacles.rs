@@ -26,7 +26,8 @@ fn bumpers(obs: &Obstacles, pose: Pose) -> [f32; 3] {
     let params = BumperParams::default();
     let mut index = NeighbourIndex::default();
     index.rebuild(ARENA, 0.1, &[pose.pos]);
-    index.bumpers_with(0, &[pose], R, ARENA, &BumperRays::new(&params), obs)
+    let rays = BumperRays::new(&params);
+    index.bumpers_facing(0, &[pose], pose.forward(), R, ARENA, &rays, obs)
 }
 
 /// One obstacle of every shape: a rotated box, a disc, a concave polygon and a bent wall.

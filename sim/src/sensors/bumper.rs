@@ -114,29 +114,17 @@ impl NeighbourIndex {
         arena: Vec2,
         rays: &BumperRays,
     ) -> [f32; 3] {
-        self.bumpers_with(index, poses, radius, arena, rays, &Obstacles::default())
-    }
-
-    /// [`Self::bumpers`] in an arena with `obstacles`: each ray also stops at the first obstacle
-    /// (parry2d ray casts against the parts near the robot, found in the obstacles' grid).
-    pub fn bumpers_with(
-        &self,
-        index: usize,
-        poses: &[Pose],
-        radius: f32,
-        arena: Vec2,
-        rays: &BumperRays,
-        obstacles: &Obstacles,
-    ) -> [f32; 3] {
         let Some(me) = poses.get(index) else {
             return [0.0; 3];
         };
-        self.bumpers_facing(index, poses, me.forward(), radius, arena, rays, obstacles)
+        let none = Obstacles::default();
+        self.bumpers_facing(index, poses, me.forward(), radius, arena, rays, &none)
     }
 
-    /// [`NeighbourIndex::bumpers_with`] with robot `index`'s heading vector (`poses[index].forward()`)
-    /// computed once by the caller, who needs it for the colour sensors too: a `sin_cos` less per
-    /// robot and step.
+    /// [`Self::bumpers`] with robot `index`'s heading vector (`poses[index].forward()`, which the
+    /// caller computes once for its colour sensors too) in an arena with `obstacles`: each ray also
+    /// stops at the first obstacle (parry2d ray casts against the parts near the robot, found in the
+    /// obstacles' grid).
     #[allow(clippy::too_many_arguments)]
     pub fn bumpers_facing(
         &self,
