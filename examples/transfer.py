@@ -223,10 +223,10 @@ def main() -> None:
     p.add_argument("--train-only", action="store_true")
     p.add_argument("--out", default="runs/transfer")
     args = p.parse_args()
-    os.makedirs(args.out, exist_ok=True)
-    paths = write_scenarios(args.out, args.fit, args.truth)
     if args.updates is not None and args.updates < 1:
         p.error(f"--updates ({args.updates}) must be at least 1")
+    os.makedirs(args.out, exist_ok=True)
+    paths = write_scenarios(args.out, args.fit, args.truth)
     train(paths, args)
     if args.train_only:
         return
