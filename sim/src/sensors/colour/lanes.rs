@@ -34,18 +34,7 @@ impl ColourSensor {
     ) -> [u16; LANES] {
         let p = &self.params;
         let scale = p.gain * p.integration_ms;
-        let mut noise = [0.0f32; LANES];
-        if p.noise > 0.0 {
-            // The stream's state in a local copy for the draws, so that it can stay in registers
-            // (the same draws in the same order).
-            let (z, mut local) = (crate::rng::ziggurat(), rng.clone());
-            for s in 0..sensors.min(LANE_SENSORS) {
-                for c in 0..3 {
-                    noise[lane(s, c)] = p.noise * crate::rng::normal_with(z, &mut local);
-                }
-            }
-            *rng = local;
-        }
+        let noise = self.noise_lanes(sensors, rng);
         let m = &self.crosstalk_lanes;
         let mut counts = [0u16; LANES];
         for i in 0..LANES {
@@ -56,16 +45,30 @@ impl ColourSensor {
         counts
     }
 
-    /// The random draws of a robot's read ([`ColourSensor::read_robot`]) without the read: for a
-    /// robot whose colour nobody reads, whose stream must go on as if it had been read.
-    pub fn draw_read_noise(&self, rng: &mut SimRng) {
-        if self.params.noise > 0.0 {
+    /// The count noise of up to four sensors (`sensors`), in lanes (`lane(s, c)`), drawn sensor by
+    /// sensor in r, g, b order: every read's random draws.
+    #[inline(always)]
+    fn noise_lanes(&self, sensors: usize, rng: &mut SimRng) -> [f32; LANES] {
+        let sd = self.params.noise;
+        let mut noise = [0.0f32; LANES];
+        if sd > 0.0 {
+            // The stream's state in a local copy for the draws, so that it can stay in registers
+            // (the same draws in the same order).
             let (z, mut local) = (crate::rng::ziggurat(), rng.clone());
-            for _ in 0..LANES {
-                crate::rng::normal_with(z, &mut local);
+            for s in 0..sensors.min(LANE_SENSORS) {
+                for c in 0..3 {
+                    noise[lane(s, c)] = sd * crate::rng::normal_with(z, &mut local);
+                }
             }
             *rng = local;
         }
+        noise
+    }
+
+    /// The random draws of a robot's read ([`ColourSensor::read_robot`]) without the read: for a
+    /// robot whose colour nobody reads, whose stream must go on as if it had been read.
+    pub fn draw_read_noise(&self, rng: &mut SimRng) {
+        self.noise_lanes(LANE_SENSORS, rng);
     }
 
     /// A robot's four sensors read from their footprints' level sums (as
