@@ -63,13 +63,10 @@ fn rate(
     let secs = t0.elapsed().as_secs_f64();
     let mut how = env.backend().describe().to_string();
     if let (Some(a), Some(b)) = (before, env.gpu_stage_seconds()) {
-        let ms = |k: usize| (b[k] - a[k]) * 1e3 / steps as f64;
-        how.push_str(&format!(
-            "; ms a step: motion {:.2}, GPU stage {:.2}, observations and rewards {:.2}",
-            ms(0),
-            ms(1),
-            ms(2)
-        ));
+        let parts: Vec<String> = (colcos_env::GPU_STAGE_PARTS.iter().enumerate())
+            .map(|(k, name)| format!("{name} {:.2}", (b[k] - a[k]) * 1e3 / steps as f64))
+            .collect();
+        how.push_str(&format!("; ms a step: {}", parts.join(", ")));
     }
     Ok(((worlds * s.num_agents * steps) as f64 / secs, how))
 }

@@ -7,10 +7,12 @@
 //! A world built on the CPU (a new episode, its fields on the CPU) is loaded into the batch before the
 //! first step it steps in; until then the batch's copy of its fields is stale and unused (its
 //! sensors' sums this step are not read).
+use crate::GPU_STAGE_PARTS;
 use crate::error::{EnvError, Result};
 use crate::world_slot::WorldSlot;
 use crate::world_step::Begun;
 use colcos_sim::field::{FieldModel, GridField, Pheromone};
+use colcos_sim::world::TrailSegment;
 use rayon::prelude::*;
 
 /// A GPU error as the environment's.
@@ -27,9 +29,8 @@ pub(crate) struct GpuStage {
     robots: usize,
     /// How each world began the current step.
     pub(crate) begun: Vec<Begun>,
-    /// Seconds spent in the three parts of the steps so far: motion, this stage, observations and
-    /// rewards.
-    pub(crate) seconds: [f64; 3],
+    /// Seconds spent in the parts of the steps so far, as [`GPU_STAGE_PARTS`] names them.
+    pub(crate) seconds: [f64; GPU_STAGE_PARTS.len()],
 }
 
 impl GpuStage {
@@ -63,7 +64,7 @@ impl GpuStage {
             sums: Vec::new(),
             robots: first.robot_count(),
             begun: vec![Begun::Stepped; slots.len()],
-            seconds: [0.0; 3],
+            seconds: [0.0; GPU_STAGE_PARTS.len()],
         };
         stage.load_fresh(slots, |_| true)?;
         Ok(stage)
@@ -104,16 +105,19 @@ impl GpuStage {
     }
 
     fn run_with(&mut self, slots: &mut [WorldSlot], begun: &[Begun], dt: f32) -> Result<()> {
+        let t0 = std::time::Instant::now();
         // New episodes that step now start from their CPU fields.
         self.load_fresh(slots, |w| begun[w] != Begun::Reset)?;
-        for (w, slot) in slots.iter().enumerate() {
-            if begun[w] != Begun::Reset {
-                (self.fields)
-                    .add_segments(w, slot.world.trail_segments())
-                    .map_err(backend_error)?;
-            }
-        }
+        // Worlds are not `Sync`: their trails are gathered here, then queued side by side.
+        let trails: Vec<Option<&[TrailSegment]>> = (slots.iter().zip(begun))
+            .map(|(slot, b)| (*b != Begun::Reset).then(|| slot.world.trail_segments()))
+            .collect();
+        (self.fields)
+            .queue_trails(|w| trails[w])
+            .map_err(backend_error)?;
+        let t1 = std::time::Instant::now();
         self.fields.step(dt).map_err(backend_error)?;
+        let t2 = std::time::Instant::now();
         let robots = self.robots;
         (self.fields.centres_mut().par_chunks_mut(4 * robots.max(1)))
             .zip(slots.par_iter_mut())
@@ -124,7 +128,16 @@ impl GpuStage {
                     }
                 }
             });
-        self.fields.sense(&mut self.sums).map_err(backend_error)
+        let t3 = std::time::Instant::now();
+        let sensed = self.fields.sense(&mut self.sums).map_err(backend_error);
+        let t4 = std::time::Instant::now();
+        for (k, (a, b)) in [(t0, t1), (t1, t2), (t2, t3), (t3, t4)]
+            .into_iter()
+            .enumerate()
+        {
+            self.seconds[1 + k] += (b - a).as_secs_f64();
+        }
+        sensed
     }
 
     /// World `w`'s footprint level sums of the last sensing, four per robot.

@@ -42,5 +42,5 @@ pub use error::{EnvError, Result};
 pub use outputs::{BufferPtrs, OutSlices, Outputs, Writer};
 pub use spaces::{EnvSpec, Space};
 pub use task::Task;
-pub use vec_env::{VecEnv, shield_bits};
+pub use vec_env::{GPU_STAGE_PARTS, VecEnv, shield_bits};
 pub use world_slot::world_index;

@@ -26,6 +26,18 @@ use rayon::prelude::*;
 
 mod place;
 
+/// The parts of a step whose seconds `VecEnv::gpu_stage_seconds` adds up: motion on the CPU, the GPU stage's
+/// four (loading new worlds and queueing trails, recording the field passes, writing the sensors'
+/// centres, sensing with the wait for the GPU and the read-back), observations and rewards.
+pub const GPU_STAGE_PARTS: [&str; 6] = [
+    "motion",
+    "loads and trails",
+    "field passes",
+    "sensor centres",
+    "sensing and wait",
+    "observations and rewards",
+];
+
 pub struct VecEnv {
     spec: EnvSpec,
     task: Box<dyn Task>,
@@ -432,8 +444,9 @@ impl VecEnv {
         self.out.clear();
     }
 
-    /// Seconds in the parts of the steps with the GPU batch: motion, GPU stage, observations.
-    pub fn gpu_stage_seconds(&self) -> Option<[f64; 3]> {
+    /// Seconds in the parts of the steps with the GPU batch so far, in the order of
+    /// [`GPU_STAGE_PARTS`] (motion, the GPU stage's four parts, observations and rewards).
+    pub fn gpu_stage_seconds(&self) -> Option<[f64; 6]> {
         #[cfg(feature = "gpu")]
         return self.gpu.as_ref().map(|g| g.seconds);
         #[cfg(not(feature = "gpu"))]

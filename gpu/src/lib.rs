@@ -323,8 +323,19 @@ impl GpuContext {
         offset: u64,
         bytes: u64,
     ) -> Result<Vec<u8>> {
+        self.read_buffer_with(src, offset, bytes, <[u8]>::to_vec)
+    }
+
+    /// Hands `bytes` bytes of `src` from `offset` to `f` (blocking), without a copy of them of our own.
+    pub(crate) fn read_buffer_with<T>(
+        &self,
+        src: &wgpu::Buffer,
+        offset: u64,
+        bytes: u64,
+        f: impl FnOnce(&[u8]) -> T,
+    ) -> Result<T> {
         if bytes == 0 {
-            return Ok(Vec::new());
+            return Ok(f(&[]));
         }
         let (tx, rx) = std::sync::mpsc::channel();
         let staging = self.scoped("reading a buffer back", || {
@@ -358,7 +369,7 @@ impl GpuContext {
             let view = staging
                 .get_mapped_range(..)
                 .map_err(|e| GpuError::Readback(format!("{e:?}")))?;
-            view.to_vec()
+            f(&view)
         };
         staging.unmap();
         Ok(out)

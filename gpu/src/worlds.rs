@@ -11,6 +11,7 @@ use colcos_sim::field::{FieldModel, GridField, GridParams, GridSpec, Pheromone};
 use colcos_sim::screen::ScreenSpec;
 use colcos_sim::world::TrailSegment;
 use glam::Vec2;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Most fields one part may hold (the batch's workgroup limit along z).
@@ -221,24 +222,43 @@ impl WorldFields {
         Ok(out)
     }
 
-    /// Queues world `w`'s trail segments of this step for [`WorldFields::step`], in order.
-    pub fn add_segments(&mut self, w: usize, segments: &[TrailSegment]) -> Result<()> {
-        let (k, i) = self.locate(w)?;
+    /// Queues every world's trail segments of this step for [`WorldFields::step`], world by world
+    /// and in order, side by side: `trails(w)` is world `w`'s, `None` for a world that does not step.
+    pub fn queue_trails<'a>(
+        &mut self,
+        trails: impl Fn(usize) -> Option<&'a [TrailSegment]> + Sync,
+    ) -> Result<()> {
         let per_world = self.per_world;
-        for s in segments {
-            if s.pheromone >= per_world {
-                return Err(GpuError::Invalid(format!(
-                    "world {w}: a trail on pheromone {} of {per_world}",
-                    s.pheromone
-                )));
-            }
-            self.parts[k].deposits.push(Deposit {
-                field: i * per_world + s.pheromone,
-                kernel: s.kernel,
-                a: s.from,
-                b: s.to,
-                amount: s.amount,
-            });
+        let bad = (0..self.len())
+            .into_par_iter()
+            .find_first(|&w| trails(w).is_some_and(|t| t.iter().any(|s| s.pheromone >= per_world)));
+        if let Some(w) = bad {
+            let s = trails(w)
+                .into_iter()
+                .flatten()
+                .find(|s| s.pheromone >= per_world);
+            return Err(GpuError::Invalid(format!(
+                "world {w}: a trail on pheromone {} of {per_world}",
+                s.map_or(0, |s| s.pheromone)
+            )));
+        }
+        for part in &mut self.parts {
+            let first = part.first;
+            part.deposits.par_extend(
+                (0..part.worlds)
+                    .into_par_iter()
+                    .with_min_len(256)
+                    .flat_map_iter(|i| {
+                        let segments = trails(first + i).unwrap_or_default();
+                        segments.iter().map(move |s| Deposit {
+                            field: i * per_world + s.pheromone,
+                            kernel: s.kernel,
+                            a: s.from,
+                            b: s.to,
+                            amount: s.amount,
+                        })
+                    }),
+            );
         }
         Ok(())
     }
@@ -329,11 +349,17 @@ impl WorldFields {
             Some(all) => all,
             None => self.parts[0].sensing.out(),
         };
-        let bytes = self
-            .ctx
-            .read_buffer(src, 0, self.centres.len() as u64 * 12)?;
-        let sums: &[u32] = bytemuck::cast_slice(&bytes);
-        out.extend(sums.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+        self.ctx
+            .read_buffer_with(src, 0, self.centres.len() as u64 * 12, |bytes| {
+                match bytemuck::try_cast_slice::<u8, [u32; 3]>(bytes) {
+                    Ok(sums) => out.extend_from_slice(sums),
+                    // A mapping not aligned to 4 bytes (none seen): element by element.
+                    Err(_) => out.extend(bytes.chunks_exact(12).map(|c| {
+                        let u = |k: usize| u32::from_ne_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+                        [u(0), u(4), u(8)]
+                    })),
+                }
+            })?;
         Ok(())
     }
 }

@@ -3,7 +3,7 @@
 //! the CPU observe, step for step, through a world rebuilt mid-run; their fields stay within 1e-5.
 mod common;
 use colcos_gpu::WorldFields;
-use colcos_sim::field::FieldModel;
+use colcos_sim::field::{FieldModel, Kernel};
 use colcos_sim::prelude::*;
 use colcos_testkit::scenarios::three_maps;
 use common::{compare, ctx};
@@ -58,10 +58,9 @@ fn worlds_sensing_from_the_batch_observe_what_cpu_worlds_observe() {
             gpu[3].set_external_grids(true);
         }
         cpu.iter_mut().for_each(World::step);
-        for (w, world) in gpu.iter_mut().enumerate() {
-            world.step();
-            fields.add_segments(w, world.trail_segments()).unwrap();
-        }
+        gpu.iter_mut().for_each(World::step);
+        let trails: Vec<_> = gpu.iter().map(|w| w.trail_segments()).collect();
+        fields.queue_trails(|w| Some(trails[w])).unwrap();
         fields.step(dt).unwrap();
         let per_world = 4 * robots;
         for (c, world) in fields.centres_mut().chunks_mut(per_world).zip(&gpu) {
@@ -108,4 +107,34 @@ fn worlds_sensing_from_the_batch_observe_what_cpu_worlds_observe() {
         }
     }
     assert!(laid > 100, "the robots laid {laid} cells of blue");
+}
+
+#[test]
+fn a_trail_on_a_pheromone_the_worlds_lack_is_an_error_naming_it() {
+    let Some(ctx) = ctx() else { return };
+    let sc = scenario();
+    let world = World::with_index(&sc, 0).unwrap();
+    let robots = world.robot_count();
+    let mut fields =
+        WorldFields::new(ctx, world.pheromones(), 2, 4 * robots, *world.screen()).unwrap();
+    let bad = [colcos_sim::world::TrailSegment {
+        pheromone: 7,
+        kernel: Kernel::Disc { radius: 0.01 },
+        from: Vec2::new(0.1, 0.1),
+        to: Vec2::new(0.2, 0.1),
+        amount: 1.0,
+    }];
+    let good: [colcos_sim::world::TrailSegment; 0] = [];
+    let err = fields
+        .queue_trails(|w| Some(if w == 1 { &bad[..] } else { &good[..] }))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("world 1: a trail on pheromone 7 of 3"),
+        "{err}"
+    );
+    // A world that does not step this time is not read.
+    fields
+        .queue_trails(|w| (w == 0).then_some(&good[..]))
+        .unwrap();
 }

@@ -1,7 +1,7 @@
 //! Trail deposits on a batch, in rounds: the k-th deposit of every field in round k, so a field's
 //! deposits are summed in the order given.
-use super::GpuGrids;
 use super::record::{Dispatch, Grown, Kind, MAX_GROUPS, PassUniform, groups};
+use super::{GpuGrids, Scratch};
 use crate::{GpuError, Result};
 use bytemuck::{Pod, Zeroable};
 use colcos_sim::field::{GridSpec, Kernel};
@@ -26,7 +26,7 @@ pub struct Deposit {
 /// One deposit as the shader reads it: the cells of its box and the kernel's segment.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-struct DepRecord {
+pub(super) struct DepRecord {
     field: u32,
     slot: u32,
     i0: u32,
@@ -56,23 +56,17 @@ impl GpuGrids {
         ctx.scoped("depositing trails", || self.deposit_inner(deposits))?
     }
 
-    /// The record of deposit `d` (`None`: it lays nothing), as the shader reads it.
-    fn deposit_record(&self, d: &Deposit) -> Result<Option<DepRecord>> {
-        if d.field >= self.fields.len() {
-            return Err(GpuError::Invalid(format!(
-                "deposit on field {} of {}",
-                d.field,
-                self.fields.len()
-            )));
-        }
+    /// The record of deposit `d` (`None`: it lays nothing), as the shader reads it; `d.field` is
+    /// one of the batch's.
+    fn deposit_record(&self, d: &Deposit) -> Option<DepRecord> {
         let support = d.kernel.support();
         if support.is_nan() || support < 0.0 || !d.a.is_finite() || !d.b.is_finite() {
-            return Ok(None);
+            return None;
         }
         let (a, b) = (d.a, d.b);
         let ((i0, i1), (j0, j1)) = self.spec.segment_cells(a, b, support);
         if i1 <= i0 || j1 <= j0 {
-            return Ok(None);
+            return None;
         }
         let ab = b - a;
         let (kind, param) = match d.kernel {
@@ -80,7 +74,7 @@ impl GpuGrids {
             Kernel::Cone { radius } => (1, radius),
             Kernel::Gaussian { sigma } => (2, sigma),
         };
-        Ok(Some(DepRecord {
+        Some(DepRecord {
             field: d.field as u32,
             slot: self.fields[d.field].slot,
             i0: i0 as u32,
@@ -97,36 +91,64 @@ impl GpuGrids {
             support,
             param,
             amount: d.amount,
-        }))
+        })
     }
 
     fn deposit_inner(&mut self, deposits: &[Deposit]) -> Result<()> {
         let GridSpec { nx, ny, cell } = self.spec;
-        // The records side by side (a vector env's batch lays tens of thousands a step) ...
-        let made: Vec<Option<DepRecord>> = deposits
-            .par_iter()
-            .with_min_len(PARALLEL_MIN)
-            .map(|d| self.deposit_record(d))
-            .collect::<Result<_>>()?;
-        // ... then each field's k-th deposit into round k, rounds one after the other.
-        let mut per_field = vec![0u32; self.fields.len()];
+        if let Some(d) = deposits.iter().find(|d| d.field >= self.fields.len()) {
+            return Err(GpuError::Invalid(format!(
+                "deposit on field {} of {}",
+                d.field,
+                self.fields.len()
+            )));
+        }
+        // The records side by side (a vector env's batch lays tens of thousands a step), into
+        // buffers kept from step to step ...
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let made = &mut scratch.made;
+        made.clear();
+        made.par_extend(
+            deposits
+                .par_iter()
+                .with_min_len(PARALLEL_MIN)
+                .map(|d| self.deposit_record(d)),
+        );
+        // ... then each field's k-th deposit into round k, rounds one after the other: `order`
+        // lists the deposits round by round.
+        let per_field = &mut scratch.per_field;
+        per_field.clear();
+        per_field.resize(self.fields.len(), 0);
+        let round_of = &mut scratch.round_of;
+        round_of.clear();
         let mut sizes: Vec<usize> = Vec::new();
         let mut cells: Vec<usize> = Vec::new();
-        let round_of: Vec<u32> = made
-            .iter()
-            .map(|r| {
-                let Some(r) = r else { return u32::MAX };
-                let k = per_field[r.field as usize];
-                per_field[r.field as usize] += 1;
-                if sizes.len() <= k as usize {
-                    sizes.push(0);
-                    cells.push(0);
-                }
-                sizes[k as usize] += 1;
-                cells[k as usize] = cells[k as usize].max((r.w * r.h) as usize);
-                k
-            })
-            .collect();
+        round_of.extend(made.iter().map(|r| {
+            let Some(r) = r else { return u32::MAX };
+            let k = per_field[r.field as usize];
+            per_field[r.field as usize] += 1;
+            if sizes.len() <= k as usize {
+                sizes.push(0);
+                cells.push(0);
+            }
+            sizes[k as usize] += 1;
+            cells[k as usize] = cells[k as usize].max((r.w * r.h) as usize);
+            k
+        }));
+        let result = self.lay_rounds(&mut scratch, &sizes, &cells, (nx, ny, cell));
+        self.scratch = scratch;
+        result
+    }
+
+    /// Uploads the records of `scratch.made` round by round (`sizes[k]` records in round `k`, the
+    /// largest covering `cells[k]` cells) and records their dispatches.
+    fn lay_rounds(
+        &mut self,
+        scratch: &mut Scratch,
+        sizes: &[usize],
+        cells: &[usize],
+        (nx, ny, cell): (usize, usize, f32),
+    ) -> Result<()> {
         if sizes.is_empty() {
             return Ok(());
         }
@@ -143,24 +165,35 @@ impl GpuGrids {
                 Some(s)
             })
             .collect();
-        let mut recs = vec![DepRecord::default(); sizes.iter().sum()];
-        for (r, &k) in made.iter().zip(&round_of) {
-            if let Some(r) = r {
-                recs[next[k as usize]] = *r;
+        let order = &mut scratch.order;
+        order.clear();
+        order.resize(sizes.iter().sum(), 0);
+        for (i, &k) in scratch.round_of.iter().enumerate() {
+            if k != u32::MAX {
+                order[next[k as usize]] = i as u32;
                 next[k as usize] += 1;
             }
         }
+        let recs = &mut scratch.recs;
+        recs.clear();
+        let made = &scratch.made;
+        recs.par_extend(
+            order
+                .par_iter()
+                .with_min_len(PARALLEL_MIN)
+                .map(|&i| made[i as usize].unwrap_or_default()),
+        );
         self.ensure(
             Grown::Deposits,
             std::mem::size_of_val(recs.as_slice()) as u64,
         );
         self.ctx
             .queue
-            .write_buffer(&self.deps, 0, bytemuck::cast_slice(&recs));
+            .write_buffer(&self.deps, 0, bytemuck::cast_slice(recs));
         let mut first = 0u32;
         let dispatches: Vec<Dispatch> = sizes
             .iter()
-            .zip(&cells)
+            .zip(cells)
             .map(|(&size, &cells)| {
                 let (gx, gy) = groups(cells, 256);
                 let count = size as u32;

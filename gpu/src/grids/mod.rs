@@ -11,8 +11,8 @@ pub use deposit::Deposit;
 pub(crate) use pipelines::FieldPipelines;
 
 use crate::{GpuContext, GpuError, Result, check_size, storage};
-use colcos_sim::field::{GridField, GridParams, GridSpec};
-use record::{MAX_GROUPS, UNIFORM_STRIDE};
+use colcos_sim::field::{GridField, GridParams, GridSpec, StepPlan};
+use record::{MAX_GROUPS, PlanEntry, UNIFORM_STRIDE};
 use std::sync::Arc;
 
 /// One field of a batch: its parameters and where its data lie.
@@ -23,6 +23,23 @@ struct FieldState {
     /// Diffusion number the Thomas coefficients were built for.
     coef_r: Option<u32>,
     slot: u32,
+}
+
+/// Buffers a step refills instead of allocating: a vector env's batch fills megabytes of them a step,
+/// and a fresh allocation of that size costs a page fault for every 4 KiB it touches.
+#[derive(Default)]
+struct Scratch {
+    /// Each field's plan of the step.
+    plans: Vec<Option<StepPlan>>,
+    /// Every pass's plan entries, pass after pass.
+    entries: Vec<PlanEntry>,
+    /// Each deposit's record, its round, and the deposits round by round.
+    made: Vec<Option<deposit::DepRecord>>,
+    round_of: Vec<u32>,
+    order: Vec<u32>,
+    recs: Vec<deposit::DepRecord>,
+    /// Deposits a field has had so far in a call.
+    per_field: Vec<u32>,
 }
 
 /// A batch of grid fields of one [`GridSpec`] (e.g. the pheromones of many worlds), on the GPU.
@@ -47,6 +64,7 @@ pub struct GpuGrids {
     uniforms: wgpu::Buffer,
     deps: wgpu::Buffer,
     bind: Option<wgpu::BindGroup>,
+    scratch: Scratch,
 }
 
 impl GpuGrids {
@@ -135,6 +153,7 @@ impl GpuGrids {
             uniforms,
             deps,
             bind: None,
+            scratch: Scratch::default(),
         })
     }
 

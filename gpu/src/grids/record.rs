@@ -182,21 +182,21 @@ impl GpuGrids {
     }
 
     /// Records step passes (kinds with one plan entry per field) into one submission.
-    pub(super) fn run_passes(&mut self, passes: &[(Kind, Vec<PlanEntry>)]) {
-        if passes.is_empty() {
+    /// `entries` holds one entry per field for each pass of `kinds`, pass after pass.
+    pub(super) fn run_passes(&mut self, kinds: &[Kind], entries: &[PlanEntry]) {
+        if kinds.is_empty() {
             return;
         }
         let nf = self.fields.len();
-        let plan: Vec<PlanEntry> = passes.iter().flat_map(|(_, e)| e.iter().copied()).collect();
-        self.ensure(Grown::Plan, std::mem::size_of_val(plan.as_slice()) as u64);
+        self.ensure(Grown::Plan, std::mem::size_of_val(entries) as u64);
         self.ctx
             .queue
-            .write_buffer(&self.plan, 0, bytemuck::cast_slice(&plan));
+            .write_buffer(&self.plan, 0, bytemuck::cast_slice(entries));
         let (nx, ny) = (self.spec.nx, self.spec.ny);
-        let dispatches: Vec<Dispatch> = passes
+        let dispatches: Vec<Dispatch> = kinds
             .iter()
             .enumerate()
-            .map(|(p, &(kind, _))| {
+            .map(|(p, &kind)| {
                 let (gx, gy) = match kind {
                     Kind::XSolve => groups(ny, 64),
                     Kind::YSolve => groups(nx, 64),

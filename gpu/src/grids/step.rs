@@ -5,34 +5,48 @@ use crate::Result;
 use colcos_sim::field::{Diffusion, GridSpec, StepPlan};
 use rayon::prelude::*;
 
-/// Passes under construction, and the slot each field's current values will be in after them.
-struct Passes {
-    list: Vec<(Kind, Vec<PlanEntry>)>,
+/// Fewest fields a thread takes when plans and entries are made side by side.
+const PARALLEL_MIN: usize = 2048;
+
+/// Passes under construction: their kinds, their entries (one per field, pass after pass), and the
+/// slot each field's current values will be in after them.
+struct Passes<'a> {
+    kinds: Vec<Kind>,
+    entries: &'a mut Vec<PlanEntry>,
     slots: Vec<u32>,
     coef_stride: usize,
 }
 
-impl Passes {
-    /// Adds a pass of `kind` with an entry for each field `make` gives one (no pass if none does).
-    fn add(&mut self, kind: Kind, make: impl Fn(usize) -> Option<PlanEntry>) {
-        let mut any = false;
-        let entries: Vec<PlanEntry> = (0..self.slots.len())
-            .map(|f| match make(f) {
+impl Passes<'_> {
+    /// Adds a pass of `kind` with an entry for each field `make` gives one (no pass if none does);
+    /// the fields' entries are made side by side (a vector env's batch has tens of thousands).
+    fn add(&mut self, kind: Kind, make: impl Fn(usize) -> Option<PlanEntry> + Sync) {
+        let start = self.entries.len();
+        let nf = self.slots.len();
+        self.entries.resize(start + nf, PlanEntry::default());
+        let stride = self.coef_stride;
+        let any = (self.entries[start..].par_iter_mut())
+            .zip(self.slots.par_iter_mut())
+            .enumerate()
+            .with_min_len(PARALLEL_MIN)
+            .map(|(f, (entry, slot))| match make(f) {
                 Some(mut e) => {
-                    any = true;
                     e.on = 1;
-                    e.src = self.slots[f];
-                    e.coef = (f * self.coef_stride) as u32;
+                    e.src = *slot;
+                    e.coef = (f * stride) as u32;
                     if kind.flips() {
-                        self.slots[f] ^= 1;
+                        *slot ^= 1;
                     }
-                    e
+                    *entry = e;
+                    true
                 }
-                None => PlanEntry::default(),
+                None => false,
             })
-            .collect();
+            .reduce(|| false, |a, b| a || b);
         if any {
-            self.list.push((kind, entries));
+            self.kinds.push(kind);
+        } else {
+            self.entries.truncate(start);
         }
     }
 }
@@ -50,19 +64,30 @@ impl GpuGrids {
         if self.fields.is_empty() {
             return Ok(());
         }
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let result = self.plan_and_run(&mut scratch, dt);
+        self.scratch = scratch;
+        result
+    }
+
+    /// [`GpuGrids::step`] with `scratch`'s buffers.
+    fn plan_and_run(&mut self, scratch: &mut super::Scratch, dt: f32) -> Result<()> {
         let spec = self.spec;
         let GridSpec { nx, ny, .. } = spec;
         let coef_stride = 2 * (nx + ny);
         // Each field's plan (two f64 transcendentals: side by side for a vector env's batch).
-        let plans: Option<Vec<StepPlan>> = self
-            .fields
-            .par_iter_mut()
-            .with_min_len(4096)
-            .map(|st| StepPlan::new(&spec, &st.params, dt, &mut st.decay_carry))
-            .collect();
-        let Some(plans) = plans else {
+        let plans = &mut scratch.plans;
+        plans.clear();
+        plans.par_extend(
+            (self.fields.par_iter_mut())
+                .with_min_len(PARALLEL_MIN)
+                .map(|st| StepPlan::new(&spec, &st.params, dt, &mut st.decay_carry)),
+        );
+        // No plan is the same for every field: `dt` not positive or an empty grid.
+        if plans.iter().any(Option::is_none) {
             return Ok(());
-        };
+        }
+        let plans: Vec<&StepPlan> = plans.iter().flatten().collect();
         for (fi, (st, plan)) in self.fields.iter_mut().zip(&plans).enumerate() {
             if let Diffusion::Implicit { r } = plan.diffusion
                 && st.coef_r != Some(r.to_bits())
@@ -79,21 +104,20 @@ impl GpuGrids {
             }
         }
 
-        let inj: Vec<i32> = self
-            .fields
-            .iter()
-            .map(|s| s.inj_offset.map_or(-1, |o| o as i32))
-            .collect();
+        let fields = &self.fields;
+        let inj = |f: usize| fields[f].inj_offset.map_or(-1, |o| o as i32);
+        scratch.entries.clear();
         let mut passes = Passes {
-            list: Vec::new(),
+            kinds: Vec::new(),
+            entries: &mut scratch.entries,
             slots: self.fields.iter().map(|s| s.slot).collect(),
             coef_stride,
         };
         passes.add(Kind::Evaporate, |f| {
             let p = &plans[f];
             // Without a map and with a = 1 the CPU leaves the values as they are (no flush either).
-            (!p.diffusion.fuses_decay() && (inj[f] >= 0 || p.a != 1.0)).then_some(PlanEntry {
-                inj: inj[f],
+            (!p.diffusion.fuses_decay() && (inj(f) >= 0 || p.a != 1.0)).then_some(PlanEntry {
+                inj: inj(f),
                 a: p.a,
                 b: p.b,
                 ..Default::default()
@@ -113,7 +137,7 @@ impl GpuGrids {
             passes.add(Kind::Explicit, |f| match plans[f].diffusion {
                 Diffusion::Explicit { substeps, r } if k < substeps => {
                     let (a, b, i) = if k == 0 {
-                        (plans[f].a, plans[f].b, inj[f])
+                        (plans[f].a, plans[f].b, inj(f))
                     } else {
                         (1.0, 0.0, -1)
                     };
@@ -140,7 +164,7 @@ impl GpuGrids {
         }
         passes.add(Kind::XSolve, |f| match plans[f].diffusion {
             Diffusion::Implicit { r } => Some(PlanEntry {
-                inj: inj[f],
+                inj: inj(f),
                 a: plans[f].a,
                 b: plans[f].b,
                 r,
@@ -160,7 +184,8 @@ impl GpuGrids {
         }
         if plans.iter().any(|p| p.diffusion == Diffusion::Uniform) {
             // Infinite diffusion (uniform at the mean): finish the passes so far, average on the CPU.
-            self.run_passes(&std::mem::take(&mut passes.list));
+            self.run_passes(&std::mem::take(&mut passes.kinds), passes.entries);
+            passes.entries.clear();
             for (f, p) in plans.iter().enumerate() {
                 if p.diffusion == Diffusion::Uniform {
                     self.fields[f].slot = passes.slots[f];
@@ -193,7 +218,7 @@ impl GpuGrids {
                 })
             });
         }
-        self.run_passes(&passes.list);
+        self.run_passes(&passes.kinds, passes.entries);
         for (st, s) in self.fields.iter_mut().zip(passes.slots) {
             st.slot = s;
         }

@@ -95,6 +95,8 @@ pub struct SensorBatch {
     out: wgpu::Buffer,
     /// The bind group, and the generation of the footprint sets it binds.
     bind: Option<(wgpu::BindGroup, u64)>,
+    /// The layer records last uploaded (they change only where a field's slot does).
+    layer_recs: Vec<LayerRec>,
 }
 
 impl SensorBatch {
@@ -138,6 +140,7 @@ impl GpuScreen {
                     mapped_at_creation: false,
                 }),
                 out: buf("colcos sensor sums", count as u64 * 12),
+                layer_recs: Vec::new(),
                 bind: None,
             }
         })
@@ -172,16 +175,22 @@ impl GpuScreen {
         footprints.upload()?;
         let nl = colours.len();
         let worlds = batch.count / batch.per_world.max(1);
-        let layers: Vec<LayerRec> = (0..worlds * nl)
-            .map(|f| LayerRec {
+        let mut layers_changed = batch.layer_recs.len() != worlds * nl;
+        batch.layer_recs.resize(worlds * nl, LayerRec::default());
+        for (f, rec) in batch.layer_recs.iter_mut().enumerate() {
+            let now = LayerRec {
                 kind: 0,
                 offset: grids.field_offset(f) as u32,
                 count: 0,
                 _pad: 0,
                 k: colours[f % nl],
                 time: 0.0,
-            })
-            .collect();
+            };
+            if *rec != now {
+                *rec = now;
+                layers_changed = true;
+            }
+        }
         let (gx, gy) = groups(batch.count, 64);
         let spec = grids.spec();
         let ps = screen.pixel_size();
@@ -206,7 +215,9 @@ impl GpuScreen {
             if let Some(sets) = sets {
                 q.write_buffer(&batch.sets, 0, bytemuck::cast_slice(sets));
             }
-            q.write_buffer(&batch.layers, 0, bytemuck::cast_slice(&layers));
+            if layers_changed {
+                q.write_buffer(&batch.layers, 0, bytemuck::cast_slice(&batch.layer_recs));
+            }
             q.write_buffer(&batch.uniform, 0, bytemuck::bytes_of(&uni));
             if batch
                 .bind

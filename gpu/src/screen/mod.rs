@@ -83,7 +83,7 @@ pub struct SensorQuery {
 }
 
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 struct LayerRec {
     kind: u32,
     offset: u32,
