@@ -72,10 +72,21 @@ impl GpuStage {
 
     /// Loads the worlds that are fresh and for which `now(w)` holds: their fields and their sensors'
     /// footprints.
-    fn load_fresh(&mut self, slots: &mut [WorldSlot], now: impl Fn(usize) -> bool) -> Result<()> {
+    fn load_fresh(
+        &mut self,
+        slots: &mut [WorldSlot],
+        now: impl Fn(usize) -> bool + Sync,
+    ) -> Result<()> {
+        // Found side by side: a serial look at every world costs a cache miss each (worlds lie
+        // apart on the heap), a millisecond for 16,384 worlds.
+        let fresh: Vec<usize> = (slots.par_iter_mut().enumerate())
+            .filter(|(w, slot)| slot.fresh && now(*w))
+            .map(|(w, _)| w)
+            .collect();
         let mut sets = Vec::with_capacity(4 * self.robots);
-        for (w, slot) in slots.iter_mut().enumerate() {
-            if slot.fresh && now(w) {
+        for w in fresh {
+            let slot = &mut slots[w];
+            {
                 let world = &slot.world;
                 (self.fields)
                     .load_world(w, world.pheromones())
@@ -108,9 +119,10 @@ impl GpuStage {
         let t0 = std::time::Instant::now();
         // New episodes that step now start from their CPU fields.
         self.load_fresh(slots, |w| begun[w] != Begun::Reset)?;
-        // Worlds are not `Sync`: their trails are gathered here, then queued side by side.
-        let trails: Vec<Option<&[TrailSegment]>> = (slots.iter().zip(begun))
-            .map(|(slot, b)| (*b != Begun::Reset).then(|| slot.world.trail_segments()))
+        // Worlds are not `Sync`: their trails are gathered (side by side, through `&mut`), then
+        // queued.
+        let trails: Vec<Option<&[TrailSegment]>> = (slots.par_iter_mut().zip(begun))
+            .map(|(slot, b)| (*b != Begun::Reset).then(|| &*slot.world.trail_segments()))
             .collect();
         (self.fields)
             .queue_trails(|w| trails[w])

@@ -7,7 +7,7 @@
 //! largest storage binding is cut into parts of whole worlds, each stepped and sensed on its own.
 use crate::screen::{FootprintSets, GpuScreen, POINTS_PER_SENSOR, SensorBatch};
 use crate::{Deposit, GpuContext, GpuError, GpuGrids, Result, storage};
-use colcos_sim::field::{FieldModel, GridField, GridParams, GridSpec, Pheromone};
+use colcos_sim::field::{FieldModel, GridField, GridParams, GridSpec, Kernel, Pheromone};
 use colcos_sim::screen::ScreenSpec;
 use colcos_sim::world::TrailSegment;
 use glam::Vec2;
@@ -222,43 +222,65 @@ impl WorldFields {
         Ok(out)
     }
 
-    /// Queues every world's trail segments of this step for [`WorldFields::step`], world by world
-    /// and in order, side by side: `trails(w)` is world `w`'s, `None` for a world that does not step.
+    /// Queues every world's trail segments of this step for [`WorldFields::step`] (replacing any queued
+    /// before), world by world and in order, side by side: `trails(w)` is world `w`'s, `None` for a
+    /// world that does not step. A trail on a pheromone the worlds lack queues nothing and is an error.
     pub fn queue_trails<'a>(
         &mut self,
         trails: impl Fn(usize) -> Option<&'a [TrailSegment]> + Sync,
     ) -> Result<()> {
         let per_world = self.per_world;
-        let bad = (0..self.len())
-            .into_par_iter()
-            .find_first(|&w| trails(w).is_some_and(|t| t.iter().any(|s| s.pheromone >= per_world)));
-        if let Some(w) = bad {
-            let s = trails(w)
-                .into_iter()
-                .flatten()
-                .find(|s| s.pheromone >= per_world);
-            return Err(GpuError::Invalid(format!(
-                "world {w}: a trail on pheromone {} of {per_world}",
-                s.map_or(0, |s| s.pheromone)
-            )));
-        }
+        let mut bad = None;
         for part in &mut self.parts {
             let first = part.first;
-            part.deposits.par_extend(
-                (0..part.worlds)
-                    .into_par_iter()
-                    .with_min_len(256)
-                    .flat_map_iter(|i| {
-                        let segments = trails(first + i).unwrap_or_default();
-                        segments.iter().map(move |s| Deposit {
+            // Each world's deposits into its own stretch of the part's list, side by side.
+            let counts: Vec<usize> = (0..part.worlds)
+                .map(|i| trails(first + i).map_or(0, <[_]>::len))
+                .collect();
+            let placeholder = Deposit {
+                field: 0,
+                kernel: Kernel::Disc { radius: 0.0 },
+                a: Vec2::ZERO,
+                b: Vec2::ZERO,
+                amount: 0.0,
+            };
+            part.deposits.clear();
+            part.deposits.resize(counts.iter().sum(), placeholder);
+            let mut stretches = Vec::with_capacity(part.worlds);
+            let mut rest = &mut part.deposits[..];
+            for &n in &counts {
+                let (stretch, tail) = rest.split_at_mut(n);
+                stretches.push(stretch);
+                rest = tail;
+            }
+            let found = (stretches.into_par_iter().enumerate())
+                .with_min_len(256)
+                .filter_map(|(i, stretch)| {
+                    let segments = trails(first + i).unwrap_or_default();
+                    for (d, s) in stretch.iter_mut().zip(segments) {
+                        if s.pheromone >= per_world {
+                            return Some((first + i, s.pheromone));
+                        }
+                        *d = Deposit {
                             field: i * per_world + s.pheromone,
                             kernel: s.kernel,
                             a: s.from,
                             b: s.to,
                             amount: s.amount,
-                        })
-                    }),
-            );
+                        };
+                    }
+                    None
+                })
+                .min_by_key(|&(w, _)| w);
+            bad = bad.or(found);
+        }
+        if let Some((w, pheromone)) = bad {
+            for part in &mut self.parts {
+                part.deposits.clear();
+            }
+            return Err(GpuError::Invalid(format!(
+                "world {w}: a trail on pheromone {pheromone} of {per_world}"
+            )));
         }
         Ok(())
     }
