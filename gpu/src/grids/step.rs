@@ -51,6 +51,32 @@ impl Passes<'_> {
     }
 }
 
+/// Which passes the fields' plans need: the most explicit, one-sided and wind sub-steps of any
+/// field, and whether any diffuses implicitly or uniformly.
+#[derive(Default)]
+struct Needs {
+    explicit: usize,
+    one_sided: usize,
+    implicit: bool,
+    uniform: bool,
+    wind: usize,
+}
+
+impl Needs {
+    fn add(&mut self, plan: &StepPlan) {
+        match plan.diffusion {
+            Diffusion::Explicit { substeps, .. } => self.explicit = self.explicit.max(substeps),
+            Diffusion::OneSided { substeps, .. } => self.one_sided = self.one_sided.max(substeps),
+            Diffusion::Implicit { .. } => self.implicit = true,
+            Diffusion::Uniform => self.uniform = true,
+            Diffusion::None => {}
+        }
+        if let Some(w) = plan.wind {
+            self.wind = self.wind.max(w.substeps);
+        }
+    }
+}
+
 impl GpuGrids {
     /// Advances every field by `dt` seconds: exact evaporation and static injection, diffusion by the
     /// field's scheme, then wind; the same passes, in the same order, as
@@ -88,7 +114,11 @@ impl GpuGrids {
             return Ok(());
         }
         let plans: Vec<&StepPlan> = plans.iter().flatten().collect();
+        // The passes some field needs (a pass no field needs is not tried), and the Thomas
+        // coefficients of implicit fields whose diffusion number changed.
+        let mut needs = Needs::default();
         for (fi, (st, plan)) in self.fields.iter_mut().zip(&plans).enumerate() {
+            needs.add(plan);
             if let Diffusion::Implicit { r } = plan.diffusion
                 && st.coef_r != Some(r.to_bits())
             {
@@ -123,17 +153,7 @@ impl GpuGrids {
                 ..Default::default()
             })
         });
-        let max_sub = plans
-            .iter()
-            .filter_map(|p| match p.diffusion {
-                Diffusion::Explicit { substeps, .. } | Diffusion::OneSided { substeps, .. } => {
-                    Some(substeps)
-                }
-                _ => None,
-            })
-            .max()
-            .unwrap_or(0);
-        for k in 0..max_sub {
+        for k in 0..needs.explicit {
             passes.add(Kind::Explicit, |f| match plans[f].diffusion {
                 Diffusion::Explicit { substeps, r } if k < substeps => {
                     let (a, b, i) = if k == 0 {
@@ -152,7 +172,7 @@ impl GpuGrids {
                 _ => None,
             });
         }
-        for k in 0..max_sub {
+        for k in 0..needs.one_sided {
             passes.add(Kind::OneSided, |f| match plans[f].diffusion {
                 Diffusion::OneSided { substeps, s } if k < substeps => Some(PlanEntry {
                     inj: -1,
@@ -162,17 +182,19 @@ impl GpuGrids {
                 _ => None,
             });
         }
-        passes.add(Kind::XSolve, |f| match plans[f].diffusion {
-            Diffusion::Implicit { r } => Some(PlanEntry {
-                inj: inj(f),
-                a: plans[f].a,
-                b: plans[f].b,
-                r,
-                ..Default::default()
-            }),
-            _ => None,
-        });
-        if ny > 1 {
+        if needs.implicit {
+            passes.add(Kind::XSolve, |f| match plans[f].diffusion {
+                Diffusion::Implicit { r } => Some(PlanEntry {
+                    inj: inj(f),
+                    a: plans[f].a,
+                    b: plans[f].b,
+                    r,
+                    ..Default::default()
+                }),
+                _ => None,
+            });
+        }
+        if needs.implicit && ny > 1 {
             passes.add(Kind::YSolve, |f| match plans[f].diffusion {
                 Diffusion::Implicit { r } => Some(PlanEntry {
                     inj: -1,
@@ -182,7 +204,7 @@ impl GpuGrids {
                 _ => None,
             });
         }
-        if plans.iter().any(|p| p.diffusion == Diffusion::Uniform) {
+        if needs.uniform {
             // Infinite diffusion (uniform at the mean): finish the passes so far, average on the CPU.
             self.run_passes(&std::mem::take(&mut passes.kinds), passes.entries);
             passes.entries.clear();
@@ -195,12 +217,7 @@ impl GpuGrids {
                 }
             }
         }
-        let max_wind = plans
-            .iter()
-            .filter_map(|p| p.wind.map(|w| w.substeps))
-            .max()
-            .unwrap_or(0);
-        for k in 0..max_wind {
+        for k in 0..needs.wind {
             passes.add(Kind::AdvectX, |f| {
                 let w = plans[f].wind.filter(|w| k < w.substeps)?;
                 w.x(&spec).map(|c| PlanEntry {
