@@ -17,8 +17,9 @@ use colcos_sim::field::BackendChoice;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::World;
 
-/// Fewest worlds for which `auto` takes a hardware GPU.
-pub const AUTO_GPU_MIN_WORLDS: usize = 4096;
+/// Fewest worlds for which `auto` takes a hardware GPU: on an H200 with 16 cores the batch ran `trail`
+/// at 0.45x the CPU backend with 256 worlds and 1.20x with 1,024 (`benches/gpu_machine.sh`).
+pub const AUTO_GPU_MIN_WORLDS: usize = 1024;
 
 /// A resolved backend choice.
 #[derive(Clone)]

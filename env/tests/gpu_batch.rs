@@ -213,7 +213,7 @@ fn auto_takes_the_cpu_for_small_batches_and_software_adapters() {
     assert_eq!(env.backend().name(), "cpu");
     let d = env.backend().describe();
     let why = [
-        "3 worlds, the GPU pays from 4096",
+        "3 worlds, the GPU pays from 1024",
         "software adapter",
         "no GPU adapter",
     ];
