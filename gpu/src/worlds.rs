@@ -5,9 +5,10 @@
 //! The worlds share one scenario, so their grids have one spec: world `w`'s pheromone `j` is field
 //! `w * P + j` of a [`GpuGrids`] batch (`P` pheromones a world). A batch larger than the adapter's
 //! largest storage binding is cut into parts of whole worlds, each stepped and sensed on its own.
+use crate::grids::DepRecord;
 use crate::screen::{FootprintSets, GpuScreen, POINTS_PER_SENSOR, SensorBatch};
 use crate::{Deposit, GpuContext, GpuError, GpuGrids, Result, storage};
-use colcos_sim::field::{FieldModel, GridField, GridParams, GridSpec, Kernel, Pheromone};
+use colcos_sim::field::{FieldModel, GridField, GridParams, GridSpec, Pheromone};
 use colcos_sim::screen::ScreenSpec;
 use colcos_sim::world::TrailSegment;
 use glam::Vec2;
@@ -23,7 +24,10 @@ struct Part {
     worlds: usize,
     grids: GpuGrids,
     sensing: SensorBatch,
-    deposits: Vec<Deposit>,
+    /// The queued trails' deposit records (`None`: lays nothing) and their rounds (a field's k-th
+    /// deposit of the step in round k; a world's fields are its own, so rounds are counted per world).
+    made: Vec<Option<DepRecord>>,
+    rounds: Vec<u32>,
 }
 
 /// The grid pheromones of `worlds` worlds of one scenario, on one device.
@@ -122,7 +126,8 @@ impl WorldFields {
                 worlds: n,
                 grids: GpuGrids::new(ctx.clone(), spec, &all)?,
                 sensing: gpu_screen.sensor_batch(n, sensors, per_world)?,
-                deposits: Vec::new(),
+                made: Vec::new(),
+                rounds: Vec::new(),
             });
             first_world += n;
         }
@@ -232,42 +237,57 @@ impl WorldFields {
         let per_world = self.per_world;
         let mut bad = None;
         for part in &mut self.parts {
-            let first = part.first;
-            // Each world's deposits into its own stretch of the part's list, side by side.
-            let counts: Vec<usize> = (0..part.worlds)
+            let Part {
+                first,
+                worlds,
+                grids,
+                made,
+                rounds,
+                ..
+            } = part;
+            let first = *first;
+            // Each world's records and rounds into its own stretch of the part's lists, side by side.
+            let counts: Vec<usize> = (0..*worlds)
                 .map(|i| trails(first + i).map_or(0, <[_]>::len))
                 .collect();
-            let placeholder = Deposit {
-                field: 0,
-                kernel: Kernel::Disc { radius: 0.0 },
-                a: Vec2::ZERO,
-                b: Vec2::ZERO,
-                amount: 0.0,
-            };
-            part.deposits.clear();
-            part.deposits.resize(counts.iter().sum(), placeholder);
-            let mut stretches = Vec::with_capacity(part.worlds);
-            let mut rest = &mut part.deposits[..];
+            let total = counts.iter().sum();
+            made.clear();
+            made.resize(total, None);
+            rounds.clear();
+            rounds.resize(total, u32::MAX);
+            let mut stretches = Vec::with_capacity(*worlds);
+            let (mut made_rest, mut rounds_rest) = (&mut made[..], &mut rounds[..]);
             for &n in &counts {
-                let (stretch, tail) = rest.split_at_mut(n);
-                stretches.push(stretch);
-                rest = tail;
+                let (m, m_tail) = made_rest.split_at_mut(n);
+                let (r, r_tail) = rounds_rest.split_at_mut(n);
+                stretches.push((m, r));
+                (made_rest, rounds_rest) = (m_tail, r_tail);
             }
+            let grids = &*grids;
             let found = (stretches.into_par_iter().enumerate())
                 .with_min_len(256)
-                .filter_map(|(i, stretch)| {
+                .filter_map(|(i, (made, rounds))| {
                     let segments = trails(first + i).unwrap_or_default();
-                    for (d, s) in stretch.iter_mut().zip(segments) {
+                    for (k, s) in segments.iter().enumerate() {
                         if s.pheromone >= per_world {
                             return Some((first + i, s.pheromone));
                         }
-                        *d = Deposit {
+                        made[k] = grids.deposit_record(&Deposit {
                             field: i * per_world + s.pheromone,
                             kernel: s.kernel,
                             a: s.from,
                             b: s.to,
                             amount: s.amount,
-                        };
+                        });
+                        if made[k].is_some() {
+                            // The deposits this world laid before on the same pheromone.
+                            let before = (0..k)
+                                .filter(|&j| {
+                                    segments[j].pheromone == s.pheromone && made[j].is_some()
+                                })
+                                .count();
+                            rounds[k] = before as u32;
+                        }
                     }
                     None
                 })
@@ -276,7 +296,8 @@ impl WorldFields {
         }
         if let Some((w, pheromone)) = bad {
             for part in &mut self.parts {
-                part.deposits.clear();
+                part.made.clear();
+                part.rounds.clear();
             }
             return Err(GpuError::Invalid(format!(
                 "world {w}: a trail on pheromone {pheromone} of {per_world}"
@@ -322,10 +343,9 @@ impl WorldFields {
     pub fn step(&mut self, dt: f32) -> Result<()> {
         for part in &mut self.parts {
             part.grids.step(dt)?;
-            let deposits = std::mem::take(&mut part.deposits);
-            part.grids.deposit(&deposits)?;
-            part.deposits = deposits;
-            part.deposits.clear();
+            part.grids.deposit_made(&mut part.made, &part.rounds)?;
+            part.made.clear();
+            part.rounds.clear();
         }
         Ok(())
     }

@@ -26,7 +26,7 @@ pub struct Deposit {
 /// One deposit as the shader reads it: the cells of its box and the kernel's segment.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub(super) struct DepRecord {
+pub(crate) struct DepRecord {
     field: u32,
     slot: u32,
     i0: u32,
@@ -58,7 +58,7 @@ impl GpuGrids {
 
     /// The record of deposit `d` (`None`: it lays nothing), as the shader reads it; `d.field` is
     /// one of the batch's.
-    fn deposit_record(&self, d: &Deposit) -> Option<DepRecord> {
+    pub(crate) fn deposit_record(&self, d: &Deposit) -> Option<DepRecord> {
         let support = d.kernel.support();
         if support.is_nan() || support < 0.0 || !d.a.is_finite() || !d.b.is_finite() {
             return None;
@@ -95,7 +95,6 @@ impl GpuGrids {
     }
 
     fn deposit_inner(&mut self, deposits: &[Deposit]) -> Result<()> {
-        let GridSpec { nx, ny, cell } = self.spec;
         if let Some(d) = deposits.iter().find(|d| d.field >= self.fields.len()) {
             return Err(GpuError::Invalid(format!(
                 "deposit on field {} of {}",
@@ -135,20 +134,80 @@ impl GpuGrids {
             cells[k as usize] = cells[k as usize].max((r.w * r.h) as usize);
             k
         }));
-        let result = self.lay_rounds(&mut scratch, &sizes, &cells, (nx, ny, cell));
+        let Scratch {
+            made,
+            round_of,
+            order,
+            recs,
+            ..
+        } = &mut scratch;
+        let result = self.lay_rounds(made, round_of, (order, recs), (&sizes, &cells));
         self.scratch = scratch;
         result
     }
 
-    /// Uploads the records of `scratch.made` round by round (`sizes[k]` records in round `k`, the
-    /// largest covering `cells[k]` cells) and records their dispatches.
+    /// Lays deposits whose records were made before the step that precedes them (a vector env's
+    /// batch makes them while queueing its worlds' trails): `made[i]` (`None`: it lays nothing) in
+    /// round `rounds[i]`, a field's k-th deposit in round k. Each record's slot is set to its
+    /// field's current one first.
+    pub(crate) fn deposit_made(
+        &mut self,
+        made: &mut [Option<DepRecord>],
+        rounds: &[u32],
+    ) -> Result<()> {
+        let ctx = self.ctx.clone();
+        ctx.scoped("depositing trails", || {
+            let fields = &self.fields;
+            if let Some(r) = made
+                .iter()
+                .flatten()
+                .find(|r| r.field as usize >= fields.len())
+            {
+                return Err(GpuError::Invalid(format!(
+                    "deposit on field {} of {}",
+                    r.field,
+                    fields.len()
+                )));
+            }
+            (made.par_iter_mut().with_min_len(PARALLEL_MIN))
+                .flatten()
+                .for_each(|r| r.slot = fields[r.field as usize].slot);
+            let mut sizes: Vec<usize> = Vec::new();
+            let mut cells: Vec<usize> = Vec::new();
+            for (r, &k) in made.iter().zip(rounds) {
+                if let Some(r) = r {
+                    let k = k as usize;
+                    if sizes.len() <= k {
+                        sizes.resize(k + 1, 0);
+                        cells.resize(k + 1, 0);
+                    }
+                    sizes[k] += 1;
+                    cells[k] = cells[k].max((r.w * r.h) as usize);
+                }
+            }
+            let mut scratch = std::mem::take(&mut self.scratch);
+            let result = self.lay_rounds(
+                made,
+                rounds,
+                (&mut scratch.order, &mut scratch.recs),
+                (&sizes, &cells),
+            );
+            self.scratch = scratch;
+            result
+        })?
+    }
+
+    /// Uploads the records of `made` round by round (`made[i]` in round `round_of[i]`; `sizes[k]`
+    /// records in round `k`, the largest covering `cells[k]` cells) through `order` and `recs`, and
+    /// records their dispatches.
     fn lay_rounds(
         &mut self,
-        scratch: &mut Scratch,
-        sizes: &[usize],
-        cells: &[usize],
-        (nx, ny, cell): (usize, usize, f32),
+        made: &[Option<DepRecord>],
+        round_of: &[u32],
+        (order, recs): (&mut Vec<u32>, &mut Vec<DepRecord>),
+        (sizes, cells): (&[usize], &[usize]),
     ) -> Result<()> {
+        let GridSpec { nx, ny, cell } = self.spec;
         if sizes.is_empty() {
             return Ok(());
         }
@@ -165,18 +224,15 @@ impl GpuGrids {
                 Some(s)
             })
             .collect();
-        let order = &mut scratch.order;
         order.clear();
         order.resize(sizes.iter().sum(), 0);
-        for (i, &k) in scratch.round_of.iter().enumerate() {
-            if k != u32::MAX {
+        for (i, (r, &k)) in made.iter().zip(round_of).enumerate() {
+            if r.is_some() {
                 order[next[k as usize]] = i as u32;
                 next[k as usize] += 1;
             }
         }
-        let recs = &mut scratch.recs;
         recs.clear();
-        let made = &scratch.made;
         recs.par_extend(
             order
                 .par_iter()

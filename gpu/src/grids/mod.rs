@@ -7,6 +7,7 @@ mod pipelines;
 mod record;
 mod step;
 
+pub(crate) use deposit::DepRecord;
 pub use deposit::Deposit;
 pub(crate) use pipelines::FieldPipelines;
 
