@@ -122,7 +122,7 @@ impl GpuStage {
         // Worlds are not `Sync`: their trails are gathered (side by side, through `&mut`), then
         // queued.
         let trails: Vec<Option<&[TrailSegment]>> = (slots.par_iter_mut().zip(begun))
-            .map(|(slot, b)| (*b != Begun::Reset).then(|| &*slot.world.trail_segments()))
+            .map(|(slot, b)| (*b != Begun::Reset).then(|| slot.world.trail_segments()))
             .collect();
         (self.fields)
             .queue_trails(|w| trails[w])
