@@ -85,6 +85,8 @@ def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> Experiment
     cfg.checkpoint_at_end = False
     cfg.checkpoint_interval = 0
     cfg.prefer_continuous_actions = not args.discrete
+    if args.lr is not None:
+        cfg.lr = args.lr
     cfg.evaluation_episodes = args.eval_episodes
     # colcos steps all worlds of a batch in Rust: large batches of worlds, one collector.
     cfg.on_policy_n_envs_per_worker = cfg.off_policy_n_envs_per_worker = args.worlds
@@ -141,6 +143,7 @@ def main() -> None:
     p.add_argument("--discrete", action="store_true", help="the discrete action variant (continuous=False)")
     p.add_argument("--tiny", action="store_true", help="one small iteration (a check that it runs)")
     p.add_argument("--threads", type=int, default=1, help="torch threads")
+    p.add_argument("--lr", type=float, default=None, help="learning rate (BenchMARL's default: 5e-5)")
     p.add_argument("--out", default="runs/benchmarl")
     args = p.parse_args()
     if args.algorithm not in ALGORITHMS:
