@@ -19,6 +19,7 @@ import pathlib
 import time
 from typing import Any
 
+import colcos
 import numpy as np
 import torch
 from benchmarl.algorithms import (
@@ -34,8 +35,6 @@ from benchmarl.algorithms import (
 )
 from benchmarl.experiment import Experiment, ExperimentConfig
 from benchmarl.models.mlp import MlpConfig
-
-import colcos
 from colcos.baselines import Baseline, RandomPolicy
 from colcos.benchmarl import task as benchmarl_task
 from colcos.vector import VecEnv
