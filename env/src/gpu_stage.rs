@@ -86,21 +86,19 @@ impl GpuStage {
         let mut sets = Vec::with_capacity(4 * self.robots);
         for w in fresh {
             let slot = &mut slots[w];
-            {
-                let world = &slot.world;
-                (self.fields)
-                    .load_world(w, world.pheromones())
-                    .map_err(backend_error)?;
-                sets.clear();
-                for i in 0..self.robots {
-                    let set = self.fields.footprint(&world.footprint_offsets(i));
-                    sets.extend([set; 4]);
-                }
-                self.fields
-                    .set_footprints(w, &sets)
-                    .map_err(backend_error)?;
-                slot.fresh = false;
+            let world = &slot.world;
+            (self.fields)
+                .load_world(w, world.pheromones())
+                .map_err(backend_error)?;
+            sets.clear();
+            for i in 0..self.robots {
+                let set = self.fields.footprint(&world.footprint_offsets(i));
+                sets.extend([set; 4]);
             }
+            self.fields
+                .set_footprints(w, &sets)
+                .map_err(backend_error)?;
+            slot.fresh = false;
         }
         Ok(())
     }

@@ -66,12 +66,12 @@ pub(crate) fn step_batch_gpu(
     let t1 = Instant::now();
     // 2. Fields, deposits and sensing of every world on the GPU.
     stage.run(slots, ctx.scenario.spec.dt)?;
+    let run_end = Instant::now();
     if ctx.writer.patch.is_some() || matches!(ctx.evaluation, Evaluation::Deferred) {
         // Patches and a task written in Python read the fields on the CPU.
         stage.sync(slots)?;
     }
     // 3. Observations from the sums, rewards, outputs.
-    let t2 = Instant::now();
     let concluded = chunks
         .par_iter_mut(slots)
         .zip(buffers.par_chunks(c))
@@ -95,8 +95,8 @@ pub(crate) fn step_batch_gpu(
             result
         });
     let t3 = Instant::now();
-    // The stage times its own parts (its sync, where there is one, counts with observations).
+    // The stage times its own four parts; its sync, where there is one, counts with observations.
     stage.seconds[0] += (t1 - t0).as_secs_f64();
-    stage.seconds[5] += (t3 - t2).as_secs_f64();
+    stage.seconds[5] += (t3 - run_end).as_secs_f64();
     concluded
 }

@@ -26,9 +26,9 @@ use rayon::prelude::*;
 
 mod place;
 
-/// The parts of a step whose seconds `VecEnv::gpu_stage_seconds` adds up: motion on the CPU, the GPU stage's
-/// four (loading new worlds and queueing trails, recording the field passes, writing the sensors'
-/// centres, sensing with the wait for the GPU and the read-back), observations and rewards.
+/// The parts of a step whose seconds `VecEnv::gpu_stage_seconds` adds up: motion on the CPU, the GPU
+/// stage's four (loading new worlds and queueing trails, recording the field passes, writing the
+/// sensors' centres, sensing with the wait for the GPU and the read-back), observations and rewards.
 pub const GPU_STAGE_PARTS: [&str; 6] = [
     "motion",
     "loads and trails",
