@@ -68,10 +68,14 @@ class ActorCritic(nn.Module):
             self.pi[-1].weight.mul_(0.01)
             self.pi[-1].bias.zero_()
 
-    def log_prob(self, obs: torch.Tensor, act: torch.Tensor) -> torch.Tensor:
+    def mean(self, obs: torch.Tensor) -> torch.Tensor:
+        """The Gaussian's mean for raw observations (normalised here)."""
+        return self.pi(self.obs_norm(obs))
+
+    def log_prob(self, obs: torch.Tensor, act: torch.Tensor, mu: torch.Tensor | None = None) -> torch.Tensor:
         """log pi(act | obs) summed over the action's entries: torch's `Normal(...).log_prob(act).sum(-1)`
-        in fewer tensor operations (the update's hot path on small batches)."""
-        z = (act - self.pi(self.obs_norm(obs))) * torch.exp(-self.log_std)
+        in fewer tensor operations (the update's hot path on small batches); `mu`: `mean(obs)` if known."""
+        z = (act - (self.mean(obs) if mu is None else mu)) * torch.exp(-self.log_std)
         return -0.5 * (z * z).sum(-1) - self.log_std.sum() - 0.5 * LOG_2PI * act.shape[-1]
 
     def value(self, critic_in: torch.Tensor) -> torch.Tensor:
@@ -130,6 +134,16 @@ class Config:
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     start_forward: float = 0.0  # the untrained actor's mean for both wheels: > 0 drives forward, an exploration prior
     start_lay: float = 0.0  # the untrained actor's mean for the outputs after the wheels (deposit rates): < 0 lays rarely
+    # Biases for learned communication (Eccles et al. 2019, "Biases for emergent communication in multi-agent
+    # RL"), both 0 (off) by default. `listen_bias`: reward wheels that respond to the message, the L1 distance
+    # between the wheel means and those with `message_inputs` (observation entries) zeroed. `signal_bias`:
+    # reward a message that depends on the observation, the mutual information between observation and
+    # sending (output `message_output` above `message_threshold`) over the minibatch.
+    listen_bias: float = 0.0
+    signal_bias: float = 0.0
+    message_inputs: tuple[int, ...] = ()
+    message_output: int = 2
+    message_threshold: float = 0.5
 
 
 def clip_wheels(a: np.ndarray) -> np.ndarray:
@@ -247,15 +261,41 @@ class Trainer:
             perm = torch.randperm(m)
             for k in range(0, m, size):
                 idx = perm[k : k + size]
-                ratio = (model.log_prob(fo[idx], fa[idx]) - fl[idx]).exp()
+                mu = model.mean(fo[idx])
+                ratio = (model.log_prob(fo[idx], fa[idx], mu) - fl[idx]).exp()
                 pg = -torch.min(ratio * fadv[idx], ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * fadv[idx]).mean()
                 vloss = 0.5 * (model.value(fc[idx]) - fret[idx]).pow(2).mean()
                 # The Gaussian's entropy is sum(log_std) + const: the same for every sample.
                 loss = pg + 0.5 * vloss - cfg.ent_coef * model.log_std.sum()
+                if cfg.listen_bias:
+                    loss = loss - cfg.listen_bias * listening(model, fo[idx], mu, cfg.message_inputs)
+                if cfg.signal_bias:
+                    loss = loss - cfg.signal_bias * signalling(model, mu, cfg.message_output, cfg.message_threshold)
                 self.opt.zero_grad()
                 loss.backward()
                 nn.utils.clip_grad_norm_(model.parameters(), 0.5)
                 self.opt.step()
+
+
+def listening(model: ActorCritic, obs: torch.Tensor, mu: torch.Tensor, inputs: tuple[int, ...]) -> torch.Tensor:
+    """How much the wheel commands (clipped means) respond to the message: the mean L1 distance to those
+    of the same observations with the message's entries `inputs` zeroed (nothing heard)."""
+    deaf = obs.clone()
+    deaf[:, list(inputs)] = 0.0
+    return (mu[:, :2].clamp(-1, 1) - model.mean(deaf)[:, :2].clamp(-1, 1)).abs().sum(-1).mean()
+
+
+def signalling(model: ActorCritic, mu: torch.Tensor, output: int, threshold: float) -> torch.Tensor:
+    """Mutual information (nats) between observation and sending over a minibatch: H(mean p) - mean H(p),
+    with p = P(output's Gaussian sample > threshold) per observation. High when the sender sends in some
+    situations and not in others, zero when it sends with the same probability everywhere."""
+    p = 0.5 * (1.0 + torch.erf((mu[:, output] - threshold) * torch.exp(-model.log_std[output]) / np.sqrt(2.0)))
+    p = p.clamp(1e-6, 1.0 - 1e-6)
+
+    def h(q: torch.Tensor) -> torch.Tensor:
+        return -(q * torch.log(q) + (1.0 - q) * torch.log1p(-q))
+
+    return h(p.mean()) - h(p).mean()
 
 
 def episode_returns(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict,

@@ -72,16 +72,35 @@ def to_env(a: np.ndarray, lay: bool) -> np.ndarray:
     return out
 
 
-def episode_steps(task: str, args: argparse.Namespace) -> int:
-    """Steps per episode: `--episode`, or with 0 the task's scenario's own duration."""
-    if args.episode:
-        return args.episode
+def scenario_of(task: str, args: argparse.Namespace) -> dict:
+    """The scenario the task runs on (`--scenario`, or the task's own), parsed."""
     if args.scenario:
         text = pathlib.Path(args.scenario).read_text()
     else:
         text = PYTHON_TASKS[task][0].scenario if task in PYTHON_TASKS else colcos.default_scenario(task)
-    scenario = tomllib.loads(text)
+    return tomllib.loads(text)
+
+
+def episode_steps(task: str, args: argparse.Namespace) -> int:
+    """Steps per episode: `--episode`, or with 0 the task's scenario's own duration."""
+    if args.episode:
+        return args.episode
+    scenario = scenario_of(task, args)
     return round(scenario["duration"] / scenario["dt"])
+
+
+def message_inputs(task: str, args: argparse.Namespace) -> tuple[int, ...]:
+    """The observation entries an agent hears the others' pheromone in (for `--listen-bias`): the colour
+    channels of every pheromone the agents lay by action, at each of the four sensors (entries
+    `3 * sensor + channel`)."""
+    scenario = scenario_of(task, args)
+    laid = set()
+    for group in scenario.get("robots", []):
+        laid.update(d["pheromone"] for d in group.get("deposit_actions", []))
+        laid.update(e["pheromone"] for e in group.get("emits", []) if e.get("when") == "action")
+    channels = sorted({c for ph in scenario.get("pheromones", []) if ph["name"] in laid
+                       for c in range(3) if ph["colour"][c] > 0})
+    return tuple(3 * s + c for s in range(4) for c in channels)
 
 
 def updates_for(args: argparse.Namespace, num_agents: int) -> int:
@@ -112,7 +131,8 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
     updates = updates_for(args, env.num_agents)
     cfg = ppo.Config(horizon=args.horizon, epochs=4, minibatches=4, lr=args.lr, gamma=args.gamma,
                      anneal=updates if args.anneal else 0, team_critic=args.team_critic,
-                     start_forward=args.start_forward, start_lay=args.start_lay)
+                     start_forward=args.start_forward, start_lay=args.start_lay, listen_bias=args.listen_bias,
+                     signal_bias=args.signal_bias, message_inputs=message_inputs(task, args))
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
@@ -208,7 +228,7 @@ def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
 def config(args: argparse.Namespace) -> dict:
     """What a saved run must share with this call to be reused."""
     keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "anneal", "team_critic", "start_forward", "start_lay",
-            "param", "shaping", "scenario", "eval_worlds", "eval_seed", "eval_policy")
+            "listen_bias", "signal_bias", "param", "shaping", "scenario", "eval_worlds", "eval_seed", "eval_policy")
     return {k: getattr(args, k) for k in keys}
 
 
@@ -349,6 +369,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                    help="the untrained policy drives forward at F (both wheels' mean output), not standing still")
     p.add_argument("--start-lay", type=float, default=0.0, metavar="F",
                    help="the untrained policy's mean deposit output (before clipping to [0, 1]): below 0 it lays rarely")
+    p.add_argument("--listen-bias", type=float, default=0.0, metavar="W",
+                   help="weight of a loss term rewarding wheels that respond to the pheromone the agents lay (both arms; "
+                        "ppo.Config.listen_bias)")
+    p.add_argument("--signal-bias", type=float, default=0.0, metavar="W",
+                   help="weight of a loss term rewarding a call that depends on what the caller senses (both arms; "
+                        "ppo.Config.signal_bias)")
     p.add_argument("--scenario", default=None, help="scenario file instead of the task's own (training and evaluation)")
     args = p.parse_args(argv)
     args.defaults = {k: p.get_default(k) for k in vars(args)} | {"param": {}, "shaping": {}}
