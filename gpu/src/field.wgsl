@@ -171,63 +171,177 @@ fn one_sided(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
     vals[cell.d + cell.i] = flush(v);
 }
 
-// Backward-Euler x-solve, one thread per row (Thomas), fused with evaporation and injection.
-@compute @workgroup_size(64)
-fn xsolve(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let line = line_of(gid, P.ny);
-    if (!line.on) { return; }
-    let nx = P.nx;
-    let first = line.i * nx;
-    let s = line.s + first;
-    let d = line.d + first;
-    let e = line.e;
-    let m = e.coef;
-    let cp = e.coef + nx;
-    var prev = 0.0;
-    for (var i = 0u; i < nx; i = i + 1u) {
-        var fv: f32;
-        if (e.inj >= 0) {
-            fv = exact(e.a * vals[s + i]) + exact(e.b * inj[u32(e.inj) + first + i]);
-        } else {
-            fv = exact(e.a * vals[s + i]);
-        }
-        let v = flush((fv + exact(e.r * prev)) * coef[m + i]);
-        vals[d + i] = v;
-        prev = v;
+// The backward-Euler solves: one thread per line (a row for the x-solve, a column for the y-solve)
+// runs the Thomas algorithm with the CPU's coefficients. A line's sweep is a chain of dependent
+// steps, so its cells go through workgroup memory in tiles: the 64 threads of a workgroup copy a tile
+// of their 64 lines x SPAN cells between the field and `tile` together, in coalesced loads and stores
+// all in flight at once, and each thread then sweeps its own line in the tile. A global load in every
+// step of the chain would wait a memory latency per cell.
+const LINES: u32 = 64u;    // lines a workgroup solves, one per thread
+const SPAN: u32 = 32u;     // cells of each line a tile holds
+const PITCH: u32 = 33u;    // a line's stride in `tile` (odd: the threads' rows fall in different banks)
+var<workgroup> tile: array<f32, 2112>;   // LINES * PITCH
+var<workgroup> down: array<f32, 32>;     // the tile's forward coefficients (1 / pivot), SPAN of them
+var<workgroup> up: array<f32, 32>;       // and its back-substitution ones
+
+// A solve's geometry for one workgroup: the field's slots, its lines [first, first + LINES) of `count`,
+// `len` cells a line; cell c of line l sits at l * line_step + c * cell_step in a slot.
+struct Solve {
+    e: PF,
+    on: bool,
+    s: u32,
+    d: u32,
+    first: u32,
+    count: u32,
+    len: u32,
+    line_step: u32,
+    cell_step: u32,
+    m: u32,      // offset of the forward coefficients in `coef`
+    cp: u32,     // and of the back-substitution ones
+};
+
+fn solve_of(wg: vec3<u32>, x: bool) -> Solve {
+    let n = P.nx * P.ny;
+    let e = entry(wg.z);
+    let first = (wg.x + wg.y * P.groups_x) * LINES;
+    let s = (2u * wg.z + e.src) * n;
+    let d = (2u * wg.z + 1u - e.src) * n;
+    if (x) {
+        return Solve(e, e.on != 0u, s, d, first, P.ny, P.nx, P.nx, 1u, e.coef, e.coef + P.nx);
     }
-    if (nx > 1u) {
-        var i = nx - 1u;
-        loop {
-            i = i - 1u;
-            vals[d + i] = flush(vals[d + i] + exact(coef[cp + i] * vals[d + i + 1u]));
-            if (i == 0u) { break; }
+    let m = e.coef + 2u * P.nx;
+    return Solve(e, e.on != 0u, s, d, first, P.nx, P.ny, 1u, P.nx, m, m + P.ny);
+}
+
+// Thread lid's q-th cell of a tile copy (q < SPAN): its line and cell in the tile. The x-solve's
+// neighbouring threads take neighbouring cells of a row, the y-solve's neighbouring columns: either
+// way neighbouring addresses in the field.
+fn copy_slot(v: Solve, lid: u32, q: u32) -> vec2<u32> {
+    if (v.cell_step == 1u) {
+        return vec2<u32>(q * (LINES / SPAN) + lid / SPAN, lid % SPAN);
+    }
+    return vec2<u32>(lid, q);
+}
+
+// Whether line l, cell c0 + c exists; and its index in a slot.
+fn in_field(v: Solve, l: u32, c0: u32, c: u32) -> bool {
+    return v.on && v.first + l < v.count && c0 + c < v.len;
+}
+
+fn at(v: Solve, l: u32, c0: u32, c: u32) -> u32 {
+    return (v.first + l) * v.line_step + (c0 + c) * v.cell_step;
+}
+
+// The right-hand side of cells [c0, c0 + SPAN) of the workgroup's lines into `tile`, and the
+// tile's coefficients. The x-solve's is evaporation and injection fused in (the CPU's psi); the
+// y-solve's the x-solve's result.
+fn load_rhs(v: Solve, lid: u32, c0: u32, x: bool) {
+    for (var q = 0u; q < SPAN; q = q + 1u) {
+        let lc = copy_slot(v, lid, q);
+        if (in_field(v, lc.x, c0, lc.y)) {
+            let k = at(v, lc.x, c0, lc.y);
+            var fv = vals[v.s + k];
+            if (x) {
+                if (v.e.inj >= 0) {
+                    fv = exact(v.e.a * fv) + exact(v.e.b * inj[u32(v.e.inj) + k]);
+                } else {
+                    fv = exact(v.e.a * fv);
+                }
+            }
+            tile[lc.x * PITCH + lc.y] = fv;
+        }
+    }
+    load_coefficients(v, lid, c0);
+}
+
+fn load_coefficients(v: Solve, lid: u32, c0: u32) {
+    if (lid < SPAN && c0 + lid < v.len) {
+        down[lid] = coef[v.m + c0 + lid];
+        up[lid] = coef[v.cp + c0 + lid];
+    }
+}
+
+// `tile` from / to the destination slot, cells [c0, c0 + SPAN).
+fn load_solution(v: Solve, lid: u32, c0: u32) {
+    for (var q = 0u; q < SPAN; q = q + 1u) {
+        let lc = copy_slot(v, lid, q);
+        if (in_field(v, lc.x, c0, lc.y)) {
+            tile[lc.x * PITCH + lc.y] = vals[v.d + at(v, lc.x, c0, lc.y)];
+        }
+    }
+    load_coefficients(v, lid, c0);
+}
+
+fn store(v: Solve, lid: u32, c0: u32) {
+    for (var q = 0u; q < SPAN; q = q + 1u) {
+        let lc = copy_slot(v, lid, q);
+        if (in_field(v, lc.x, c0, lc.y)) {
+            vals[v.d + at(v, lc.x, c0, lc.y)] = tile[lc.x * PITCH + lc.y];
         }
     }
 }
 
-// Backward-Euler y-solve, one thread per column.
-@compute @workgroup_size(64)
-fn ysolve(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let line = line_of(gid, P.nx);
-    if (!line.on) { return; }
-    let nx = P.nx;
-    let ny = P.ny;
-    let s = line.s + line.i;
-    let d = line.d + line.i;
-    let e = line.e;
-    let m = e.coef + 2u * nx;
-    let cp = m + ny;
-    vals[d] = flush(vals[s] * coef[m]);
-    for (var j = 1u; j < ny; j = j + 1u) {
-        vals[d + j * nx] = flush((vals[s + j * nx] + exact(e.r * vals[d + (j - 1u) * nx])) * coef[m + j]);
+// Thomas over the workgroup's lines, tile by tile: forward elimination (v_i = (f_i + r v_{i-1}) m_i),
+// then back-substitution (v_i += c'_i v_{i+1}) from the far end, the same operations in the same
+// order as the CPU's (sim/src/field/grid.rs). Barriers sit in uniform control flow: every thread of
+// the workgroup runs every loop (a thread past the last line only copies nothing).
+fn thomas(v: Solve, lid: u32, x: bool) {
+    let mine = v.on && v.first + lid < v.count;
+    let row = lid * PITCH;
+    let tiles = (v.len + SPAN - 1u) / SPAN;
+    var prev = 0.0;
+    for (var t = 0u; t < tiles; t = t + 1u) {
+        let c0 = t * SPAN;
+        load_rhs(v, lid, c0, x);
+        workgroupBarrier();
+        if (mine) {
+            let w = min(SPAN, v.len - c0);
+            for (var c = 0u; c < w; c = c + 1u) {
+                let val = flush((tile[row + c] + exact(v.e.r * prev)) * down[c]);
+                tile[row + c] = val;
+                prev = val;
+            }
+        }
+        workgroupBarrier();
+        store(v, lid, c0);
+        workgroupBarrier();
     }
-    if (ny < 2u) { return; }
-    var j = ny - 1u;
+    // The last cell is final after elimination: substitution starts from it.
+    var next = prev;
+    var t = tiles;
     loop {
-        j = j - 1u;
-        vals[d + j * nx] = flush(vals[d + j * nx] + exact(coef[cp + j] * vals[d + (j + 1u) * nx]));
-        if (j == 0u) { break; }
+        if (t == 0u) { break; }
+        t = t - 1u;
+        let c0 = t * SPAN;
+        load_solution(v, lid, c0);
+        workgroupBarrier();
+        if (mine) {
+            var c = min(SPAN, v.len - c0);
+            if (c0 + c == v.len) { c = c - 1u; }  // skip the last cell itself
+            loop {
+                if (c == 0u) { break; }
+                c = c - 1u;
+                let val = flush(tile[row + c] + exact(up[c] * next));
+                tile[row + c] = val;
+                next = val;
+            }
+        }
+        workgroupBarrier();
+        store(v, lid, c0);
+        workgroupBarrier();
     }
+}
+
+// Backward-Euler x-solve, fused with evaporation and injection.
+@compute @workgroup_size(64)
+fn xsolve(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    thomas(solve_of(wg, true), lid, true);
+}
+
+// Backward-Euler y-solve.
+@compute @workgroup_size(64)
+fn ysolve(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    thomas(solve_of(wg, false), lid, false);
 }
 
 // Upwind advection by the field's Courant number c (|c| <= 1/2) along an axis of `len` cells, `stride`

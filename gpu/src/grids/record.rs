@@ -198,6 +198,7 @@ impl GpuGrids {
             .enumerate()
             .map(|(p, &kind)| {
                 let (gx, gy) = match kind {
+                    // 64 lines a workgroup: `LINES` of field.wgsl's solves.
                     Kind::XSolve => groups(ny, 64),
                     Kind::YSolve => groups(nx, 64),
                     _ => groups(nx * ny, 256),
