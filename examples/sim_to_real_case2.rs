@@ -167,12 +167,11 @@ fn on_twin(label: &str, host: &Scenario, twin: &Scenario) -> Curve {
     c
 }
 
-use colcos_sim::output::draw::FONT;
-
-/// The S(t) curves (label, points) in one chart.
+/// The S(t) curves (label, points) in one chart, in the style of the case II figures.
 fn plot(curves: &[(String, Vec<(f64, f64)>)], title: &str, path: &std::path::Path) {
+    use colcos::experiment::plots::{ensure_font, series_legend};
     use plotters::prelude::*;
-    let _ = plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, FONT);
+    ensure_font();
     let (w, h) = (1200u32, 600u32);
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
@@ -207,14 +206,7 @@ fn plot(curves: &[(String, Vec<(f64, f64)>)], title: &str, path: &std::path::Pat
                     PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3))
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 16))
-            .draw()
-            .expect("legend");
+        series_legend(&mut chart).expect("legend");
         root.present().expect("present");
     }
     let img = image::RgbImage::from_raw(w, h, buf).expect("image");

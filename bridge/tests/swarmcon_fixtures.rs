@@ -14,6 +14,14 @@ fn frames(msgs: &[TrackerMessage]) -> Vec<&TrackerFrame> {
         .collect()
 }
 
+/// The frames a fresh parser makes of `bytes`, and the parser (for its counters).
+fn parse_frames(bytes: &[u8]) -> (Vec<TrackerFrame>, StreamParser) {
+    let mut p = StreamParser::new();
+    let out = p.feed(bytes);
+    let f = frames(&out).into_iter().cloned().collect();
+    (f, p)
+}
+
 const PLAIN: &[u8] = b"Detected 2 of 3 at 1700000000123456 \n\
 Robot 000 0.512 0.300 45.000 1700000000123456 \n\
 Robot 001 -0.020 -0.105 -179.500 1700000000100000 \n\
@@ -21,11 +29,9 @@ Robot -01 1.250 0.700 0.000 -1 \n";
 
 #[test]
 fn plain_header_with_fresh_stale_never_seen_and_unidentified() {
-    let mut p = StreamParser::new();
-    let out = p.feed(PLAIN);
-    let f = frames(&out);
+    let (f, p) = parse_frames(PLAIN);
     assert_eq!(f.len(), 1);
-    let f = f[0];
+    let f = &f[0];
     assert_eq!(
         (f.found, f.tracked, f.t_us, f.updated),
         (2, 3, 1_700_000_000_123_456, None)
@@ -51,18 +57,14 @@ fn plain_header_with_fresh_stale_never_seen_and_unidentified() {
 
 #[test]
 fn dot_header() {
-    let mut p = StreamParser::new();
-    let out = p.feed(b"Detected 1 of 1 at 42. \nRobot 007 0.100 0.200 3.000 42 \n");
-    let f = frames(&out);
+    let (f, _) = parse_frames(b"Detected 1 of 1 at 42. \nRobot 007 0.100 0.200 3.000 42 \n");
     assert_eq!(f.len(), 1);
     assert_eq!((f[0].t_us, f[0].updated, f[0].robots[0].id), (42, None, 7));
 }
 
 #[test]
 fn updated_header() {
-    let mut p = StreamParser::new();
-    let out = p.feed(b"Detected 1 of 2 at 99, 1 updated. \nRobot 003 0.100 0.200 3.000 99 \nRobot 004 0.300 0.400 5.000 98 \n");
-    let f = frames(&out);
+    let (f, _) = parse_frames(b"Detected 1 of 2 at 99, 1 updated. \nRobot 003 0.100 0.200 3.000 99 \nRobot 004 0.300 0.400 5.000 98 \n");
     assert_eq!(f.len(), 1);
     assert_eq!((f[0].t_us, f[0].updated), (99, Some(1)));
     assert_eq!(f[0].robots[1].state, SlotState::Stale);
@@ -73,9 +75,7 @@ fn repeated_blocks_repeat_frames_and_empty_blocks_emit() {
     let block = b"Detected 1 of 1 at 500 \nRobot 002 0.100 0.100 0.000 500 \n";
     let mut stream = block.repeat(3);
     stream.extend_from_slice(b"Detected 0 of 0 at 501 \n");
-    let mut p = StreamParser::new();
-    let out = p.feed(&stream);
-    let f = frames(&out);
+    let (f, _) = parse_frames(&stream);
     assert_eq!(f.len(), 4);
     assert_eq!(f[0], f[2]);
     assert!(f[3].robots.is_empty());
@@ -83,11 +83,9 @@ fn repeated_blocks_repeat_frames_and_empty_blocks_emit() {
 
 #[test]
 fn repeated_slot_ids_are_kept_in_order() {
-    let mut p = StreamParser::new();
-    let out = p.feed(
+    let (f, _) = parse_frames(
         b"Detected 2 of 2 at 7 \nRobot 005 0.100 0.100 0.000 7 \nRobot 005 0.200 0.200 0.000 7 \n",
     );
-    let f = frames(&out);
     assert_eq!(
         f[0].robots.iter().map(|r| r.x).collect::<Vec<_>>(),
         vec![0.1, 0.2]
@@ -116,7 +114,6 @@ fn truncated_block_is_dropped_and_counted() {
 
 #[test]
 fn garbage_invalid_utf8_nan_and_absurd_numbers_are_counted() {
-    let mut p = StreamParser::new();
     let mut s = Vec::new();
     s.extend_from_slice(b"\xff\xfe garbage\n");
     s.extend_from_slice(b"hello world\n");
@@ -125,8 +122,7 @@ fn garbage_invalid_utf8_nan_and_absurd_numbers_are_counted() {
     s.extend_from_slice(b"Detected 1 of 1 at 6 \nRobot 001 99999999.000 0.1 0.0 6 \n");
     s.extend_from_slice(b"Detected 1 of 99999 at 7 \n");
     s.extend_from_slice(b"Detected 1 of 1 at 8 \nRobot 001 0.100 0.100 0.000 8 \n");
-    let out = p.feed(&s);
-    let f = frames(&out);
+    let (f, p) = parse_frames(&s);
     assert_eq!(f.len(), 1);
     assert_eq!(f[0].t_us, 8);
     assert_eq!(p.counters().errors, 6);
@@ -147,11 +143,10 @@ fn over_long_lines_are_dropped_without_growing() {
 
 #[test]
 fn writer_matches_c_sprintf_bytes() {
-    let mut p = StreamParser::new();
-    let out = p.feed(PLAIN);
-    let f = frames(&out)[0].clone();
-    assert_eq!(write_block(&f, HeaderForm::Plain, false).as_bytes(), PLAIN);
-    let dot = write_block(&f, HeaderForm::Dot, true);
+    let (f, _) = parse_frames(PLAIN);
+    let f = &f[0];
+    assert_eq!(write_block(f, HeaderForm::Plain, false).as_bytes(), PLAIN);
+    let dot = write_block(f, HeaderForm::Dot, true);
     assert!(dot.starts_with("Detected 2 of 3 at 1700000000123456. \n"));
     assert!(dot.ends_with(" -1 \nCalibrated\n"));
     let mut g = f.clone();

@@ -46,6 +46,17 @@ fn gpu_and_cpu(mut c: EnvConfig) -> Option<(VecEnv, VecEnv)> {
     Some((gpu, VecEnv::new(&c).unwrap()))
 }
 
+/// `trail` with `worlds` worlds of episodes of `max_cycles` steps, on the GPU and on the CPU, both
+/// reset, or `None` (skipping) as [`gpu_env`].
+fn reset_trail_pair(worlds: usize, max_cycles: u64) -> Option<(VecEnv, VecEnv)> {
+    let mut c = cfg("trail", None, worlds, BackendChoice::Gpu);
+    c.max_cycles = max_cycles;
+    let (mut gpu, mut cpu) = gpu_and_cpu(c)?;
+    gpu.reset(None, None).unwrap();
+    cpu.reset(None, None).unwrap();
+    Some((gpu, cpu))
+}
+
 /// The largest difference between two grids' values, relative to the CPU grid `c`'s largest.
 fn relative_error(g: &FieldModel, c: &FieldModel) -> f32 {
     let (FieldModel::Grid(g), FieldModel::Grid(c)) = (g, c) else {
@@ -224,13 +235,9 @@ fn auto_takes_the_cpu_for_small_batches_and_software_adapters() {
 /// own (stale) CPU copies of the fields lack the trails laid since the episode began.
 #[test]
 fn renders_draw_the_batch_fields() {
-    let mut c = cfg("trail", None, 2, BackendChoice::Gpu);
-    c.max_cycles = 100;
-    let Some((mut gpu, mut cpu)) = gpu_and_cpu(c) else {
+    let Some((mut gpu, mut cpu)) = reset_trail_pair(2, 100) else {
         return;
     };
-    gpu.reset(None, None).unwrap();
-    cpu.reset(None, None).unwrap();
     let ahead = vec![0.7f32; gpu.spec().num_envs * gpu.spec().num_agents * 2];
     for _ in 0..40 {
         gpu.step(Actions::Continuous(&ahead)).unwrap();
@@ -262,13 +269,9 @@ fn renders_draw_the_batch_fields() {
 /// to date before the task's hooks would read them, and the concluded outputs are the CPU's.
 #[test]
 fn deferred_steps_see_current_fields_and_conclude_as_the_cpu() {
-    let mut c = cfg("trail", None, 3, BackendChoice::Gpu);
-    c.max_cycles = 6;
-    let Some((mut gpu, mut cpu)) = gpu_and_cpu(c) else {
+    let Some((mut gpu, mut cpu)) = reset_trail_pair(3, 6) else {
         return;
     };
-    gpu.reset(None, None).unwrap();
-    cpu.reset(None, None).unwrap();
     for step in 0..10 {
         let a = actions(&gpu, step);
         cpu.step_deferred(Actions::Continuous(&a)).unwrap();

@@ -137,20 +137,36 @@ fn only_keys(p: &Parts<'_>, allowed: &[&str], expected: &'static str) -> Result<
     }
 }
 
+/// The query option `key` through `parse` (`None` when the URL has no such option); a value `parse`
+/// refuses is an error that gives `reason`.
+fn query_option<T>(
+    p: &Parts<'_>,
+    key: &str,
+    reason: &'static str,
+    parse: impl Fn(&str) -> Option<T>,
+) -> Result<Option<T>, UrlError> {
+    let Some((k, v)) = p.query.iter().find(|(k, _)| *k == key) else {
+        return Ok(None);
+    };
+    match parse(v) {
+        Some(x) => Ok(Some(x)),
+        None => Err(UrlError::Query {
+            url: p.url.into(),
+            key: (*k).into(),
+            value: (*v).into(),
+            reason,
+        }),
+    }
+}
+
 fn baud(p: &Parts<'_>) -> Result<u32, UrlError> {
     only_keys(p, &["baud"], "`baud`")?;
-    match p.query.iter().find(|(k, _)| *k == "baud") {
-        None => Ok(DEFAULT_BAUD),
-        Some((k, v)) => match v.parse::<u32>() {
-            Ok(b) if (300..=10_000_000).contains(&b) => Ok(b),
-            _ => Err(UrlError::Query {
-                url: p.url.into(),
-                key: (*k).into(),
-                value: (*v).into(),
-                reason: "must be a baud rate from 300 to 10000000",
-            }),
-        },
-    }
+    let baud = query_option(p, "baud", "must be a baud rate from 300 to 10000000", |v| {
+        v.parse::<u32>()
+            .ok()
+            .filter(|b| (300..=10_000_000).contains(b))
+    })?;
+    Ok(baud.unwrap_or(DEFAULT_BAUD))
 }
 
 impl std::str::FromStr for PoseUrl {
@@ -178,26 +194,20 @@ impl std::str::FromStr for PoseUrl {
                         what: "file",
                     });
                 }
-                let mut speed = Some(1.0);
-                if let Some((k, v)) = p.query.iter().find(|(k, _)| *k == "speed") {
-                    speed = match *v {
-                        "max" => None,
-                        s => match s.parse::<f64>() {
-                            Ok(x) if x.is_finite() && x > 0.0 => Some(x),
-                            _ => {
-                                return Err(UrlError::Query {
-                                    url: url.into(),
-                                    key: (*k).into(),
-                                    value: s.into(),
-                                    reason: "must be a positive factor or `max`",
-                                });
-                            }
-                        },
-                    };
-                }
+                // `max`: as fast as possible (no factor); absent: recorded speed (1).
+                let factor = |v: &str| match v {
+                    "max" => Some(None),
+                    s => s
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|x| x.is_finite() && *x > 0.0)
+                        .map(Some),
+                };
+                let speed =
+                    query_option(&p, "speed", "must be a positive factor or `max`", factor)?;
                 Ok(PoseUrl::Replay {
                     path: PathBuf::from(p.rest),
-                    speed,
+                    speed: speed.unwrap_or(Some(1.0)),
                 })
             }
             other => Err(UrlError::Scheme {

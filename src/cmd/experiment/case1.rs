@@ -13,7 +13,6 @@ use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::field::FieldModel;
 use colcos_sim::metrics::{ArrivalCounts, TrialOutcome, arrival};
 use colcos_sim::prelude::*;
-use rayon::prelude::*;
 
 /// The three groups: name and pheromones.
 pub const GROUPS: [(&str, &[&str]); 3] = [
@@ -168,20 +167,15 @@ pub fn run(cfg: &Case1Config, tick: &(dyn Fn() + Sync)) -> Result<Case1Result> {
     let tasks: Vec<(usize, usize)> = (0..GROUPS.len())
         .flat_map(|g| (0..cfg.trials).map(move |t| (g, t)))
         .collect();
-    let results: Vec<Result<Trial>> = tasks
-        .par_iter()
-        .map(|&(g, t)| {
-            let r = run_trial(
-                &scenarios[g],
-                t,
-                &ends,
-                cfg.arrival_radius,
-                cfg.trajectory_every,
-            );
-            tick();
-            r
-        })
-        .collect();
+    let results: Vec<Result<Trial>> = super::par_map_ticking(&tasks, tick, |&(g, t)| {
+        run_trial(
+            &scenarios[g],
+            t,
+            &ends,
+            cfg.arrival_radius,
+            cfg.trajectory_every,
+        )
+    });
     let mut groups: Vec<GroupResult> = GROUPS
         .iter()
         .map(|(name, ph)| GroupResult {

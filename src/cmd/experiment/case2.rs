@@ -11,7 +11,6 @@ use colcos_sim::metrics::{
 use colcos_sim::output::draw;
 use colcos_sim::prelude::*;
 use colcos_sim::screen;
-use rayon::prelude::*;
 
 /// The scenario file of case II, compiled in.
 pub const SCENARIO_TOML: &str = include_str!("../../../scenarios/case2_alarm.toml");
@@ -178,14 +177,8 @@ pub fn snapshots_at(
 /// Every run in parallel, gathered by run index. `tick` is called once per finished run.
 pub fn run(cfg: &Case2Config, tick: &(dyn Fn() + Sync)) -> Result<Case2Result> {
     let started = std::time::Instant::now();
-    let runs: Vec<Result<Case2Run>> = (0..cfg.runs)
-        .into_par_iter()
-        .map(|i| {
-            let r = run_one(cfg, i);
-            tick();
-            r
-        })
-        .collect();
+    let runs: Vec<Result<Case2Run>> =
+        super::par_map_ticking(0..cfg.runs, tick, |i| run_one(cfg, i));
     let runs = runs.into_iter().collect::<Result<Vec<_>>>()?;
     Ok(Case2Result {
         config: cfg.clone(),

@@ -3,7 +3,7 @@
 //! its moments come from [`super::moments`].
 use super::case2::{Case2Result, role_colour, snapshots_at};
 use super::moments::{featured_run, key_moments};
-use super::plots::{ensure_font, err, label, save, text_width};
+use super::plots::{ensure_font, err, label, save, series_legend, text_width};
 use anyhow::{Result, anyhow};
 use colcos_sim::metrics::PhaseKind;
 use colcos_sim::output::draw;
@@ -116,14 +116,7 @@ pub fn fig8_s_t(r: &Case2Result, path: &Path) -> Result<()> {
                 .label(name)
                 .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 16))
-            .draw()
-            .map_err(err)?;
+        series_legend(&mut chart)?;
         root.present().map_err(err)?;
     }
     let img = RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("image buffer"))?;

@@ -229,6 +229,28 @@ pub fn run(opts: &Options) -> Result<Report> {
     })
 }
 
+/// `f` of every item in parallel, gathered in the items' order (never by completion order), `tick`
+/// called once per finished item for a shared progress count.
+fn par_map_ticking<I, R>(
+    items: I,
+    tick: &(dyn Fn() + Sync),
+    f: impl Fn(I::Item) -> R + Sync + Send,
+) -> Vec<R>
+where
+    I: rayon::iter::IntoParallelIterator,
+    R: Send,
+{
+    use rayon::iter::ParallelIterator;
+    items
+        .into_par_iter()
+        .map(|item| {
+            let r = f(item);
+            tick();
+            r
+        })
+        .collect()
+}
+
 /// A CSV writer into memory with its header row written (`\n` line ends, fields quoted only where
 /// they must be).
 fn csv_writer(header: &[&str]) -> csv::Writer<Vec<u8>> {

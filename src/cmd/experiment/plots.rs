@@ -11,7 +11,8 @@ use std::path::Path;
 
 use colcos_sim::output::draw::FONT;
 
-pub(super) fn ensure_font() {
+/// Registers the compiled-in font as plotters' `sans-serif` (once; every chart's text needs it).
+pub fn ensure_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
@@ -24,6 +25,22 @@ pub(super) fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
 
 pub(super) fn save(img: &RgbImage, path: &Path) -> Result<()> {
     screen::save_png(img, path)?;
+    Ok(())
+}
+
+/// The series legend of the S(t) charts (Fig. 8 and the sim-to-real example's): top right, on a
+/// nearly opaque white box, so every S(t) figure reads the same.
+pub fn series_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
     Ok(())
 }
 

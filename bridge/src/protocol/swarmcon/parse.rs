@@ -84,6 +84,21 @@ fn int<T: std::str::FromStr>(
         .map_err(|_| field_err(line, field, "is not an integer", tok))
 }
 
+/// An integer whose only allowed negative value is the sentinel -1; below it the error gives
+/// `negative` (which says what -1 means).
+fn int_or_minus_one<T: std::str::FromStr + PartialOrd + From<i8>>(
+    line: &'static str,
+    field: &'static str,
+    tok: Option<&str>,
+    negative: &'static str,
+) -> Result<T, TrackerError> {
+    let v: T = int(line, field, tok)?;
+    if v < T::from(-1) {
+        return Err(field_err(line, field, negative, tok.unwrap_or("")));
+    }
+    Ok(v)
+}
+
 /// A `%.3f` number: digits, one optional leading minus and a dot; no exponent, `nan` or `inf`.
 fn decimal(
     line: &'static str,
@@ -114,6 +129,14 @@ fn expect(line: &'static str, word: &'static str, tok: Option<&str>) -> Result<(
             "keyword expected",
             other.unwrap_or(""),
         )),
+    }
+}
+
+/// Nothing may follow a line's last field.
+fn end_of_line(line: &'static str, tok: Option<&str>) -> Result<(), TrackerError> {
+    match tok {
+        Some(extra) => Err(field_err(line, "end of line", "expected", extra)),
+        None => Ok(()),
     }
 }
 
@@ -170,9 +193,7 @@ fn parse_header(s: &str) -> Result<TrackerLine, TrackerError> {
     } else {
         None
     };
-    if let Some(extra) = it.next() {
-        return Err(field_err(L, "end of line", "expected", extra));
-    }
+    end_of_line(L, it.next())?;
     Ok(TrackerLine::Header {
         found,
         tracked,
@@ -185,32 +206,22 @@ fn parse_robot(s: &str) -> Result<TrackerLine, TrackerError> {
     const L: &str = "Robot";
     let mut it = s.split_ascii_whitespace();
     expect(L, "Robot", it.next())?;
-    let id_tok = it.next();
-    let id: i32 = int(L, "id", id_tok)?;
-    if id < -1 {
-        return Err(field_err(
-            L,
-            "id",
-            "is negative (only -1 means unidentified)",
-            id_tok.unwrap_or(""),
-        ));
-    }
+    let id: i32 = int_or_minus_one(
+        L,
+        "id",
+        it.next(),
+        "is negative (only -1 means unidentified)",
+    )?;
     let x = decimal(L, "x", it.next(), MAX_COORD_M)?;
     let y = decimal(L, "y", it.next(), MAX_COORD_M)?;
     let yaw_deg = decimal(L, "yaw", it.next(), MAX_YAW_DEG)?;
-    let seen_tok = it.next();
-    let last_seen_us: i64 = int(L, "last-seen time", seen_tok)?;
-    if last_seen_us < -1 {
-        return Err(field_err(
-            L,
-            "last-seen time",
-            "is negative (only -1 means never seen)",
-            seen_tok.unwrap_or(""),
-        ));
-    }
-    if let Some(extra) = it.next() {
-        return Err(field_err(L, "end of line", "expected", extra));
-    }
+    let last_seen_us: i64 = int_or_minus_one(
+        L,
+        "last-seen time",
+        it.next(),
+        "is negative (only -1 means never seen)",
+    )?;
+    end_of_line(L, it.next())?;
     Ok(TrackerLine::Robot {
         id,
         x,
