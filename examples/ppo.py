@@ -136,7 +136,7 @@ class Config:
     start_lay: float = 0.0  # the untrained actor's mean for the outputs after the wheels (deposit rates): < 0 lays rarely
     # Biases for learned communication (Eccles et al. 2019, "Biases for emergent communication in multi-agent
     # RL"), both 0 (off) by default. `listen_bias`: reward wheels that respond to the message, the L1 distance
-    # between the wheel means and those with `message_inputs` (observation entries) zeroed. `signal_bias`:
+    # between the wheel means and those with `message_inputs` (observation entries) at their mean. `signal_bias`:
     # reward a message that depends on the observation, the mutual information between observation and
     # sending (output `message_output` above `message_threshold`) over the minibatch.
     listen_bias: float = 0.0
@@ -279,10 +279,12 @@ class Trainer:
 
 def listening(model: ActorCritic, obs: torch.Tensor, mu: torch.Tensor, inputs: tuple[int, ...]) -> torch.Tensor:
     """How much the wheel commands (clipped means) respond to the message: the mean L1 distance to those
-    of the same observations with the message's entries `inputs` zeroed (nothing heard)."""
-    deaf = obs.clone()
-    deaf[:, list(inputs)] = 0.0
-    return (mu[:, :2].clamp(-1, 1) - model.mean(deaf)[:, :2].clamp(-1, 1)).abs().sum(-1).mean()
+    of the same observations with the message's entries `inputs` at their running mean (the actor's
+    normalised input 0). The mean, not a raw 0: a sensor never reads exactly nothing, and an input far
+    outside what the actor has seen would reward reacting to that, not to the message."""
+    z = model.obs_norm(obs)
+    z[:, list(inputs)] = 0.0
+    return (mu[:, :2].clamp(-1, 1) - model.pi(z)[:, :2].clamp(-1, 1)).abs().sum(-1).mean()
 
 
 def signalling(model: ActorCritic, mu: torch.Tensor, output: int, threshold: float) -> torch.Tensor:

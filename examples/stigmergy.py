@@ -131,8 +131,10 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
     updates = updates_for(args, env.num_agents)
     cfg = ppo.Config(horizon=args.horizon, epochs=4, minibatches=4, lr=args.lr, gamma=args.gamma,
                      anneal=updates if args.anneal else 0, team_critic=args.team_critic,
-                     start_forward=args.start_forward, start_lay=args.start_lay, listen_bias=args.listen_bias,
-                     signal_bias=args.signal_bias, message_inputs=message_inputs(task, args))
+                     start_forward=args.start_forward, start_lay=args.start_lay,
+                     # The communication biases act on a message: the arm that lays none has none to hear.
+                     listen_bias=args.listen_bias if lay else 0.0, signal_bias=args.signal_bias if lay else 0.0,
+                     message_inputs=message_inputs(task, args))
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
@@ -370,11 +372,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--start-lay", type=float, default=0.0, metavar="F",
                    help="the untrained policy's mean deposit output (before clipping to [0, 1]): below 0 it lays rarely")
     p.add_argument("--listen-bias", type=float, default=0.0, metavar="W",
-                   help="weight of a loss term rewarding wheels that respond to the pheromone the agents lay (both arms; "
-                        "ppo.Config.listen_bias)")
+                   help="weight of a loss term rewarding wheels that respond to the pheromone the agents lay (the arm "
+                        "with pheromone actions; ppo.Config.listen_bias)")
     p.add_argument("--signal-bias", type=float, default=0.0, metavar="W",
-                   help="weight of a loss term rewarding a call that depends on what the caller senses (both arms; "
-                        "ppo.Config.signal_bias)")
+                   help="weight of a loss term rewarding a call that depends on what the caller senses (the arm with "
+                        "pheromone actions; ppo.Config.signal_bias)")
     p.add_argument("--scenario", default=None, help="scenario file instead of the task's own (training and evaluation)")
     args = p.parse_args(argv)
     args.defaults = {k: p.get_default(k) for k in vars(args)} | {"param": {}, "shaping": {}}

@@ -36,11 +36,16 @@ def test_listening_is_zero_for_wheels_deaf_to_the_message_and_positive_otherwise
     with torch.no_grad():
         model.pi[0].weight[:, list(inputs)] = 0.0  # the actor no longer reads the message's entries
     assert ppo.listening(model, obs, model.mean(obs), inputs).item() == pytest.approx(0.0, abs=1e-7)
-    # Nothing heard (the entries already 0): zeroing them changes nothing.
+    # The message's entries at their running mean already: setting them there changes nothing.
     model = _model(ppo)
+    model.obs_norm.update(torch.rand(256, 18) * 3.0)
+    usual = obs.clone()
+    usual[:, list(inputs)] = model.obs_norm.mean[list(inputs)]
+    assert ppo.listening(model, usual, model.mean(usual), inputs).item() == pytest.approx(0.0, abs=1e-6)
+    # Elsewhere it counts: the same entries at their raw 0, far below their mean of about 1.5.
     quiet = obs.clone()
     quiet[:, list(inputs)] = 0.0
-    assert ppo.listening(model, quiet, model.mean(quiet), inputs).item() == pytest.approx(0.0, abs=1e-7)
+    assert ppo.listening(model, quiet, model.mean(quiet), inputs).item() > 1e-3
 
 
 def test_signalling_is_the_mutual_information_of_sending_and_observation():
@@ -94,3 +99,11 @@ def test_the_study_hears_rally_s_call_on_the_green_entries_and_saves_the_biases(
     assert run.returncode == 0, run.stderr[-2000:]
     saved = json.loads((tmp_path / "rally" / "with_seed0.json").read_text())["config"]
     assert saved["listen_bias"] == 0.05 and saved["signal_bias"] == 0.01
+    # The arm without pheromone actions has no message: it trains without the biases, as with none given.
+    plain = tmp_path / "plain"
+    run = subprocess.run([sys.executable, str(REPO / "examples" / "stigmergy.py"), "--tasks", "rally", "--modes", "without",
+                          "--steps", "1500", "--seeds", "0", "--episode", "30", "--num-envs", "2", "--horizon", "16",
+                          "--eval-worlds", "2", "--out", str(plain)], capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 0, run.stderr[-2000:]
+    without = json.loads((tmp_path / "rally" / "without_seed0.json").read_text())["eval"]
+    assert without == json.loads((plain / "rally" / "without_seed0.json").read_text())["eval"]
