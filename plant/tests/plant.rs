@@ -1,9 +1,12 @@
 //! The RL plants over loopback: the digital twin started in-process and a recorded run replayed, with
 //! the spaces and outputs of the simulated environment, and the shield keeping a policy that drives at
 //! the walls inside the arena.
-use colcos_env::{Actions, EnvConfig, VecEnv};
+mod common;
+
+use colcos_env::{Actions, VecEnv};
 use colcos_plant::{LiveEnv, PlantKind, PlantOptions, TwinScenario};
 use colcos_sim::world::ArenaView;
+use common::{config, twin_at_rest};
 
 /// The twins of these tests run in real time, and one of them measures a latency in ticks: one test
 /// at a time, so that the others do not take its cores.
@@ -11,12 +14,6 @@ static REAL_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
     REAL_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-fn config() -> EnvConfig {
-    let mut cfg = EnvConfig::new("aggregation");
-    cfg.max_cycles = 120;
-    cfg
 }
 
 /// Every agent drives full speed ahead: on its way to a wall within a few seconds.
@@ -144,17 +141,8 @@ fn a_plant_without_what_it_needs_names_it() {
 /// Steps (20 ms) from the first full-ahead command until the tracker shows the host any agent moved
 /// 8 mm (the tracker's noise is 1 mm), on a twin playing `twin` (none: the host's scenario).
 fn steps_until_seen_moving(twin: Option<TwinScenario>) -> usize {
-    let cfg = config();
-    let mut opts = PlantOptions::new(PlantKind::Twin);
-    opts.goto = false;
-    opts.twin_scenario = twin;
-    let mut env = LiveEnv::new(&cfg, &opts).unwrap();
-    env.reset(Some(5)).unwrap();
-    let n = env.spec().num_agents;
     // Still for half a second: every pose the host holds is of robots at rest.
-    for _ in 0..25 {
-        env.step(Actions::Continuous(&vec![0.0; 2 * n])).unwrap();
-    }
+    let (mut env, n) = twin_at_rest(|opts| opts.twin_scenario = twin, 25);
     let start: Vec<_> = env.host().tracked().to_vec();
     // The agents, which the policy drives: a scripted robot wanders on its own.
     let agents = env.spec().agent_robots.clone();

@@ -1,27 +1,15 @@
 //! The twin plant with hidden per-robot truths (`PlantOptions::twin_truth`, Python `truth=`): the
 //! twin's robots drive with their own wheel scales while the host assumes the nominal ones, so the
 //! host sees its agents cover less ground than it commanded; a bad truth file is refused by name.
-use colcos_env::{Actions, EnvConfig, VecEnv};
-use colcos_plant::{LiveEnv, PlantKind, PlantOptions};
+mod common;
 
-fn config() -> EnvConfig {
-    let mut cfg = EnvConfig::new("aggregation");
-    cfg.max_cycles = 120;
-    cfg
-}
+use colcos_env::{Actions, VecEnv};
+use colcos_plant::{LiveEnv, PlantKind, PlantOptions};
+use common::{config, twin_at_rest};
 
 /// Mean distance (m) the host sees its agents cover in 40 steps at half speed ahead.
 fn distance_seen(truth: Option<std::path::PathBuf>) -> f32 {
-    let cfg = config();
-    let mut opts = PlantOptions::new(PlantKind::Twin);
-    opts.goto = false;
-    opts.twin_truth = truth;
-    let mut env = LiveEnv::new(&cfg, &opts).unwrap();
-    env.reset(Some(5)).unwrap();
-    let n = env.spec().num_agents;
-    for _ in 0..10 {
-        env.step(Actions::Continuous(&vec![0.0; 2 * n])).unwrap();
-    }
+    let (mut env, n) = twin_at_rest(|opts| opts.twin_truth = truth, 10);
     let agents = env.spec().agent_robots.clone();
     let start: Vec<_> = env.host().tracked().to_vec();
     for _ in 0..40 {

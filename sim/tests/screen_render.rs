@@ -23,6 +23,17 @@ fn grid(spec: GridSpec, colour: [f32; 3], mut value: impl FnMut(usize) -> f32) -
     }
 }
 
+/// A grid of `cells` (nx, ny) of `cell` m and a screen of `resolution` pixels showing `size` m.
+fn grid_and_screen(
+    cells: [usize; 2],
+    cell: f32,
+    resolution: [u32; 2],
+    size: [f32; 2],
+) -> (GridSpec, ScreenSpec) {
+    let [nx, ny] = cells;
+    (GridSpec { nx, ny, cell }, ScreenSpec { resolution, size })
+}
+
 fn random_colour(rng: &mut SmallRng) -> [f32; 3] {
     std::array::from_fn(|_| match rng.random_range(0..5) {
         0 | 1 => 0.0,
@@ -153,15 +164,7 @@ fn large_images_render_as_the_reference_render() {
 /// Values no scenario makes (NaN, infinities, huge) still give the reference's bytes.
 #[test]
 fn non_finite_values_render_as_the_reference_render() {
-    let spec = GridSpec {
-        nx: 13,
-        ny: 7,
-        cell: 0.05,
-    };
-    let screen = ScreenSpec {
-        resolution: [97, 61],
-        size: [0.6, 0.4],
-    };
+    let (spec, screen) = grid_and_screen([13, 7], 0.05, [97, 61], [0.6, 0.4]);
     let specials = [f32::NAN, f32::INFINITY, -f32::INFINITY, f32::MAX, -f32::MAX];
     for (k, &special) in specials.iter().enumerate() {
         let ps = [
@@ -178,15 +181,7 @@ fn non_finite_values_render_as_the_reference_render() {
 /// `to_level` gives them, in every instruction set.
 #[test]
 fn rounding_edges_give_to_level() {
-    let spec = GridSpec {
-        nx: 4,
-        ny: 3,
-        cell: 0.1,
-    };
-    let screen = ScreenSpec {
-        resolution: [37, 5],
-        size: [0.4, 0.3],
-    };
+    let (spec, screen) = grid_and_screen([4, 3], 0.1, [37, 5], [0.4, 0.3]);
     let below_half = f32::from_bits(0.5f32.to_bits() - 1);
     let edges = [
         0.0,
@@ -228,15 +223,7 @@ fn rounding_edges_give_to_level() {
 /// draw each frame as `render` does.
 #[test]
 fn kept_renderers_follow_changing_fields_and_sizes() {
-    let spec = GridSpec {
-        nx: 30,
-        ny: 20,
-        cell: 0.04,
-    };
-    let screen = ScreenSpec {
-        resolution: [300, 200],
-        size: [1.2, 0.8],
-    };
+    let (spec, screen) = grid_and_screen([30, 20], 0.04, [300, 200], [1.2, 0.8]);
     let mut renderer = ScreenRenderer::new();
     let mut rng = SmallRng::seed_from_u64(3);
     for (frame, (w, h)) in [(300, 200), (300, 200), (77, 41), (300, 200)]

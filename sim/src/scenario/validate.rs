@@ -30,6 +30,15 @@ fn finite(key: &str, v: f32) -> Result<()> {
     }
 }
 
+/// `v` is at most `max`; the error says so with `unit` (and any reason) after the number.
+fn at_most(key: &str, v: f32, max: f32, unit: &str) -> Result<()> {
+    if v > max {
+        Err(SimError::invalid(key, v, format!("at most {max} {unit}")))
+    } else {
+        Ok(())
+    }
+}
+
 pub(super) fn validate(sc: &Scenario) -> Result<()> {
     let s = &sc.spec;
     positive("duration", s.duration)?;
@@ -170,21 +179,14 @@ fn validate_robot_params(sc: &Scenario) -> Result<()> {
     }
     let t = &s.tracker;
     positive("tracker.rate_hz", t.rate_hz)?;
-    if t.rate_hz > MAX_TRACKER_RATE_HZ {
-        return Err(SimError::invalid(
-            "tracker.rate_hz",
-            t.rate_hz,
-            format!("at most {MAX_TRACKER_RATE_HZ} Hz (every frame is simulated)"),
-        ));
-    }
+    at_most(
+        "tracker.rate_hz",
+        t.rate_hz,
+        MAX_TRACKER_RATE_HZ,
+        "Hz (every frame is simulated)",
+    )?;
     non_negative("tracker.latency", t.latency)?;
-    if t.latency > MAX_TRACKER_LATENCY {
-        return Err(SimError::invalid(
-            "tracker.latency",
-            t.latency,
-            format!("at most {MAX_TRACKER_LATENCY} s"),
-        ));
-    }
+    at_most("tracker.latency", t.latency, MAX_TRACKER_LATENCY, "s")?;
     // Every frame captured but not yet delivered is held in memory.
     let in_flight = (t.rate_hz * t.latency).ceil().max(1.0) as f64 * sc.robot_count() as f64;
     if in_flight > MAX_POSES_IN_FLIGHT {
