@@ -281,7 +281,11 @@ fn implicit_solves_in_tiles_are_the_cpus_bit_for_bit() {
         }
         for (k, (g, c)) in gpu.read_all().unwrap().iter().zip(&cpu).enumerate() {
             let (_, same) = compare(g, c.values());
-            assert_eq!(same, spec.len(), "{nx}x{ny}, case {k}: cells equal to the CPU's");
+            assert_eq!(
+                same,
+                spec.len(),
+                "{nx}x{ny}, case {k}: cells equal to the CPU's"
+            );
         }
     }
 }
