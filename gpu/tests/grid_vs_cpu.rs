@@ -1,9 +1,10 @@
 //! The GPU grid backend against the CPU one: every scheme and option, hundreds of steps, 1e-5 relative.
 mod common;
-use colcos_gpu::{Deposit, GpuGrids};
+use colcos_gpu::{Deposit, GpuContext, GpuGrids};
 use colcos_sim::Vec2;
 use colcos_sim::field::{DiffusionScheme, GridField, GridParams, GridSpec, Kernel};
 use common::{Lcg, compare, ctx};
+use std::sync::Arc;
 
 const TOL: f64 = 1e-5;
 
@@ -30,6 +31,23 @@ fn random_field(spec: GridSpec, params: GridParams, seed: u64, with_injection: b
     f
 }
 
+/// Each case as a random CPU field (seeds from `seed`) and the same fields as one GPU batch.
+fn batch(
+    ctx: Arc<GpuContext>,
+    spec: GridSpec,
+    cases: &[(GridParams, bool)],
+    seed: u64,
+) -> (Vec<GridField>, GpuGrids) {
+    let cpu: Vec<GridField> = cases
+        .iter()
+        .enumerate()
+        .map(|(k, &(p, inj))| random_field(spec, p, seed + k as u64, inj))
+        .collect();
+    let refs: Vec<&GridField> = cpu.iter().collect();
+    let gpu = GpuGrids::from_fields(ctx, &refs).expect("gpu grids");
+    (cpu, gpu)
+}
+
 /// Steps `cases` on the CPU and, together in one batch, on the GPU; checks every `check` steps.
 fn run_cases(
     name: &str,
@@ -40,13 +58,7 @@ fn run_cases(
     deposits: bool,
 ) {
     let Some(ctx) = ctx() else { return };
-    let mut cpu: Vec<GridField> = cases
-        .iter()
-        .enumerate()
-        .map(|(k, &(p, inj))| random_field(spec, p, 7 + k as u64, inj))
-        .collect();
-    let refs: Vec<&GridField> = cpu.iter().collect();
-    let mut gpu = GpuGrids::from_fields(ctx, &refs).expect("gpu grids");
+    let (mut cpu, mut gpu) = batch(ctx, spec, cases, 7);
     let mut rng = Lcg(99);
     let kernels = [
         Kernel::Disc { radius: 0.012 },
@@ -268,13 +280,7 @@ fn implicit_solves_in_tiles_are_the_cpus_bit_for_bit() {
             ny,
             cell: 0.005,
         };
-        let mut cpu: Vec<GridField> = cases
-            .iter()
-            .enumerate()
-            .map(|(k, &(p, inj))| random_field(spec, p, 3 + k as u64, inj))
-            .collect();
-        let refs: Vec<&GridField> = cpu.iter().collect();
-        let mut gpu = GpuGrids::from_fields(ctx.clone(), &refs).expect("gpu grids");
+        let (mut cpu, mut gpu) = batch(ctx.clone(), spec, &cases, 3);
         for _ in 0..30 {
             cpu.iter_mut().for_each(|f| f.step(0.02));
             gpu.step(0.02).unwrap();
