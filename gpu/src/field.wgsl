@@ -187,6 +187,7 @@ var<workgroup> up: array<f32, 32>;       // and its back-substitution ones
 // A solve's geometry for one workgroup: the field's slots, its lines [first, first + LINES) of `count`,
 // `len` cells a line; cell c of line l sits at l * line_step + c * cell_step in a slot.
 struct Solve {
+    x: bool,     // the x-solve (lines are rows), else the y-solve
     e: PF,
     on: bool,
     s: u32,
@@ -207,17 +208,17 @@ fn solve_of(wg: vec3<u32>, x: bool) -> Solve {
     let s = (2u * wg.z + e.src) * n;
     let d = (2u * wg.z + 1u - e.src) * n;
     if (x) {
-        return Solve(e, e.on != 0u, s, d, first, P.ny, P.nx, P.nx, 1u, e.coef, e.coef + P.nx);
+        return Solve(true, e, e.on != 0u, s, d, first, P.ny, P.nx, P.nx, 1u, e.coef, e.coef + P.nx);
     }
     let m = e.coef + 2u * P.nx;
-    return Solve(e, e.on != 0u, s, d, first, P.nx, P.ny, 1u, P.nx, m, m + P.ny);
+    return Solve(false, e, e.on != 0u, s, d, first, P.nx, P.ny, 1u, P.nx, m, m + P.ny);
 }
 
 // Thread lid's q-th cell of a tile copy (q < SPAN): its line and cell in the tile. The x-solve's
 // neighbouring threads take neighbouring cells of a row, the y-solve's neighbouring columns: either
 // way neighbouring addresses in the field.
 fn copy_slot(v: Solve, lid: u32, q: u32) -> vec2<u32> {
-    if (v.cell_step == 1u) {
+    if (v.x) {
         return vec2<u32>(q * (LINES / SPAN) + lid / SPAN, lid % SPAN);
     }
     return vec2<u32>(lid, q);
@@ -235,13 +236,13 @@ fn at(v: Solve, l: u32, c0: u32, c: u32) -> u32 {
 // The right-hand side of cells [c0, c0 + SPAN) of the workgroup's lines into `tile`, and the
 // tile's coefficients. The x-solve's is evaporation and injection fused in (the CPU's psi); the
 // y-solve's the x-solve's result.
-fn load_rhs(v: Solve, lid: u32, c0: u32, x: bool) {
+fn load_rhs(v: Solve, lid: u32, c0: u32) {
     for (var q = 0u; q < SPAN; q = q + 1u) {
         let lc = copy_slot(v, lid, q);
         if (in_field(v, lc.x, c0, lc.y)) {
             let k = at(v, lc.x, c0, lc.y);
             var fv = vals[v.s + k];
-            if (x) {
+            if (v.x) {
                 if (v.e.inj >= 0) {
                     fv = exact(v.e.a * fv) + exact(v.e.b * inj[u32(v.e.inj) + k]);
                 } else {
@@ -284,15 +285,16 @@ fn store(v: Solve, lid: u32, c0: u32) {
 // Thomas over the workgroup's lines, tile by tile: forward elimination (v_i = (f_i + r v_{i-1}) m_i),
 // then back-substitution (v_i += c'_i v_{i+1}) from the far end, the same operations in the same
 // order as the CPU's (sim/src/field/grid.rs). Barriers sit in uniform control flow: every thread of
-// the workgroup runs every loop (a thread past the last line only copies nothing).
-fn thomas(v: Solve, lid: u32, x: bool) {
+// the workgroup runs every loop (a thread past the last line only copies nothing). The last tile
+// stays in `tile` from elimination to substitution: it is stored once, after both.
+fn thomas(v: Solve, lid: u32) {
     let mine = v.on && v.first + lid < v.count;
     let row = lid * PITCH;
     let tiles = (v.len + SPAN - 1u) / SPAN;
     var prev = 0.0;
     for (var t = 0u; t < tiles; t = t + 1u) {
         let c0 = t * SPAN;
-        load_rhs(v, lid, c0, x);
+        load_rhs(v, lid, c0);
         workgroupBarrier();
         if (mine) {
             let w = min(SPAN, v.len - c0);
@@ -303,7 +305,9 @@ fn thomas(v: Solve, lid: u32, x: bool) {
             }
         }
         workgroupBarrier();
-        store(v, lid, c0);
+        if (t + 1u < tiles) {
+            store(v, lid, c0);
+        }
         workgroupBarrier();
     }
     // The last cell is final after elimination: substitution starts from it.
@@ -313,7 +317,9 @@ fn thomas(v: Solve, lid: u32, x: bool) {
         if (t == 0u) { break; }
         t = t - 1u;
         let c0 = t * SPAN;
-        load_solution(v, lid, c0);
+        if (t + 1u < tiles) {
+            load_solution(v, lid, c0);
+        }
         workgroupBarrier();
         if (mine) {
             var c = min(SPAN, v.len - c0);
@@ -335,13 +341,13 @@ fn thomas(v: Solve, lid: u32, x: bool) {
 // Backward-Euler x-solve, fused with evaporation and injection.
 @compute @workgroup_size(64)
 fn xsolve(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    thomas(solve_of(wg, true), lid, true);
+    thomas(solve_of(wg, true), lid);
 }
 
 // Backward-Euler y-solve.
 @compute @workgroup_size(64)
 fn ysolve(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    thomas(solve_of(wg, false), lid, false);
+    thomas(solve_of(wg, false), lid);
 }
 
 // Upwind advection by the field's Courant number c (|c| <= 1/2) along an axis of `len` cells, `stride`
