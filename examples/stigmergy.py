@@ -189,14 +189,14 @@ def run(task: str, mode: str, seed: int, args: argparse.Namespace) -> dict:
     path = folder / f"{mode}_seed{seed}.json"
     if path.exists():
         saved = json.loads(path.read_text())
-        if same_config(saved["config"], config(args), args):
+        if same_config(saved["config"], config(args, mode), args):
             return saved
         print(f"{path}: made with another configuration, trained again", flush=True)
     lay = mode == "with"
     model, log = train(task, lay, seed, args)
     torch.save(model.state_dict(), folder / f"{mode}_seed{seed}.pt")
     t0 = time.time()
-    rec = {"task": task, "mode": mode, "seed": seed, "config": config(args), **log,
+    rec = {"task": task, "mode": mode, "seed": seed, "config": config(args, mode), **log,
            "eval": evaluate(task, acting(model, lay, args), args)}
     if lay:
         rec["eval_rates_off"] = evaluate(task, acting(model, False, args), args)
@@ -227,11 +227,16 @@ def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
     return returns
 
 
-def config(args: argparse.Namespace) -> dict:
-    """What a saved run must share with this call to be reused."""
+def config(args: argparse.Namespace, mode: str = "with") -> dict:
+    """What a saved run of `mode` must share with this call to be reused. The arm without pheromone
+    actions trains without the communication biases (`train`), so it records them as 0: one such run
+    serves studies with any biases."""
     keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "anneal", "team_critic", "start_forward", "start_lay",
             "listen_bias", "signal_bias", "param", "shaping", "scenario", "eval_worlds", "eval_seed", "eval_policy")
-    return {k: getattr(args, k) for k in keys}
+    out = {k: getattr(args, k) for k in keys}
+    if mode == "without":
+        out["listen_bias"] = out["signal_bias"] = 0.0
+    return out
 
 
 def same_config(saved: dict, current: dict, args: argparse.Namespace) -> bool:
