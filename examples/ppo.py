@@ -55,21 +55,44 @@ def mlp(i: int, o: int, hidden: int) -> nn.Sequential:
 class ActorCritic(nn.Module):
     """Gaussian actor on the agent's own observation; critic on observation + global state + agent id.
 
-    `pi`, `obs_norm` and `log_std` are what a robot runs (`onboard_export.py` reads them by name)."""
+    With `agents` = N > 0 the actor also sees which of the N agents it drives (a one-hot appended to
+    the observation, `actor_input`): one network, but free to drive robots that differ (wheels, lags,
+    sensor gains) each in its own way. `pi`, `obs_norm` and `log_std` are what a robot runs
+    (`onboard_export.py` reads them by name; it takes only actors of the 17 observation entries)."""
 
-    def __init__(self, obs_dim: int, critic_dim: int, act_dim: int = 2, hidden: int = 64) -> None:
+    def __init__(self, obs_dim: int, critic_dim: int, act_dim: int = 2, hidden: int = 64, agents: int = 0) -> None:
         super().__init__()
-        self.pi = mlp(obs_dim, act_dim, hidden)
+        self.agents = agents
+        self.pi = mlp(obs_dim + agents, act_dim, hidden)
         self.v = mlp(critic_dim, 1, hidden)
         self.log_std = nn.Parameter(torch.full((act_dim,), -0.5))
-        self.obs_norm = RunningNorm(obs_dim)
+        self.obs_norm = RunningNorm(obs_dim + agents)
         self.critic_norm = RunningNorm(critic_dim)
         with torch.no_grad():  # small initial actions: the policy starts near "stand still", not saturated
             self.pi[-1].weight.mul_(0.01)
             self.pi[-1].bias.zero_()
 
+    def actor_input(self, obs: np.ndarray, ids: np.ndarray | None = None) -> np.ndarray:
+        """What the actor reads for observations `obs` (..., N, obs_dim): the observations, and with
+        `agents` the one-hot of each row's agent appended. Rows along axis -2 are agents 0..N-1 unless
+        `ids` (their agent indices, shape (N,)) says otherwise (a PettingZoo dict of the live agents)."""
+        obs = np.asarray(obs, dtype=np.float32)
+        if not self.agents:
+            return obs
+        if ids is None:
+            if obs.ndim < 2 or obs.shape[-2] != self.agents:
+                raise ValueError(f"an actor of {self.agents} agents needs observations (..., {self.agents}, obs) "
+                                 f"or the agents' ids, got shape {obs.shape}")
+            ids = np.arange(self.agents)
+        ids = np.asarray(ids)
+        if ids.shape != obs.shape[-2:-1] or ids.min(initial=0) < 0 or ids.max(initial=0) >= self.agents:
+            raise ValueError(f"agent ids {ids.tolist()} for observations of shape {obs.shape}: one id in "
+                             f"0..{self.agents - 1} per row")
+        hot = np.broadcast_to(np.eye(self.agents, dtype=np.float32)[ids], (*obs.shape[:-1], self.agents))
+        return np.concatenate([obs, hot], axis=-1)
+
     def mean(self, obs: torch.Tensor) -> torch.Tensor:
-        """The Gaussian's mean for raw observations (normalised here)."""
+        """The Gaussian's mean for raw actor inputs (`actor_input`; normalised here)."""
         return self.pi(self.obs_norm(obs))
 
     def log_prob(self, obs: torch.Tensor, act: torch.Tensor, mu: torch.Tensor | None = None) -> torch.Tensor:
@@ -82,20 +105,35 @@ class ActorCritic(nn.Module):
         return self.v(self.critic_norm(critic_in)).squeeze(-1)
 
     @torch.no_grad()
-    def act(self, obs: np.ndarray) -> np.ndarray:
-        """Deterministic action (the mean, clipped to [-1, 1]) for observations of shape (..., obs_dim)."""
-        o = torch.from_numpy(np.array(obs, dtype=np.float32).reshape(-1, obs.shape[-1]))
+    def act(self, obs: np.ndarray, ids: np.ndarray | None = None) -> np.ndarray:
+        """Deterministic action (the mean, clipped to [-1, 1]) for observations of shape (..., obs_dim)
+        ((..., N, obs_dim) with `agents`, or `ids` given: see `actor_input`)."""
+        x = self.actor_input(obs, ids)
+        o = torch.from_numpy(np.array(x, dtype=np.float32).reshape(-1, x.shape[-1]))
         a = self.pi(self.obs_norm(o)).clamp(-1, 1)
-        return a.numpy().reshape(*obs.shape[:-1], -1).astype(np.float32)
+        return a.numpy().reshape(*x.shape[:-1], -1).astype(np.float32)
 
     @torch.no_grad()
-    def sample(self, obs: np.ndarray, generator: torch.Generator) -> np.ndarray:
+    def sample(self, obs: np.ndarray, generator: torch.Generator, ids: np.ndarray | None = None) -> np.ndarray:
         """Stochastic action, as in training: the mean plus Gaussian noise of sd `exp(log_std)` drawn
         from `generator`, unclipped (the env's action map clips it)."""
-        o = torch.from_numpy(np.array(obs, dtype=np.float32).reshape(-1, obs.shape[-1]))
+        x = self.actor_input(obs, ids)
+        o = torch.from_numpy(np.array(x, dtype=np.float32).reshape(-1, x.shape[-1]))
         mu = self.pi(self.obs_norm(o))
         a = mu + torch.exp(self.log_std) * torch.randn(mu.shape, generator=generator)
-        return a.numpy().reshape(*obs.shape[:-1], -1).astype(np.float32)
+        return a.numpy().reshape(*x.shape[:-1], -1).astype(np.float32)
+
+
+def load_model(path: str, obs_dim: int) -> ActorCritic:
+    """A saved `ActorCritic` (its `state_dict`), its sizes (critic input, actions, hidden units, agent
+    ids) read from the saved tensors; in evaluation mode."""
+    state = torch.load(path)
+    hidden, inputs = state["pi.0.weight"].shape
+    model = ActorCritic(obs_dim, state["v.0.weight"].shape[1], act_dim=state["log_std"].shape[0], hidden=hidden,
+                        agents=inputs - obs_dim)
+    model.load_state_dict(state)
+    model.eval()
+    return model
 
 
 def critic_input(obs: np.ndarray, state: np.ndarray, team: bool = False) -> np.ndarray:
@@ -131,6 +169,7 @@ class Config:
     ent_coef: float = 0.0
     hidden: int = 64
     anneal: int = 0  # with N > 0, the learning rate falls linearly to 0 over N updates (the budget)
+    agent_id: bool = False  # the actor also sees which agent it drives (a one-hot: ActorCritic's `agents`)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     start_forward: float = 0.0  # the untrained actor's mean for both wheels: > 0 drives forward, an exploration prior
     start_lay: float = 0.0  # the untrained actor's mean for the outputs after the wheels (deposit rates): < 0 lays rarely
@@ -165,7 +204,8 @@ class Trainer:
         self.e, self.n, self.d, self.b = e, n, d, e * n
         self.w = env.single_action_space.shape[0]
         self.c = critic_dim(env, cfg.team_critic)
-        self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden)
+        self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden, agents=n if cfg.agent_id else 0)
+        self.d_in = d + self.model.agents  # the actor's input: the observation (and the agent's one-hot)
         with torch.no_grad():
             self.model.pi[-1].bias[:2] = cfg.start_forward
             self.model.pi[-1].bias[2:] = cfg.start_lay
@@ -185,8 +225,8 @@ class Trainer:
 
     def iterate(self) -> float:
         """One rollout and one PPO update; returns the rollout's mean reward per agent-step."""
-        cfg, e, n, d, b, T = self.cfg, self.e, self.n, self.d, self.b, self.cfg.horizon
-        obs_buf = np.zeros((T, b, d), np.float32)
+        cfg, e, n, b, T = self.cfg, self.e, self.n, self.b, self.cfg.horizon
+        obs_buf = np.zeros((T, b, self.d_in), np.float32)
         cri_buf = np.zeros((T + 1, b, self.c), np.float32)
         act_buf = torch.zeros(T, b, self.w)
         logp_buf = torch.zeros(T, b)
@@ -196,7 +236,7 @@ class Trainer:
         model = self.model
         for t in range(T):
             t0 = time.perf_counter()
-            obs_buf[t] = self.obs.reshape(b, d)
+            obs_buf[t] = model.actor_input(self.obs).reshape(b, self.d_in)
             cri_buf[t] = critic_input(self.obs, self.state, self.cfg.team_critic)
             with torch.no_grad():
                 noise = torch.randn(b, self.w)

@@ -25,14 +25,13 @@ import time
 import tomllib
 
 import numpy as np
-import torch
 
 import colcos
 from colcos.baselines import Baseline
 from colcos.vector import VecEnv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from ppo import ActorCritic, episode_returns  # noqa: E402
+from ppo import episode_returns, load_model  # noqa: E402
 
 TWIN_LATENCY = 0.15
 RANDOMIZE = """
@@ -48,13 +47,6 @@ def twin_values(base: dict) -> dict:
     sensor = base["sensor"]
     cross = [[v if i == j else v + 0.1 for j, v in enumerate(row)] for i, row in enumerate(sensor["crosstalk"])]
     return {"tracker.latency": TWIN_LATENCY, "sensor.gain": 0.7 * sensor["gain"], "sensor.crosstalk": cross}
-
-
-def load(path: str, d: int, c: int) -> ActorCritic:
-    model = ActorCritic(d, c)
-    model.load_state_dict(torch.load(path))
-    model.eval()
-    return model
 
 
 def sim_returns(act, scenario: str, worlds: int, steps: int, seed: int) -> list[float]:
@@ -80,10 +72,11 @@ def twin_episode(env, make, seed: int) -> float:
 
 
 def stacked(act):
-    """A policy on stacked observations (agents, obs) as a `make(env)` for twin_episode."""
+    """A policy `act(obs, ids)` on stacked observations (agents, obs) and the agents' indices as a
+    `make(env)` for twin_episode."""
 
     def run(env, obs):
-        acts = act(np.stack([obs[a] for a in env.agents]))
+        acts = act(np.stack([obs[a] for a in env.agents]), np.array([env.possible_agents.index(a) for a in env.agents]))
         return {a: acts[i] for i, a in enumerate(env.agents)}
 
     return lambda _env: run
@@ -120,9 +113,8 @@ def main() -> None:
             subprocess.run([sys.executable, os.path.join(here, "train_aggregation.py"), "--minutes", str(args.minutes),
                             "--episode", str(args.episode), "--scenario", scen, "--out", out], check=True)
     v = VecEnv("aggregation", num_envs=1, max_cycles=args.episode)
-    d, n = v.single_observation_space.shape[0], v.num_agents
-    c = d + v.state_space.shape[0] + n
-    models = {name: load(os.path.join(args.out, name, "policy.pt"), d, c) for name in ("plain", "randomized")}
+    d = v.single_observation_space.shape[0]
+    models = {name: load_model(os.path.join(args.out, name, "policy.pt"), d) for name in ("plain", "randomized")}
     twin = twin_values(base)
     rows = []
     t0 = time.time()

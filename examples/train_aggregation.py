@@ -54,7 +54,8 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     """One training run: its evaluation curve (training seconds, updates, agent-steps, return)."""
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr,
-                     anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic)
+                     anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
+                     agent_id=args.agent_id)
     trainer = ppo.Trainer(env, cfg, seed)
     evaluate = lambda: round(ppo.evaluate(lambda v: trainer.model.act, env_kwargs, args.eval_worlds, args.episode, args.eval_seed), 2)
     curve: list[tuple[float, int, int, float]] = [(0.0, 0, 0, evaluate())]
@@ -136,6 +137,8 @@ def main() -> None:
     p.add_argument("--lr", type=float, default=1e-3)
     p.add_argument("--anneal", action="store_true", help="the learning rate falls linearly to 0 over --updates")
     p.add_argument("--team-critic", action="store_true", help="the critic also sees every follower's observation")
+    p.add_argument("--agent-id", action="store_true",
+                   help="the actor also sees which follower it drives (a one-hot): one policy, each robot its own way")
     p.add_argument("--episode", type=int, default=500, help="steps per episode (10 s)")
     p.add_argument("--threads", type=int, default=None, help="env worker threads (default: one per core)")
     p.add_argument("--eval-worlds", type=int, default=32)

@@ -35,7 +35,8 @@ from colcos.baselines import Baseline
 from colcos.vector import VecEnv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from sim_to_real_policies import load, sim_returns, stacked, twin_episode  # noqa: E402
+from sim_to_real_policies import sim_returns, stacked, twin_episode  # noqa: E402
+from ppo import load_model  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "data", "transfer")
@@ -85,6 +86,7 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     budget = ["--updates", str(args.updates)] if args.updates else ["--minutes", str(args.minutes)]
     threads = ["--threads", str(args.threads)] if args.threads else []
     anneal = ["--anneal"] if args.anneal and args.updates else []
+    anneal += ["--agent-id"] if args.agent_id else []
     for seed in args.seeds:
         for name in VARIANTS:
             d = os.path.join(args.out, f"{name}-s{seed}")
@@ -104,12 +106,11 @@ def hand_written(env):
 def policies(out: str, seeds: list[int], episode: int) -> dict:
     """Every policy as (simulator act factory, twin act): PPO per variant and seed, references."""
     v = VecEnv("aggregation", num_envs=1, max_cycles=episode)
-    d, n = v.single_observation_space.shape[0], v.num_agents
-    c = d + v.state_space.shape[0] + n
+    d = v.single_observation_space.shape[0]
     table: dict = {}
     for seed in seeds:
         for name in VARIANTS:
-            model = load(os.path.join(out, f"{name}-s{seed}", "policy.pt"), d, c)
+            model = load_model(os.path.join(out, f"{name}-s{seed}", "policy.pt"), d)
             table[f"{name}-s{seed}"] = (lambda _v, m=model: m.act, stacked(model.act))
     table["hand-written"] = (lambda v: Baseline(v, "aggregation_follower").act,
                              hand_written)
@@ -220,6 +221,8 @@ def main() -> None:
     p.add_argument("--twin-episodes", type=int, default=8)
     p.add_argument("--fit", default=os.path.join(DATA, "fit.toml"))
     p.add_argument("--truth", default=os.path.join(DATA, "truth.toml"))
+    p.add_argument("--agent-id", action="store_true",
+                   help="each policy's actor also sees which follower it drives (train_aggregation.py --agent-id)")
     p.add_argument("--train-only", action="store_true")
     p.add_argument("--out", default="runs/transfer")
     args = p.parse_args()

@@ -104,3 +104,35 @@ def test_quickstart_refuses_a_bad_param(tmp_path):
                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert res.returncode == 2
     assert "--param 'progress_weight': expected KEY=VALUE" in res.stderr
+
+
+def test_an_agent_id_actor_tells_its_agents_apart_and_loads_back(tmp_path):
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=20, num_threads=1)
+    trainer = ppo.Trainer(env, ppo.Config(horizon=4, epochs=1, minibatches=1, agent_id=True), seed=0)
+    trainer.iterate()
+    model, n = trainer.model, env.num_agents
+    assert model.agents == n and model.pi[0].in_features == 17 + n
+    with torch.no_grad():  # a first layer that reads only the one-hot: the agents' actions differ
+        model.pi[0].weight[:, :17] = 0.0
+        model.pi[-1].weight.normal_()
+    obs = np.repeat(np.random.default_rng(1).normal(size=(2, 1, 17)).astype(np.float32), n, axis=1)
+    act = model.act(obs)
+    assert act.shape == (2, n, 2)
+    assert not np.allclose(act[:, 0], act[:, 1]) and not np.allclose(act[:, 1], act[:, 2])
+    # A PettingZoo dict of some agents, in another order: the ids name each row's agent.
+    np.testing.assert_allclose(model.act(obs[0, [2, 0]], ids=np.array([2, 0])), act[0, [2, 0]], rtol=1e-6)
+    with pytest.raises(ValueError, match=r"an actor of 3 agents needs observations \(\.\.\., 3, obs\)"):
+        model.act(obs[:, :2])
+    with pytest.raises(ValueError, match=r"agent ids \[0, 3\]"):
+        model.act(obs[0, :2], ids=np.array([0, 3]))
+    torch.save(model.state_dict(), tmp_path / "policy.pt")
+    loaded = ppo.load_model(str(tmp_path / "policy.pt"), 17)
+    assert (loaded.agents, loaded.pi[-1].out_features) == (n, 2)
+    np.testing.assert_array_equal(loaded.act(obs), act)
+    plain = ppo.Trainer(env, ppo.Config(horizon=4), seed=0).model
+    torch.save(plain.state_dict(), tmp_path / "plain.pt")
+    assert ppo.load_model(str(tmp_path / "plain.pt"), 17).agents == 0

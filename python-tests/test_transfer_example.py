@@ -1,0 +1,32 @@
+"""`examples/transfer.py` end to end on a tiny budget: the three trainings with actors that see their
+agent's id, the simulator's columns and one short episode on the in-process twin for every policy."""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+
+
+def test_tiny_transfer_study_with_agent_ids(tmp_path):
+    pytest.importorskip("torch")
+    args = ["--updates", "1", "--seeds", "0", "--agent-id", "--episode", "20", "--eval-worlds", "2",
+            "--twin-episodes", "1", "--threads", "1", "--out", str(tmp_path)]
+    out = subprocess.run([sys.executable, str(REPO / "examples" / "transfer.py"), *args],
+                         capture_output=True, text=True, timeout=900, check=True).stdout
+    assert "| identified-s0 |" in out and "| standing still |" in out
+    result = json.loads((tmp_path / "result.json").read_text())
+    returns = result["returns"]
+    assert set(returns) == {"nominal-s0", "generic-s0", "identified-s0", "hand-written", "standing still"}
+    for policy, cols in returns.items():
+        assert len(cols["sim_nominal"]) == len(cols["sim_truth"]) == 2, policy
+        assert len(cols["twin"]) == 1, policy
+    for variant in ("nominal", "generic", "identified"):
+        trained = result["trained"][f"{variant}-s0"]
+        assert trained["runs"][0]["updates"] == 1
+        assert "--agent-id" in trained["command"]
