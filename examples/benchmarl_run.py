@@ -1,7 +1,7 @@
 """Train a BenchMARL algorithm on a colcos task, then compare it with the task's hand-written policy
 and random actions on the same measure (mean over agents and episodes of an agent's episode return).
 
-    python examples/benchmarl_run.py --algorithm mappo --task aggregation --frames 600000 --seeds 0 1 2
+    python examples/benchmarl_run.py --algorithm mappo --task aggregation --seeds 0 1 2
     python examples/benchmarl_run.py --algorithm qmix --task aggregation --discrete --frames 300000
     python examples/benchmarl_run.py --algorithm masac --task colony --tiny          # one small iteration
 
@@ -9,6 +9,12 @@ Algorithms: BenchMARL's (`mappo`, `ippo`, `masac`, `isac`, `maddpg`, `iddpg`, `q
 ...); tasks: `colcos.tasks()`. Each run writes BenchMARL's own outputs (CSV logs, marl-eval JSON,
 checkpoints) under `--out`, and `summary.json` there with every run's final evaluation return, its
 wall time and the references. Needs `benchmarl` (python-tests/requirements-benchmarl.txt).
+
+On-policy algorithms (`mappo`, `ippo`) train with the settings of colcos's own PPO
+(`examples/ppo.py`) unless `--benchmarl-defaults`: batches of `--horizon` 64 steps of every world,
+4 passes of 4 minibatches over each, learning rate 1e-3, gamma 0.98, GAE lambda 0.95, gradients
+clipped at norm 0.5. BenchMARL's defaults (batches of 6,000 frames, 45 passes of 400-frame minibatches,
+learning rate 5e-5) are made for GPU-sized batches: on two cores they learn little in an hour.
 """
 
 from __future__ import annotations
@@ -39,6 +45,7 @@ from colcos.baselines import Baseline, RandomPolicy
 from colcos.benchmarl import task as benchmarl_task
 from colcos.vector import VecEnv
 
+ON_POLICY = ("mappo", "ippo")
 ALGORITHMS: dict[str, Any] = {
     "mappo": MappoConfig,
     "ippo": IppoConfig,
@@ -84,13 +91,20 @@ def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> Experiment
     cfg.checkpoint_at_end = False
     cfg.checkpoint_interval = 0
     cfg.prefer_continuous_actions = not args.discrete
-    if args.lr is not None:
-        cfg.lr = args.lr
     cfg.evaluation_episodes = args.eval_episodes
     # colcos steps all worlds of a batch in Rust: large batches of worlds, one collector.
     cfg.on_policy_n_envs_per_worker = cfg.off_policy_n_envs_per_worker = args.worlds
     cfg.on_policy_collected_frames_per_batch = cfg.off_policy_collected_frames_per_batch = args.worlds * args.max_steps
-    cfg.evaluation_interval = cfg.on_policy_collected_frames_per_batch * args.eval_every
+    if ppo_settings(args):
+        # examples/ppo.py's: short rollouts of every world, a few passes of a few minibatches each.
+        cfg.on_policy_collected_frames_per_batch = args.worlds * args.horizon
+        cfg.on_policy_n_minibatch_iters = 4
+        cfg.on_policy_minibatch_size = max(1, cfg.on_policy_collected_frames_per_batch // 4)
+        cfg.lr, cfg.gamma, cfg.clip_grad_norm, cfg.clip_grad_val = 1e-3, 0.98, True, 0.5
+    if args.lr is not None:
+        cfg.lr = args.lr
+    batch = cfg.on_policy_collected_frames_per_batch if args.algorithm in ON_POLICY else cfg.off_policy_collected_frames_per_batch
+    cfg.evaluation_interval = batch * args.eval_every
     if args.tiny:
         cfg.max_n_iters = 1
         cfg.max_n_frames = cfg.on_policy_collected_frames_per_batch
@@ -103,10 +117,17 @@ def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> Experiment
     return cfg
 
 
+def ppo_settings(args: argparse.Namespace) -> bool:
+    """Whether this run takes examples/ppo.py's settings instead of BenchMARL's defaults."""
+    return args.algorithm in ON_POLICY and not args.benchmarl_defaults and not args.tiny
+
+
 def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any]:
     task = benchmarl_task(args.task)
     task.config["max_steps"] = args.max_steps
     algorithm = ALGORITHMS[args.algorithm].get_from_yaml()
+    if ppo_settings(args):
+        algorithm.lmbda = 0.95
     t0 = time.time()
     experiment = Experiment(
         task=task,
@@ -134,10 +155,16 @@ def main() -> None:
     p.add_argument("--algorithm", default="mappo", help=f"one of {sorted(ALGORITHMS)}")
     p.add_argument("--task", default="aggregation", help="a colcos task (colcos.tasks())")
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
-    p.add_argument("--frames", type=int, default=600_000, help="agent-world steps of training (BenchMARL's frames)")
+    p.add_argument("--frames", type=int, default=None,
+                   help="world steps of training (BenchMARL's frames; default 1,474,560 = 720 batches of 32 x 64 with the "
+                        "PPO settings, as the quick start's 720 updates, else 600,000)")
     p.add_argument("--worlds", type=int, default=32, help="worlds stepped as one batch")
     p.add_argument("--max-steps", type=int, default=500, help="steps per episode")
-    p.add_argument("--eval-every", type=int, default=5, help="evaluate every this many collected batches")
+    p.add_argument("--horizon", type=int, default=64, help="steps of every world per collected batch (PPO settings)")
+    p.add_argument("--benchmarl-defaults", action="store_true",
+                   help="on-policy algorithms keep BenchMARL's own batch, passes and learning rate")
+    p.add_argument("--eval-every", type=int, default=None,
+                   help="evaluate every this many collected batches (default 60 with the PPO settings, else 5)")
     p.add_argument("--eval-episodes", type=int, default=8)
     p.add_argument("--discrete", action="store_true", help="the discrete action variant (continuous=False)")
     p.add_argument("--tiny", action="store_true", help="one small iteration (a check that it runs)")
@@ -151,6 +178,12 @@ def main() -> None:
         p.error(f"--task {args.task!r}: one of {sorted(colcos.tasks())}")
     if args.tiny:
         args.worlds, args.max_steps, args.eval_episodes = 2, 20, 1
+    if args.horizon < 1:
+        p.error(f"--horizon {args.horizon}: at least 1")
+    if args.frames is None:
+        args.frames = 720 * args.worlds * args.horizon if ppo_settings(args) else 600_000
+    if args.eval_every is None:
+        args.eval_every = 60 if ppo_settings(args) else 5
     torch.set_num_threads(args.threads)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -162,7 +195,9 @@ def main() -> None:
         refs[name] = episode_return(args.task, lambda v: Baseline(v, name).act, args.max_steps, episodes, 12345)
     refs["random"] = episode_return(args.task, lambda v: RandomPolicy(v, seed=1).act, args.max_steps, episodes, 12345)
     finals = [r["final_return"] for r in runs if r["final_return"] is not None]
-    summary = {"algorithm": args.algorithm, "task": args.task, "continuous": not args.discrete, "runs": runs, "references": refs}
+    summary = {"algorithm": args.algorithm, "task": args.task, "continuous": not args.discrete,
+               "settings": "examples/ppo.py" if ppo_settings(args) else "BenchMARL defaults",
+               "frames": args.frames, "runs": runs, "references": refs}
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     print(f"{args.algorithm} on {args.task} ({'discrete' if args.discrete else 'continuous'}), {args.frames} frames:")
     for r in runs:
