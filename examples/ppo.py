@@ -170,6 +170,7 @@ class Config:
     hidden: int = 64
     anneal: int = 0  # with N > 0, the learning rate falls linearly to 0 over N updates (the budget)
     agent_id: bool = False  # the actor also sees which agent it drives (a one-hot: ActorCritic's `agents`)
+    actor_warmup: int = 0  # the first N updates train only the critic (an actor that starts good, e.g. kickstarted, keeps still)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     start_forward: float = 0.0  # the untrained actor's mean for both wheels: > 0 drives forward, an exploration prior
     start_lay: float = 0.0  # the untrained actor's mean for the outputs after the wheels (deposit rates): < 0 lays rarely
@@ -307,6 +308,8 @@ class Trainer:
                 vloss = 0.5 * (model.value(fc[idx]) - fret[idx]).pow(2).mean()
                 # The Gaussian's entropy is sum(log_std) + const: the same for every sample.
                 loss = pg + 0.5 * vloss - cfg.ent_coef * model.log_std.sum()
+                if self.updates < cfg.actor_warmup:
+                    loss = 0.5 * vloss
                 if cfg.listen_bias:
                     loss = loss - cfg.listen_bias * listening(model, fo[idx], mu, cfg.message_inputs)
                 if cfg.signal_bias:

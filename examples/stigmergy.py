@@ -54,6 +54,7 @@ from colcos.vector import VecEnv
 from torch import nn
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import kickstart
 import ppo
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "tasks"))
@@ -134,8 +135,11 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
                      start_forward=args.start_forward, start_lay=args.start_lay,
                      # The communication biases act on a message: the arm that lays none has none to hear.
                      listen_bias=args.listen_bias if lay else 0.0, signal_bias=args.signal_bias if lay else 0.0,
-                     message_inputs=message_inputs(task, args))
+                     message_inputs=message_inputs(task, args), actor_warmup=args.actor_warmup)
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
+    kicked: dict = {}
+    if args.kickstart:
+        kicked = kickstart_actor(trainer.model, task, lay, seed, args)
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
     start = time.time()
@@ -150,8 +154,30 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
                   f"last episodes {episode_curve[-1][1] if episode_curve else float('nan'):.2f}, "
                   f"{time.time() - start:.0f} s", flush=True)
     log = {"updates": updates, "agent_steps": trainer.agent_steps, "train_seconds": round(time.time() - start, 1),
-           "rate_curve": rate_curve, "episode_curve": episode_curve}
+           "rate_curve": rate_curve, "episode_curve": episode_curve, **kicked}
     return trainer.model, log
+
+
+def teacher(task: str):
+    """The task's hand-written policy as `make(env)` -> (observations -> actions)."""
+    if task in PYTHON_TASKS:
+        return lambda v: PYTHON_TASKS[task][1](seed=1).act
+    name = {t: p for p, (t, _) in colcos.task_policies().items()}[task]
+    return lambda v: Baseline(v, name).act
+
+
+def kickstart_actor(model: nn.Module, task: str, lay: bool, seed: int, args: argparse.Namespace) -> dict:
+    """`--kickstart`: the actor imitates the task's hand-written policy, acting in worlds of this arm
+    (without pheromone actions its trails are never laid), before PPO; the imitation's error and the
+    kickstarted policy's evaluation, for the run's record."""
+    t0 = time.time()
+    env_kwargs = {"max_cycles": episode_steps(task, args), "num_threads": args.threads, **task_kwargs(task, args, training=True)}
+    obs, acts = kickstart.demonstrations(teacher(task), env_kwargs, args.num_envs, args.kickstart, seed + 1000,
+                                         lambda a: to_env(a, lay))
+    space = VecEnv(num_envs=1, max_cycles=2, **task_kwargs(task, args, training=True)).single_action_space
+    losses = kickstart.imitate(model, obs, acts, space.low, space.high, std=args.kickstart_std, seed=seed)
+    return {"kickstart_mse": [round(v, 5) for v in losses], "kickstart_seconds": round(time.time() - t0, 1),
+            "eval_kickstart": evaluate(task, acting(model, lay, args), args)}
 
 
 def evaluate(task: str, act, args: argparse.Namespace) -> list[float]:
@@ -232,7 +258,8 @@ def config(args: argparse.Namespace, mode: str = "with") -> dict:
     actions trains without the communication biases (`train`), so it records them as 0: one such run
     serves studies with any biases."""
     keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "anneal", "team_critic", "start_forward", "start_lay",
-            "listen_bias", "signal_bias", "param", "shaping", "scenario", "eval_worlds", "eval_seed", "eval_policy")
+            "listen_bias", "signal_bias", "param", "shaping", "scenario", "eval_worlds", "eval_seed", "eval_policy",
+            "kickstart", "kickstart_std", "actor_warmup")
     out = {k: getattr(args, k) for k in keys}
     if mode == "without":
         out["listen_bias"] = out["signal_bias"] = 0.0
@@ -382,8 +409,17 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--signal-bias", type=float, default=0.0, metavar="W",
                    help="weight of a loss term rewarding a call that depends on what the caller senses (the arm with "
                         "pheromone actions; ppo.Config.signal_bias)")
+    p.add_argument("--kickstart", type=int, default=0, metavar="STEPS",
+                   help="before PPO the actor imitates the task's hand-written policy over STEPS agent-steps of it acting "
+                        "(in the arm's own worlds: without pheromone actions nothing it lays is laid); 0: off")
+    p.add_argument("--kickstart-std", type=float, default=0.2, help="the kickstarted actor's noise (sd of its Gaussian)")
+    p.add_argument("--actor-warmup", type=int, default=0, metavar="N",
+                   help="the first N PPO updates train only the critic (for a kickstarted actor)")
     p.add_argument("--scenario", default=None, help="scenario file instead of the task's own (training and evaluation)")
     args = p.parse_args(argv)
+    if args.kickstart < 0 or args.actor_warmup < 0 or not args.kickstart_std > 0:
+        p.error(f"--kickstart ({args.kickstart}) and --actor-warmup ({args.actor_warmup}) must be at least 0, "
+                f"--kickstart-std ({args.kickstart_std}) above 0")
     args.defaults = {k: p.get_default(k) for k in vars(args)} | {"param": {}, "shaping": {}}
     for name in ("param", "shaping"):
         setattr(args, name, dict(parse_param(p, f"--{name}", kv) for kv in getattr(args, name)))
