@@ -16,10 +16,9 @@ import math
 from collections.abc import Callable
 
 import numpy as np
+import ppo
 import torch
 from colcos.vector import VecEnv
-
-import ppo
 
 
 def demonstrations(teacher: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict, worlds: int,
