@@ -56,7 +56,7 @@ def imitate(model: ppo.ActorCritic, obs: np.ndarray, actions: np.ndarray, low: n
             opt.zero_grad()
             loss.backward()
             opt.step()
-            total += float(loss) * len(idx)
+            total += float(loss.detach()) * len(idx)
         losses.append(total / len(x))
     with torch.no_grad():
         model.log_std.fill_(math.log(std))

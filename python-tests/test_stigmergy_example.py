@@ -8,6 +8,7 @@ import pathlib
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
@@ -63,3 +64,35 @@ def test_a_bad_task_parameter_is_refused_by_name(tmp_path):
     assert run.returncode != 0 and "colony.bogus" in run.stderr, run.stderr[-2000:]
     run = _study(tmp_path, "--tasks", "colony", "--param", "no_equals_sign")
     assert run.returncode != 0 and "--param 'no_equals_sign': expected KEY=VALUE" in run.stderr, run.stderr[-2000:]
+
+
+def test_a_kickstarted_study_imitates_the_hand_written_policy_first(tmp_path):
+    pytest.importorskip("torch")
+    run = _study(tmp_path, "--tasks", "colony", "--kickstart", "6000", "--actor-warmup", "1")
+    assert run.returncode == 0, run.stderr[-2000:]
+    for mode in ("with", "without"):
+        saved = json.loads((tmp_path / "colony" / f"{mode}_seed0.json").read_text())
+        assert saved["config"]["kickstart"] == 6000 and saved["config"]["actor_warmup"] == 1
+        mse = saved["kickstart_mse"]
+        assert len(mse) == 20 and mse[-1] < 0.5 * mse[0], mse  # the actor learns the teacher's actions
+        assert len(saved["eval_kickstart"]) == 2
+    bad = _study(tmp_path / "bad", "--tasks", "colony", "--kickstart", "-1")
+    assert bad.returncode == 2 and "--kickstart (-1)" in bad.stderr, bad.stderr[-2000:]
+
+
+def test_imitation_fits_a_teacher_and_sets_the_noise():
+    torch = pytest.importorskip("torch")
+    sys.path.insert(0, str(REPO / "examples"))
+    from example_modules import load_ppo
+
+    load_ppo()
+    import kickstart
+
+    rng = np.random.default_rng(0)
+    obs = rng.normal(2.0, 3.0, size=(4000, 5)).astype(np.float32)
+    teacher = np.tanh(obs @ rng.normal(size=(5, 2)) / 3.0).astype(np.float32)  # a smooth policy in the box
+    model = sys.modules["ppo"].ActorCritic(5, 4, act_dim=2)
+    losses = kickstart.imitate(model, obs, teacher, np.array([-1.0, -1.0]), np.array([1.0, 1.0]), epochs=30, minibatch=256, std=0.3)
+    assert losses[-1] < 0.05 * losses[0], losses
+    assert torch.allclose(model.log_std.exp(), torch.tensor(0.3))
+    assert np.abs(model.act(obs) - teacher).mean() < 0.1
