@@ -1,7 +1,7 @@
 """Train a BenchMARL algorithm on a colcos task, then compare it with the task's hand-written policy
 and random actions on the same measure (mean over agents and episodes of an agent's episode return).
 
-    python examples/benchmarl_run.py --algorithm mappo --task aggregation --seeds 0 1 2
+    python examples/benchmarl_run.py --algorithm mappo --task aggregation --frames 600000 --seeds 0 1 2
     python examples/benchmarl_run.py --algorithm qmix --task aggregation --discrete --frames 300000
     python examples/benchmarl_run.py --algorithm masac --task colony --tiny          # one small iteration
 
@@ -10,11 +10,10 @@ Algorithms: BenchMARL's (`mappo`, `ippo`, `masac`, `isac`, `maddpg`, `iddpg`, `q
 checkpoints) under `--out`, and `summary.json` there with every run's final evaluation return, its
 wall time and the references. Needs `benchmarl` (python-tests/requirements-benchmarl.txt).
 
-On-policy algorithms (`mappo`, `ippo`) train with the settings of colcos's own PPO
-(`examples/ppo.py`) unless `--benchmarl-defaults`: batches of `--horizon` 64 steps of every world,
-4 passes of 4 minibatches over each, learning rate 1e-3, gamma 0.98, GAE lambda 0.95, gradients
-clipped at norm 0.5. BenchMARL's defaults (batches of 6,000 frames, 45 passes of 400-frame minibatches,
-learning rate 5e-5) are made for GPU-sized batches: on two cores they learn little in an hour.
+`--ppo-settings` trains the on-policy algorithms (`mappo`, `ippo`) with the settings of colcos's own
+PPO (`examples/ppo.py`) instead of BenchMARL's defaults: batches of `--horizon` 64 steps of every
+world, 4 passes of 4 minibatches over each, learning rate 1e-3, gamma 0.98, GAE lambda 0.95,
+gradients clipped at 0.5 (docs/training.md: on `aggregation` MAPPO learned no better with them).
 """
 
 from __future__ import annotations
@@ -119,7 +118,7 @@ def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> Experiment
 
 def ppo_settings(args: argparse.Namespace) -> bool:
     """Whether this run takes examples/ppo.py's settings instead of BenchMARL's defaults."""
-    return args.algorithm in ON_POLICY and not args.benchmarl_defaults and not args.tiny
+    return args.algorithm in ON_POLICY and args.ppo_settings and not args.tiny
 
 
 def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any]:
@@ -161,8 +160,8 @@ def main() -> None:
     p.add_argument("--worlds", type=int, default=32, help="worlds stepped as one batch")
     p.add_argument("--max-steps", type=int, default=500, help="steps per episode")
     p.add_argument("--horizon", type=int, default=64, help="steps of every world per collected batch (PPO settings)")
-    p.add_argument("--benchmarl-defaults", action="store_true",
-                   help="on-policy algorithms keep BenchMARL's own batch, passes and learning rate")
+    p.add_argument("--ppo-settings", action="store_true",
+                   help="on-policy algorithms train with examples/ppo.py's batch, passes and learning rate, not BenchMARL's")
     p.add_argument("--eval-every", type=int, default=None,
                    help="evaluate every this many collected batches (default 60 with the PPO settings, else 5)")
     p.add_argument("--eval-episodes", type=int, default=8)

@@ -79,20 +79,20 @@ def _example():
     return module
 
 
-def test_on_policy_runs_take_the_ppo_settings_unless_told_otherwise(tmp_path):
+def test_ppo_settings_replace_benchmarls_defaults_for_on_policy_runs(tmp_path):
     import argparse
 
     example = _example()
     args = argparse.Namespace(algorithm="mappo", frames=100_000, discrete=False, lr=None, eval_episodes=8, worlds=32,
-                              max_steps=500, tiny=False, horizon=64, benchmarl_defaults=False, eval_every=60)
+                              max_steps=500, tiny=False, horizon=64, ppo_settings=False, eval_every=5)
+    own = example.experiment_config(args, tmp_path)
+    assert (own.on_policy_collected_frames_per_batch, own.on_policy_n_minibatch_iters, own.lr) == (32 * 500, 45, 5e-5)
+    args.ppo_settings, args.eval_every = True, 60
     cfg = example.experiment_config(args, tmp_path)
     assert (cfg.on_policy_collected_frames_per_batch, cfg.on_policy_n_minibatch_iters, cfg.on_policy_minibatch_size) == (2048, 4, 512)
     assert (cfg.lr, cfg.gamma, cfg.clip_grad_val) == (1e-3, 0.98, 0.5)
     assert cfg.evaluation_interval == 60 * 2048
     args.lr = 3e-4
     assert example.experiment_config(args, tmp_path).lr == 3e-4
-    args.lr, args.benchmarl_defaults = None, True
-    own = example.experiment_config(args, tmp_path)
-    assert (own.on_policy_collected_frames_per_batch, own.on_policy_n_minibatch_iters, own.lr) == (32 * 500, 45, 5e-5)
-    args.benchmarl_defaults, args.algorithm = False, "masac"  # off-policy: BenchMARL's own settings
+    args.lr, args.algorithm = None, "masac"  # off-policy: BenchMARL's own settings
     assert not example.ppo_settings(args) and example.experiment_config(args, tmp_path).lr == 5e-5
