@@ -55,18 +55,21 @@ def mlp(i: int, o: int, hidden: int) -> nn.Sequential:
 class ActorCritic(nn.Module):
     """Gaussian actor on the agent's own observation; critic on observation + global state + agent id.
 
-    With `agents` = N > 0 the actor also sees which of the N agents it drives (a one-hot appended to
-    the observation, `actor_input`): one network, but free to drive robots that differ (wheels, lags,
-    sensor gains) each in its own way. `pi`, `obs_norm` and `log_std` are what a robot runs
-    (`onboard_export.py` reads them by name; it takes only actors of the 17 observation entries)."""
+    With `history` = k > 1 the actor reads the agent's last k observations, oldest first (a `Memory`
+    stacks them: `policy()` gives an acting function that keeps one). With `agents` = N > 0 it also
+    sees which of the N agents it drives (a one-hot appended, `actor_input`): one network, but free to
+    drive robots that differ (wheels, lags, sensor gains) each in its own way. `pi`, `obs_norm` and
+    `log_std` are what a robot runs (`onboard_export.py` reads them by name; it takes only actors of
+    the 17 observation entries)."""
 
-    def __init__(self, obs_dim: int, critic_dim: int, act_dim: int = 2, hidden: int = 64, agents: int = 0) -> None:
+    def __init__(self, obs_dim: int, critic_dim: int, act_dim: int = 2, hidden: int = 64, agents: int = 0,
+                 history: int = 1) -> None:  # fmt: skip
         super().__init__()
-        self.agents = agents
-        self.pi = mlp(obs_dim + agents, act_dim, hidden)
+        self.agents, self.history = agents, history
+        self.pi = mlp(obs_dim * history + agents, act_dim, hidden)
         self.v = mlp(critic_dim, 1, hidden)
         self.log_std = nn.Parameter(torch.full((act_dim,), -0.5))
-        self.obs_norm = RunningNorm(obs_dim + agents)
+        self.obs_norm = RunningNorm(obs_dim * history + agents)
         self.critic_norm = RunningNorm(critic_dim)
         with torch.no_grad():  # small initial actions: the policy starts near "stand still", not saturated
             self.pi[-1].weight.mul_(0.01)
@@ -104,10 +107,19 @@ class ActorCritic(nn.Module):
     def value(self, critic_in: torch.Tensor) -> torch.Tensor:
         return self.v(self.critic_norm(critic_in)).squeeze(-1)
 
+    def policy(self) -> Callable[..., np.ndarray]:
+        """`act` for a stream of observations (one episode, or one per world of a batch): with a
+        `history`, each call's observations join the last ones in a fresh `Memory`."""
+        if self.history == 1:
+            return self.act
+        memory = Memory(self.history)
+        return lambda obs, ids=None: self.act(memory.push(obs), ids)
+
     @torch.no_grad()
     def act(self, obs: np.ndarray, ids: np.ndarray | None = None) -> np.ndarray:
         """Deterministic action (the mean, clipped to [-1, 1]) for observations of shape (..., obs_dim)
-        ((..., N, obs_dim) with `agents`, or `ids` given: see `actor_input`)."""
+        ((..., N, obs_dim) with `agents`, or `ids` given: see `actor_input`; with a `history`, stacked
+        observations: see `policy`)."""
         x = self.actor_input(obs, ids)
         o = torch.from_numpy(np.array(x, dtype=np.float32).reshape(-1, x.shape[-1]))
         a = self.pi(self.obs_norm(o)).clamp(-1, 1)
@@ -124,13 +136,37 @@ class ActorCritic(nn.Module):
         return a.numpy().reshape(*x.shape[:-1], -1).astype(np.float32)
 
 
-def load_model(path: str, obs_dim: int) -> ActorCritic:
-    """A saved `ActorCritic` (its `state_dict`), its sizes (critic input, actions, hidden units, agent
-    ids) read from the saved tensors; in evaluation mode."""
+class Memory:
+    """The last `history` observations of every row, oldest first, flattened: what an actor with a
+    history reads. A row's first observation (or one marked `fresh`: the first of a new episode)
+    fills its whole history."""
+
+    def __init__(self, history: int) -> None:
+        self.history = history
+        self.stack: np.ndarray | None = None
+
+    def push(self, obs: np.ndarray, fresh: np.ndarray | None = None) -> np.ndarray:
+        """Adds `obs` (..., obs_dim); returns (..., history * obs_dim). `fresh`: a mask over the rows
+        (obs.shape[:-1]) that start again."""
+        obs = np.asarray(obs, dtype=np.float32)
+        if self.history == 1:
+            return obs
+        if self.stack is None or self.stack.shape[:-2] != obs.shape[:-1]:
+            self.stack = np.repeat(obs[..., None, :], self.history, axis=-2)
+        else:
+            self.stack = np.concatenate([self.stack[..., 1:, :], obs[..., None, :]], axis=-2)
+            if fresh is not None and fresh.any():
+                self.stack[fresh] = obs[fresh][..., None, :]
+        return self.stack.reshape(*obs.shape[:-1], -1)
+
+
+def load_model(path: str, obs_dim: int, history: int = 1) -> ActorCritic:
+    """A saved `ActorCritic` (its `state_dict`) of actors with `history`; its sizes (critic input,
+    actions, hidden units, agent ids) read from the saved tensors; in evaluation mode."""
     state = torch.load(path)
     hidden, inputs = state["pi.0.weight"].shape
     model = ActorCritic(obs_dim, state["v.0.weight"].shape[1], act_dim=state["log_std"].shape[0], hidden=hidden,
-                        agents=inputs - obs_dim)
+                        agents=inputs - obs_dim * history, history=history)
     model.load_state_dict(state)
     model.eval()
     return model
@@ -170,6 +206,7 @@ class Config:
     hidden: int = 64
     anneal: int = 0  # with N > 0, the learning rate falls linearly to 0 over N updates (the budget)
     agent_id: bool = False  # the actor also sees which agent it drives (a one-hot: ActorCritic's `agents`)
+    history: int = 1  # the actor reads the last `history` observations (ActorCritic's `history`)
     actor_warmup: int = 0  # the first N updates train only the critic (an actor that starts good, e.g. kickstarted, keeps still)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     start_forward: float = 0.0  # the untrained actor's mean for both wheels: > 0 drives forward, an exploration prior
@@ -205,8 +242,11 @@ class Trainer:
         self.e, self.n, self.d, self.b = e, n, d, e * n
         self.w = env.single_action_space.shape[0]
         self.c = critic_dim(env, cfg.team_critic)
-        self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden, agents=n if cfg.agent_id else 0)
-        self.d_in = d + self.model.agents  # the actor's input: the observation (and the agent's one-hot)
+        self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden, agents=n if cfg.agent_id else 0,
+                                 history=cfg.history)
+        # The actor's input: the observations it remembers (and the agent's one-hot).
+        self.d_in = d * cfg.history + self.model.agents
+        self.memory = Memory(cfg.history)
         with torch.no_grad():
             self.model.pi[-1].bias[:2] = cfg.start_forward
             self.model.pi[-1].bias[2:] = cfg.start_lay
@@ -217,6 +257,7 @@ class Trainer:
         self.disc_ret = np.zeros(self.b)
         obs, infos = env.reset(seed=seed)
         self.obs, self.state = obs, infos["state"]
+        self.view = self.memory.push(obs)  # what the actor reads
         self.prev_done = np.zeros(self.b, dtype=bool)
         self.ep_return = np.zeros(self.b)
         self.finished: list[float] = []  # returns of the training episodes, in the order they ended
@@ -237,7 +278,7 @@ class Trainer:
         model = self.model
         for t in range(T):
             t0 = time.perf_counter()
-            obs_buf[t] = model.actor_input(self.obs).reshape(b, self.d_in)
+            obs_buf[t] = model.actor_input(self.view).reshape(b, self.d_in)
             cri_buf[t] = critic_input(self.obs, self.state, self.cfg.team_critic)
             with torch.no_grad():
                 noise = torch.randn(b, self.w)
@@ -246,6 +287,8 @@ class Trainer:
             action = self.to_env(act_buf[t].numpy().reshape(e, n, self.w))
             t1 = time.perf_counter()
             self.obs, rew, term, trunc, infos = self.env.step(action)
+            # A step after a done one reset its world: that row's history starts again.
+            self.view = self.memory.push(self.obs, fresh=self.prev_done.reshape(e, n))
             self.seconds["env"] += time.perf_counter() - t1
             self.seconds["act"] += t1 - t0
             self.state = infos["state"]

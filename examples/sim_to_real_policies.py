@@ -71,21 +71,28 @@ def twin_episode(env, make, seed: int) -> float:
     return total
 
 
-def stacked(act):
-    """A policy `act(obs, ids)` on stacked observations (agents, obs) and the agents' indices as a
-    `make(env)` for twin_episode."""
+def stacked(make_act):
+    """A policy on stacked observations (agents, obs) as a `make(env)` for twin_episode: `make_act()`
+    gives, fresh each episode, `act(obs, ids)` of the live agents' observations and indices."""
 
-    def run(env, obs):
-        acts = act(np.stack([obs[a] for a in env.agents]), np.array([env.possible_agents.index(a) for a in env.agents]))
-        return {a: acts[i] for i, a in enumerate(env.agents)}
+    def make(_env):
+        act = make_act()
 
-    return lambda _env: run
+        def run(env, obs):
+            ids = np.array([env.possible_agents.index(a) for a in env.agents])
+            acts = act(np.stack([obs[a] for a in env.agents]), ids)
+            return {a: acts[i] for i, a in enumerate(env.agents)}
+
+        return run
+
+    return make
 
 
-def on_twin(act, scenario: str, twin, episodes: int, steps: int, seed: int) -> float:
-    """Mean return per follower over `episodes` real-time episodes on the twin started here."""
+def on_twin(make_act, scenario: str, twin, episodes: int, steps: int, seed: int) -> float:
+    """Mean return per follower over `episodes` real-time episodes on the twin started here
+    (`make_act`: see `stacked`)."""
     with colcos.parallel_env(task="aggregation", scenario=scenario, plant="twin", twin_scenario=twin, max_cycles=steps) as env:
-        return float(np.mean([twin_episode(env, stacked(act), seed + k) for k in range(episodes)]))
+        return float(np.mean([twin_episode(env, stacked(make_act), seed + k) for k in range(episodes)]))
 
 
 def main() -> None:
@@ -119,13 +126,13 @@ def main() -> None:
     rows = []
     t0 = time.time()
     for name, model in models.items():
-        sim = on_sim(lambda _v, m=model: m.act, plain_path, args.eval_worlds, args.episode, 12345)
-        tw = on_twin(model.act, host_path, twin, args.twin_episodes, args.episode, 100)
+        sim = on_sim(lambda _v, m=model: m.policy(), plain_path, args.eval_worlds, args.episode, 12345)
+        tw = on_twin(model.policy, host_path, twin, args.twin_episodes, args.episode, 100)
         rows.append((f"PPO, {name}", sim, tw))
     hand = on_sim(lambda v: Baseline(v, "aggregation_follower").act, plain_path, args.eval_worlds, args.episode, 12345)
     still = on_sim(lambda v: (lambda o: np.zeros((v.num_envs, v.num_agents, 2), np.float32)), plain_path,
                    args.eval_worlds, args.episode, 12345)
-    still_twin = on_twin(lambda o: np.zeros((o.shape[0], 2), np.float32), host_path, twin, args.twin_episodes, args.episode, 100)
+    still_twin = on_twin(lambda: (lambda o, _ids: np.zeros((o.shape[0], 2), np.float32)), host_path, twin, args.twin_episodes, args.episode, 100)
     rows += [("hand-written follower", hand, None), ("standing still", still, still_twin)]
     lines = [
         f"| policy | simulator, training values ({args.eval_worlds} worlds) | twin: tracker {TWIN_LATENCY} s, "

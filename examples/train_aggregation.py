@@ -55,9 +55,9 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
-                     agent_id=args.agent_id)
+                     agent_id=args.agent_id, history=args.history)
     trainer = ppo.Trainer(env, cfg, seed)
-    evaluate = lambda: round(ppo.evaluate(lambda v: trainer.model.act, env_kwargs, args.eval_worlds, args.episode, args.eval_seed), 2)
+    evaluate = lambda: round(ppo.evaluate(lambda v: trainer.model.policy(), env_kwargs, args.eval_worlds, args.episode, args.eval_seed), 2)
     curve: list[tuple[float, int, int, float]] = [(0.0, 0, 0, evaluate())]
     budget = args.minutes * 60 if args.minutes else None
     train_seconds, cpu_start = 0.0, time.process_time()
@@ -139,6 +139,8 @@ def main() -> None:
     p.add_argument("--team-critic", action="store_true", help="the critic also sees every follower's observation")
     p.add_argument("--agent-id", action="store_true",
                    help="the actor also sees which follower it drives (a one-hot): one policy, each robot its own way")
+    p.add_argument("--history", type=int, default=1,
+                   help="the actor reads its last K observations (oldest first): a memory of its recent readings and commands")
     p.add_argument("--episode", type=int, default=500, help="steps per episode (10 s)")
     p.add_argument("--threads", type=int, default=None, help="env worker threads (default: one per core)")
     p.add_argument("--eval-worlds", type=int, default=32)
@@ -148,8 +150,8 @@ def main() -> None:
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="numeric task parameter for training and evaluation, e.g. progress_weight=0 (repeatable)")
     args = p.parse_args()
-    if args.updates < 1 or args.eval_every < 1:
-        p.error(f"--updates ({args.updates}) and --eval-every ({args.eval_every}) must be at least 1")
+    if args.updates < 1 or args.eval_every < 1 or args.history < 1:
+        p.error(f"--updates ({args.updates}), --eval-every ({args.eval_every}) and --history ({args.history}) must be at least 1")
     # The policy's tensors are small: one torch thread is fastest (two fight the env's workers).
     torch.set_num_threads(1)
     os.makedirs(args.out, exist_ok=True)

@@ -87,6 +87,7 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     threads = ["--threads", str(args.threads)] if args.threads else []
     anneal = ["--anneal"] if args.anneal and args.updates else []
     anneal += ["--agent-id"] if args.agent_id else []
+    anneal += ["--history", str(args.history)]
     for seed in args.seeds:
         for name in VARIANTS:
             d = os.path.join(args.out, f"{name}-s{seed}")
@@ -103,15 +104,15 @@ def hand_written(env):
     return lambda _env, _obs: follower.actions()
 
 
-def policies(out: str, seeds: list[int], episode: int) -> dict:
+def policies(out: str, seeds: list[int], episode: int, history: int = 1) -> dict:
     """Every policy as (simulator act factory, twin act): PPO per variant and seed, references."""
     v = VecEnv("aggregation", num_envs=1, max_cycles=episode)
     d = v.single_observation_space.shape[0]
     table: dict = {}
     for seed in seeds:
         for name in VARIANTS:
-            model = load_model(os.path.join(out, f"{name}-s{seed}", "policy.pt"), d)
-            table[f"{name}-s{seed}"] = (lambda _v, m=model: m.act, stacked(model.act))
+            model = load_model(os.path.join(out, f"{name}-s{seed}", "policy.pt"), d, history)
+            table[f"{name}-s{seed}"] = (lambda _v, m=model: m.policy(), stacked(model.policy))
     table["hand-written"] = (lambda v: Baseline(v, "aggregation_follower").act,
                              hand_written)
     table["standing still"] = (lambda v: (lambda o: np.zeros((v.num_envs, v.num_agents, 2), np.float32)),
@@ -133,7 +134,7 @@ def ratio(tw: np.ndarray, sim: np.ndarray) -> float:
 
 def evaluate(paths: dict[str, str], args) -> dict:
     """Every policy's returns: simulator (nominal, truth) per world, twin per episode (interleaved)."""
-    table = policies(args.out, args.seeds, args.episode)
+    table = policies(args.out, args.seeds, args.episode, args.history)
     res: dict = {k: {} for k in table}
     for k, (sim_act, _) in table.items():
         for col in ("nominal", "truth"):
@@ -223,11 +224,15 @@ def main() -> None:
     p.add_argument("--truth", default=os.path.join(DATA, "truth.toml"))
     p.add_argument("--agent-id", action="store_true",
                    help="each policy's actor also sees which follower it drives (train_aggregation.py --agent-id)")
+    p.add_argument("--history", type=int, default=1,
+                   help="each policy's actor reads its last K observations (train_aggregation.py --history)")
     p.add_argument("--train-only", action="store_true")
     p.add_argument("--out", default="runs/transfer")
     args = p.parse_args()
     if args.updates is not None and args.updates < 1:
         p.error(f"--updates ({args.updates}) must be at least 1")
+    if args.history < 1:
+        p.error(f"--history ({args.history}) must be at least 1")
     os.makedirs(args.out, exist_ok=True)
     paths = write_scenarios(args.out, args.fit, args.truth)
     train(paths, args)

@@ -136,3 +136,39 @@ def test_an_agent_id_actor_tells_its_agents_apart_and_loads_back(tmp_path):
     plain = ppo.Trainer(env, ppo.Config(horizon=4), seed=0).model
     torch.save(plain.state_dict(), tmp_path / "plain.pt")
     assert ppo.load_model(str(tmp_path / "plain.pt"), 17).agents == 0
+
+
+def test_a_memory_stacks_each_rows_last_observations_and_starts_rows_again():
+    ppo = load_ppo()
+    memory = ppo.Memory(3)
+    first = np.arange(4, dtype=np.float32).reshape(2, 1, 2)  # 2 worlds x 1 agent x 2 entries
+    np.testing.assert_array_equal(memory.push(first), np.tile(first, 3))  # the first fills the history
+    second = first + 10
+    np.testing.assert_array_equal(memory.push(second)[0, 0], [0, 1, 0, 1, 10, 11])
+    third = first + 20
+    got = memory.push(third, fresh=np.array([[False], [True]]))
+    np.testing.assert_array_equal(got[0, 0], [0, 1, 10, 11, 20, 21])  # oldest first
+    np.testing.assert_array_equal(got[1, 0], [22, 23, 22, 23, 22, 23])  # world 1 started a new episode
+    assert ppo.Memory(1).push(first) is not None and ppo.Memory(1).push(first).shape == first.shape
+
+
+def test_an_actor_with_a_history_trains_acts_on_a_stream_and_loads_back(tmp_path):
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=6, num_threads=1)
+    trainer = ppo.Trainer(env, ppo.Config(horizon=8, epochs=1, minibatches=1, history=3), seed=0)
+    trainer.iterate()  # episodes of 6 steps end inside the rollout: the memory starts again
+    model = trainer.model
+    assert model.pi[0].in_features == 3 * 17 and trainer.view.shape == (2, env.num_agents, 3 * 17)
+    obs = env.reset(seed=1)[0].copy()  # the env's arrays are views its next step overwrites
+    act = model.policy()
+    a0 = act(obs)
+    np.testing.assert_array_equal(a0, model.act(np.tile(obs, 3)))  # the first observation fills the history
+    obs2, *_ = env.step(a0)
+    np.testing.assert_array_equal(act(obs2), model.act(np.concatenate([obs, obs, obs2], axis=-1)))
+    torch.save(model.state_dict(), tmp_path / "policy.pt")
+    loaded = ppo.load_model(str(tmp_path / "policy.pt"), 17, history=3)
+    assert (loaded.history, loaded.agents) == (3, 0)
+    np.testing.assert_array_equal(loaded.act(np.tile(obs, 3)), model.act(np.tile(obs, 3)))
