@@ -12,6 +12,7 @@ and `onboard_export.py`. Needs torch.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import time
 from collections.abc import Callable
@@ -207,6 +208,7 @@ class Config:
     anneal: int = 0  # with N > 0, the learning rate falls linearly to 0 over N updates (the budget)
     agent_id: bool = False  # the actor also sees which agent it drives (a one-hot: ActorCritic's `agents`)
     history: int = 1  # the actor reads the last `history` observations (ActorCritic's `history`)
+    anchor: float = 0.0  # weight of a term keeping the actor's mean near the one `Trainer.set_anchor` froze
     actor_warmup: int = 0  # the first N updates train only the critic (an actor that starts good, e.g. kickstarted, keeps still)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     start_forward: float = 0.0  # the untrained actor's mean for both wheels: > 0 drives forward, an exploration prior
@@ -258,12 +260,19 @@ class Trainer:
         obs, infos = env.reset(seed=seed)
         self.obs, self.state = obs, infos["state"]
         self.view = self.memory.push(obs)  # what the actor reads
+        self.anchor: tuple[nn.Module, RunningNorm] | None = None  # set_anchor's frozen actor
         self.prev_done = np.zeros(self.b, dtype=bool)
         self.ep_return = np.zeros(self.b)
         self.finished: list[float] = []  # returns of the training episodes, in the order they ended
         self.updates = 0
         self.agent_steps = 0
         self.seconds = {"env": 0.0, "act": 0.0, "learn": 0.0}  # wall time of each phase
+
+    def set_anchor(self) -> None:
+        """Freezes a copy of the actor as it is now (e.g. after imitation): with `cfg.anchor` > 0 the
+        loss adds `anchor` x the squared distance of the actor's mean from the frozen one's, as
+        kickstarting does (Schmitt et al. 2018), so that PPO refines that actor rather than loses it."""
+        self.anchor = (copy.deepcopy(self.model.pi).requires_grad_(False), copy.deepcopy(self.model.obs_norm))
 
     def iterate(self) -> float:
         """One rollout and one PPO update; returns the rollout's mean reward per agent-step."""
@@ -351,6 +360,10 @@ class Trainer:
                 vloss = 0.5 * (model.value(fc[idx]) - fret[idx]).pow(2).mean()
                 # The Gaussian's entropy is sum(log_std) + const: the same for every sample.
                 loss = pg + 0.5 * vloss - cfg.ent_coef * model.log_std.sum()
+                if cfg.anchor and self.anchor is not None:
+                    with torch.no_grad():
+                        frozen = self.anchor[0](self.anchor[1](fo[idx]))
+                    loss = loss + cfg.anchor * (mu - frozen).pow(2).sum(-1).mean()
                 if self.updates < cfg.actor_warmup:
                     loss = 0.5 * vloss
                 if cfg.listen_bias:

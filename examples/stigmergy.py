@@ -135,11 +135,13 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
                      start_forward=args.start_forward, start_lay=args.start_lay,
                      # The communication biases act on a message: the arm that lays none has none to hear.
                      listen_bias=args.listen_bias if lay else 0.0, signal_bias=args.signal_bias if lay else 0.0,
-                     message_inputs=message_inputs(task, args), actor_warmup=args.actor_warmup)
+                     message_inputs=message_inputs(task, args), actor_warmup=args.actor_warmup,
+                     anchor=args.anchor)
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
     kicked: dict = {}
     if args.kickstart:
         kicked = kickstart_actor(trainer.model, task, lay, seed, args)
+        trainer.set_anchor()
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
     start = time.time()
@@ -259,7 +261,7 @@ def config(args: argparse.Namespace, mode: str = "with") -> dict:
     serves studies with any biases."""
     keys = ("steps", "num_envs", "horizon", "episode", "lr", "gamma", "anneal", "team_critic", "start_forward", "start_lay",
             "listen_bias", "signal_bias", "param", "shaping", "scenario", "eval_worlds", "eval_seed", "eval_policy",
-            "kickstart", "kickstart_std", "actor_warmup")
+            "kickstart", "kickstart_std", "actor_warmup", "anchor")
     out = {k: getattr(args, k) for k in keys}
     if mode == "without":
         out["listen_bias"] = out["signal_bias"] = 0.0
@@ -413,13 +415,16 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                    help="before PPO the actor imitates the task's hand-written policy over STEPS agent-steps of it acting "
                         "(in the arm's own worlds: without pheromone actions nothing it lays is laid); 0: off")
     p.add_argument("--kickstart-std", type=float, default=0.2, help="the kickstarted actor's noise (sd of its Gaussian)")
+    p.add_argument("--anchor", type=float, default=0.0, metavar="W",
+                   help="with --kickstart: weight of a loss term keeping the actor near the imitated one during PPO "
+                        "(ppo.Config.anchor)")
     p.add_argument("--actor-warmup", type=int, default=0, metavar="N",
                    help="the first N PPO updates train only the critic (for a kickstarted actor)")
     p.add_argument("--scenario", default=None, help="scenario file instead of the task's own (training and evaluation)")
     args = p.parse_args(argv)
-    if args.kickstart < 0 or args.actor_warmup < 0 or not args.kickstart_std > 0:
-        p.error(f"--kickstart ({args.kickstart}) and --actor-warmup ({args.actor_warmup}) must be at least 0, "
-                f"--kickstart-std ({args.kickstart_std}) above 0")
+    if args.kickstart < 0 or args.actor_warmup < 0 or not args.kickstart_std > 0 or not args.anchor >= 0:
+        p.error(f"--kickstart ({args.kickstart}), --actor-warmup ({args.actor_warmup}) and --anchor ({args.anchor}) "
+                f"must be at least 0, --kickstart-std ({args.kickstart_std}) above 0")
     args.defaults = {k: p.get_default(k) for k in vars(args)} | {"param": {}, "shaping": {}}
     for name in ("param", "shaping"):
         setattr(args, name, dict(parse_param(p, f"--{name}", kv) for kv in getattr(args, name)))

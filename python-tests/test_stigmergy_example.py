@@ -96,3 +96,26 @@ def test_imitation_fits_a_teacher_and_sets_the_noise():
     assert losses[-1] < 0.05 * losses[0], losses
     assert torch.allclose(model.log_std.exp(), torch.tensor(0.3))
     assert np.abs(model.act(obs) - teacher).mean() < 0.1
+
+
+def test_an_anchored_trainer_stays_nearer_its_frozen_actor():
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+    from example_modules import load_ppo
+
+    ppo = load_ppo()
+    env = VecEnv(task="alarm", num_envs=2, max_cycles=40, num_threads=1)
+
+    def drift(anchor: float) -> float:
+        trainer = ppo.Trainer(env, ppo.Config(horizon=16, epochs=2, minibatches=2, lr=3e-3, anchor=anchor), seed=0)
+        trainer.set_anchor()
+        probe = torch.randn(256, env.single_observation_space.shape[0], generator=torch.Generator().manual_seed(1))
+        with torch.no_grad():
+            before = trainer.anchor[0](trainer.anchor[1](probe))
+        for _ in range(4):
+            trainer.iterate()
+        with torch.no_grad():
+            return float((trainer.model.pi(trainer.anchor[1](probe)) - before).pow(2).sum(-1).mean())
+
+    free, held = drift(0.0), drift(100.0)
+    assert held < 0.5 * free, (held, free)
