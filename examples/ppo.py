@@ -296,10 +296,10 @@ class Trainer:
             action = self.to_env(act_buf[t].numpy().reshape(e, n, self.w))
             t1 = time.perf_counter()
             self.obs, rew, term, trunc, infos = self.env.step(action)
-            # A step after a done one reset its world: that row's history starts again.
-            self.view = self.memory.push(self.obs, fresh=self.prev_done.reshape(e, n))
             self.seconds["env"] += time.perf_counter() - t1
             self.seconds["act"] += t1 - t0
+            # A step after a done one reset its world: that row's history starts again.
+            self.view = self.memory.push(self.obs, fresh=self.prev_done.reshape(e, n))
             self.state = infos["state"]
             r = rew.reshape(b).astype(np.float64)
             done = (term | trunc).reshape(b)
@@ -364,12 +364,12 @@ class Trainer:
                     with torch.no_grad():
                         frozen = self.anchor[0](self.anchor[1](fo[idx]))
                     loss = loss + cfg.anchor * (mu - frozen).pow(2).sum(-1).mean()
-                if self.updates < cfg.actor_warmup:
-                    loss = 0.5 * vloss
                 if cfg.listen_bias:
                     loss = loss - cfg.listen_bias * listening(model, fo[idx], mu, cfg.message_inputs)
                 if cfg.signal_bias:
                     loss = loss - cfg.signal_bias * signalling(model, mu, cfg.message_output, cfg.message_threshold)
+                if self.updates < cfg.actor_warmup:
+                    loss = 0.5 * vloss
                 self.opt.zero_grad()
                 loss.backward()
                 nn.utils.clip_grad_norm_(model.parameters(), 0.5)
