@@ -380,7 +380,9 @@ def listening(model: ActorCritic, obs: torch.Tensor, mu: torch.Tensor, inputs: t
     """How much the wheel commands (clipped means) respond to the message: the mean L1 distance to those
     of the same observations with the message's entries `inputs` at their running mean (the actor's
     normalised input 0). The mean, not a raw 0: a sensor never reads exactly nothing, and an input far
-    outside what the actor has seen would reward reacting to that, not to the message."""
+    outside what the actor has seen would reward reacting to that, not to the message. `inputs` index
+    the actor's input, which is the observation itself only for an actor without `history` or
+    `agents` (as `stigmergy.py` trains)."""
     z = model.obs_norm(obs)
     z[:, list(inputs)] = 0.0
     return (mu[:, :2].clamp(-1, 1) - model.pi(z)[:, :2].clamp(-1, 1)).abs().sum(-1).mean()
