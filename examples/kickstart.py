@@ -3,11 +3,11 @@ task's reward as usual. For tasks whose reward a Gaussian-noise learner never me
 untrained agent ever carries food home), the teacher's demonstrations put the learner where the
 reward is; what the learner then keeps, changes or loses of the teacher's behaviour is up to PPO.
 
-`imitate(trainer, teacher, env_kwargs, steps, to_env)` collects `steps` agent-steps of the teacher
-acting in its own env (the env gets the teacher's actions through `to_env`, so an ablation that
-forces some outputs to 0 sees its own world), fits the actor's mean to the teacher's actions (mean
-squared error on the actions clipped to the action box) and sets the actor's noise. Used by
-`stigmergy.py --kickstart`. Needs torch.
+`demonstrations(teacher, env_kwargs, worlds, steps, seed, to_env)` records the teacher acting in
+its own env (the env gets the teacher's actions through `to_env`, so an ablation that forces some
+outputs to 0 sees its own world); `imitate(model, obs, actions, low, high)` fits the actor's mean to
+those actions (mean squared error on the actions clipped to the action box) and sets the actor's
+noise. Used by `stigmergy.py --kickstart`. Needs torch.
 """
 
 from __future__ import annotations

@@ -140,7 +140,7 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
     trainer = ppo.Trainer(env, cfg, seed, to_env=lambda a: to_env(a, lay))
     kicked: dict = {}
     if args.kickstart:
-        kicked = kickstart_actor(trainer.model, task, lay, seed, args)
+        kicked = kickstart_actor(trainer, task, lay, seed, args)
         trainer.set_anchor()
     rate_curve: list[tuple[int, float]] = []
     episode_curve: list[tuple[int, float]] = []
@@ -160,26 +160,27 @@ def train(task: str, lay: bool, seed: int, args: argparse.Namespace) -> tuple[nn
     return trainer.model, log
 
 
-def teacher(task: str):
-    """The task's hand-written policy as `make(env)` -> (observations -> actions)."""
+def hand_written(task: str):
+    """The task's hand-written policy as `make(env)` -> (observations -> actions): the baseline of
+    every study and the teacher of `--kickstart`."""
     if task in PYTHON_TASKS:
         return lambda v: PYTHON_TASKS[task][1](seed=1).act
     name = {t: p for p, (t, _) in colcos.task_policies().items()}[task]
     return lambda v: Baseline(v, name).act
 
 
-def kickstart_actor(model: nn.Module, task: str, lay: bool, seed: int, args: argparse.Namespace) -> dict:
-    """`--kickstart`: the actor imitates the task's hand-written policy, acting in worlds of this arm
-    (without pheromone actions its trails are never laid), before PPO; the imitation's error and the
-    kickstarted policy's evaluation, for the run's record."""
+def kickstart_actor(trainer: ppo.Trainer, task: str, lay: bool, seed: int, args: argparse.Namespace) -> dict:
+    """`--kickstart`: the trainer's actor imitates the task's hand-written policy, acting in worlds of
+    this arm (without pheromone actions its trails are never laid), before PPO; the imitation's error
+    and the kickstarted policy's evaluation, for the run's record."""
     t0 = time.time()
     env_kwargs = {"max_cycles": episode_steps(task, args), "num_threads": args.threads, **task_kwargs(task, args, training=True)}
-    obs, acts = kickstart.demonstrations(teacher(task), env_kwargs, args.num_envs, args.kickstart, seed + 1000,
+    obs, acts = kickstart.demonstrations(hand_written(task), env_kwargs, args.num_envs, args.kickstart, seed + 1000,
                                          lambda a: to_env(a, lay))
-    space = VecEnv(num_envs=1, max_cycles=2, **task_kwargs(task, args, training=True)).single_action_space
-    losses = kickstart.imitate(model, obs, acts, space.low, space.high, std=args.kickstart_std, seed=seed)
+    space = trainer.env.single_action_space
+    losses = kickstart.imitate(trainer.model, obs, acts, space.low, space.high, std=args.kickstart_std, seed=seed)
     return {"kickstart_mse": [round(v, 5) for v in losses], "kickstart_seconds": round(time.time() - t0, 1),
-            "eval_kickstart": evaluate(task, acting(model, lay, args), args)}
+            "eval_kickstart": evaluate(task, acting(trainer.model, lay, args), args)}
 
 
 def evaluate(task: str, act, args: argparse.Namespace) -> list[float]:
@@ -243,14 +244,8 @@ def reference(task: str, name: str, args: argparse.Namespace) -> list[float]:
         saved = json.loads(path.read_text())
         if same_config(saved["config"], cfg, args):
             return saved["eval"]
-    if name == "baseline":
-        if task in PYTHON_TASKS:
-            returns = evaluate(task, lambda v: PYTHON_TASKS[task][1](seed=1).act, args)
-        else:
-            policy = {t: p for p, (t, _) in colcos.task_policies().items()}[task]
-            returns = evaluate(task, lambda v: Baseline(v, policy).act, args)
-    else:
-        returns = evaluate(task, lambda v: RandomPolicy(v, seed=1).act, args)
+    make = hand_written(task) if name == "baseline" else (lambda v: RandomPolicy(v, seed=1).act)
+    returns = evaluate(task, make, args)
     _dump(path, {"config": cfg, "eval": returns})
     return returns
 

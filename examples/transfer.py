@@ -85,15 +85,15 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     PPO updates each (the same samples for every variant, whatever the machine's load), or `--minutes`."""
     budget = ["--updates", str(args.updates)] if args.updates else ["--minutes", str(args.minutes)]
     threads = ["--threads", str(args.threads)] if args.threads else []
-    anneal = ["--anneal"] if args.anneal and args.updates else []
-    anneal += ["--agent-id"] if args.agent_id else []
-    anneal += ["--history", str(args.history)]
+    flags = ["--anneal"] if args.anneal and args.updates else []
+    flags += ["--agent-id"] if args.agent_id else []
+    flags += ["--history", str(args.history)]
     for seed in args.seeds:
         for name in VARIANTS:
             d = os.path.join(args.out, f"{name}-s{seed}")
             if os.path.exists(os.path.join(d, "policy.pt")):
                 continue
-            subprocess.run([sys.executable, os.path.join(HERE, "train_aggregation.py"), *budget, *anneal, *threads,
+            subprocess.run([sys.executable, os.path.join(HERE, "train_aggregation.py"), *budget, *flags, *threads,
                             "--episode", str(args.episode), "--scenario", paths[name], "--seed", str(seed), "--out", d],
                            check=True)
 
