@@ -6,6 +6,7 @@ use colcos_sim::field::{
     Kernel, Pheromone, image_map, polyline_map,
 };
 use colcos_sim::screen::{ScreenSpec, pixel_at, render, save_png};
+use colcos_testkit::threads::on_threads;
 
 fn eq5(s: &GaussianSource, p: Vec2, t: f64) -> f64 {
     if t < s.start as f64 {
@@ -276,11 +277,7 @@ fn stepping_is_bit_identical_across_thread_counts() {
     };
     let h = spec.cell;
     let run = |threads: usize| -> Vec<Vec<f32>> {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let cases = [
                 (DiffusionScheme::Auto, 0.2 * h * h / 0.02, Vec2::ZERO, true),
                 (

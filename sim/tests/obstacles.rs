@@ -6,6 +6,7 @@ use colcos_sim::scenario::Scenario;
 use colcos_sim::sensors::{BumperParams, BumperRays, NeighbourIndex};
 use colcos_sim::world::World;
 use colcos_testkit::parsing::assert_all_refused;
+use colcos_testkit::threads::on_threads;
 use glam::Vec2;
 use rand::{RngExt, SeedableRng};
 use std::path::Path;
@@ -459,11 +460,7 @@ fn the_same_seed_gives_the_same_run_whatever_the_thread_count() {
         );
         let sc = Scenario::from_toml_str(&text, ".").unwrap();
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            on_threads(threads, || {
                 let mut world = World::new(&sc).unwrap();
                 for _ in 0..150 {
                     world.step();

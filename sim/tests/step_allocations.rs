@@ -4,6 +4,7 @@
 use colcos_sim::prelude::*;
 use colcos_sim::robot::PhysicsBackend;
 use colcos_testkit::alloc::{Counting, allocations, assert_installed};
+use colcos_testkit::threads::on_threads;
 
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
@@ -24,11 +25,7 @@ fn allocations_per_step(file: &str, physics: PhysicsBackend) -> f64 {
     let path = format!("{}/../scenarios/{file}", env!("CARGO_MANIFEST_DIR"));
     let mut sc = Scenario::from_file(&path).unwrap();
     sc.spec.physics = physics;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    on_threads(2, || {
         let mut w = World::new(&sc).unwrap();
         for _ in 0..300 {
             w.step();

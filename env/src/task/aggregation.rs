@@ -16,7 +16,7 @@
 //! leader (the aggregation phase: gather). The first term is dense and depends on the follower's own
 //! action only, which is what makes the task learnable in minutes; the others are the state's cost.
 //! No termination: episodes end by truncation.
-use super::{Outcome, Task, TaskState, check_non_negative, parse_params, require_role};
+use super::{Outcome, Task, TaskState, check_non_negative, parse_with_agents, require_role};
 use crate::error::Result;
 use colcos_sim::channel::Channel;
 use colcos_sim::scenario::Scenario;
@@ -81,8 +81,8 @@ pub struct Aggregation {
 }
 
 pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn Task>> {
-    let p: Params = parse_params("aggregation", params)?;
-    let agents = require_role(scenario, &p.agent_role, "aggregation.agent_role")?;
+    let (p, agents) =
+        parse_with_agents("aggregation", scenario, params, |p: &Params| &p.agent_role)?;
     let leader = require_role(scenario, &p.leader_role, "aggregation.leader_role")?[0];
     // A scenario without a predator is allowed: pure aggregation.
     let predators = super::robots_with_role(scenario, &p.predator_role);

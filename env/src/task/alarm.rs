@@ -14,7 +14,7 @@
 //! No termination: a captured agent may escape and be safe again. A scenario without a robot of
 //! `predator_role` is refused (nothing would threaten the agents).
 use super::{
-    ExtraObs, Outcome, Task, TaskState, check_non_negative, check_positive, parse_params,
+    ExtraObs, Outcome, Task, TaskState, check_non_negative, check_positive, parse_with_agents,
     require_role,
 };
 use crate::error::{EnvError, Result};
@@ -65,8 +65,7 @@ pub struct Alarm {
 }
 
 pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn Task>> {
-    let p: Params = parse_params("alarm", params)?;
-    let agents = require_role(scenario, &p.agent_role, "alarm.agent_role")?;
+    let (p, agents) = parse_with_agents("alarm", scenario, params, |p: &Params| &p.agent_role)?;
     let predators = require_role(scenario, &p.predator_role, "alarm.predator_role")?;
     if predators.iter().any(|i| agents.contains(i)) {
         return Err(EnvError::param(

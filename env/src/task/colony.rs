@@ -16,8 +16,8 @@
 //! the lowest agent index that reaches it in that step. In the built-in scenario the agents may lay
 //! `food` (green) and `home` (red) trails; the nest glows blue (a fixed Gaussian source).
 use super::{
-    ExtraObs, Outcome, Task, TaskState, check_non_negative, check_positive, parse_params,
-    point_in_arena, points_in_arena, require_role,
+    ExtraObs, Outcome, Task, TaskState, check_non_negative, check_positive, parse_with_agents,
+    point_in_arena, points_in_arena,
 };
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
@@ -107,8 +107,8 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
 
 impl Colony {
     pub fn new(scenario: &Scenario, params: &serde_json::Value) -> Result<Self> {
-        let p: Params = parse_params("colony", params)?;
-        let agents = require_role(scenario, &p.agent_role, "colony.agent_role")?;
+        let (p, agents) =
+            parse_with_agents("colony", scenario, params, |p: &Params| &p.agent_role)?;
         if p.food.is_empty() {
             return Err(EnvError::param(
                 "colony.food",

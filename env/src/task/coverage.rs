@@ -13,9 +13,7 @@
 //! so an episode's team return is `cell_reward` times the cells covered (minus the bumps): each
 //! cell pays once per episode. No termination. The observation has no extra entry: the only memory
 //! of where the team has been is what it lays.
-use super::{
-    Outcome, Task, TaskState, check_non_negative, check_positive, parse_params, require_role,
-};
+use super::{Outcome, Task, TaskState, check_non_negative, check_positive, parse_with_agents};
 use crate::error::{EnvError, Result};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
@@ -64,8 +62,8 @@ pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn 
 
 impl Coverage {
     pub fn new(scenario: &Scenario, params: &serde_json::Value) -> Result<Self> {
-        let p: Params = parse_params("coverage", params)?;
-        let agents = require_role(scenario, &p.agent_role, "coverage.agent_role")?;
+        let (p, agents) =
+            parse_with_agents("coverage", scenario, params, |p: &Params| &p.agent_role)?;
         let cell = check_positive("coverage.cell", p.cell)?;
         let arena = scenario.arena_size();
         let (cols, rows) = (

@@ -2,7 +2,7 @@
 //! by a `colcos.Task` written in Python, once per batched step over every world (see
 //! `VecEnv::step_deferred` and `VecEnv::conclude`). Here only the agents are chosen: the robots
 //! whose group has role `agent_role`.
-use super::{Outcome, Task, TaskState, parse_params, require_role};
+use super::{Outcome, Task, TaskState, parse_with_agents};
 use crate::error::Result;
 use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
@@ -37,8 +37,7 @@ pub struct External {
 }
 
 pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn Task>> {
-    let p: Params = parse_params(NAME, params)?;
-    let agents = require_role(scenario, &p.agent_role, "python.agent_role")?;
+    let (p, agents) = parse_with_agents(NAME, scenario, params, |p: &Params| &p.agent_role)?;
     Ok(Box::new(External {
         agents,
         prefill: p.prefill,

@@ -5,9 +5,7 @@
 //! agent terminates when it reaches a branch end: `+food_reward` at a food end, `-wrong_end_penalty`
 //! at any other; every step costs `step_penalty`. At reset the static maps are brought to their
 //! steady state `e J` (the paper assumes the trails are already laid).
-use super::{
-    Outcome, Task, TaskState, check_non_negative, parse_params, points_in_arena, require_role,
-};
+use super::{Outcome, Task, TaskState, check_non_negative, parse_with_agents, points_in_arena};
 use crate::error::{EnvError, Result};
 use colcos_sim::field::Pheromone;
 use colcos_sim::scenario::Scenario;
@@ -64,8 +62,7 @@ pub struct Foraging {
 }
 
 pub fn build(scenario: &Scenario, params: &serde_json::Value) -> Result<Box<dyn Task>> {
-    let p: Params = parse_params("foraging", params)?;
-    let agents = require_role(scenario, &p.agent_role, "foraging.agent_role")?;
+    let (p, agents) = parse_with_agents("foraging", scenario, params, |p: &Params| &p.agent_role)?;
     if p.food.is_empty() {
         return Err(EnvError::param(
             "foraging.food",

@@ -100,6 +100,19 @@ pub fn parse_params<T: DeserializeOwned>(task: &str, params: &serde_json::Value)
     })
 }
 
+/// Task `task`'s parameter object, parsed as [`parse_params`] does, and its agents: the robots of
+/// the role `role` reads from it, refused as [`require_role`] does under the key `<task>.agent_role`.
+pub fn parse_with_agents<P: DeserializeOwned>(
+    task: &str,
+    scenario: &Scenario,
+    params: &serde_json::Value,
+    role: impl Fn(&P) -> &str,
+) -> Result<(P, Vec<usize>)> {
+    let p: P = parse_params(task, params)?;
+    let agents = require_role(scenario, role(&p), &format!("{task}.agent_role"))?;
+    Ok((p, agents))
+}
+
 /// World indices of the robots whose group has role `role`.
 pub fn robots_with_role(scenario: &Scenario, role: &str) -> Vec<usize> {
     let mut first = 0;
