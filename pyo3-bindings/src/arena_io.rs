@@ -1,5 +1,6 @@
 //! The numpy side that the batch (`VecEnv`) and a plant (`Plant`) share: views of the output
-//! buffers, actions copied in, and the seed, render width, image and poses of their methods.
+//! buffers, reset and step with their arguments checked, and the seed, render width, image and poses
+//! of their other methods.
 use crate::args;
 use crate::errors::Kind;
 use colcos_env::{Actions, BufferPtrs, EnvSpec, Space};
@@ -8,6 +9,7 @@ use numpy::ndarray::{ArrayView, IxDyn};
 use numpy::{
     Element, PyArray, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods,
 };
+use pyo3::PyClass;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -30,26 +32,42 @@ unsafe fn view<'py, T: Element>(
     Ok(unsafe { PyArray::borrow_from_array(&a, owner.clone()) }.into_any())
 }
 
-/// The dict of numpy views of the output buffers that `buffers` (run with the GIL released) hands
-/// out with their spec: `obs [E,N,D]`, `rewards`, `terminated`, `truncated`, `shield [E,N]`,
-/// `final_obs [E,N,D]`, `final_mask [E]`, and `state [E,S]` and `patch [E,N,P,P,3]` where the spec
-/// has them. Each view keeps `owner` alive.
+/// A pyclass over an arena's output buffers (the batch of worlds, a plant's one arena): what the
+/// shared `views`, `reset` and `step` below need of it. `buffers`, `reset_now` and `step_now` take
+/// its lock: call them with the GIL released.
 ///
 /// # Safety
-/// The buffers must be those of an `Outputs` made for the spec, allocated once and never reallocated
-/// for as long as `owner` lives.
-pub(crate) unsafe fn views<'py>(
-    owner: &Bound<'py, PyAny>,
-    buffers: impl FnOnce() -> (BufferPtrs, EnvSpec) + Send,
-) -> PyResult<Bound<'py, PyDict>> {
-    let py = owner.py();
+/// `buffers` must hand out the buffers of an `Outputs` made for the spec it returns, allocated once
+/// and never reallocated for as long as the object lives.
+pub(crate) unsafe trait Arena: PyClass + Sync {
+    /// The arena's own error, made a Python exception (with the GIL held) by `py_err`.
+    type Error: Send;
+    fn py_err(e: Self::Error) -> PyErr;
+    /// Worlds, agents per world and the width of a continuous action row (None: discrete), fixed
+    /// at construction.
+    fn sizes(&self) -> (usize, usize, Option<usize>);
+    fn buffers(&self) -> (BufferPtrs, EnvSpec);
+    fn reset_now(&self, seed: Option<u64>, mask: Option<&[bool]>) -> Result<(), Self::Error>;
+    /// A step, or its first half only (`deferred`: a task written in Python concludes it).
+    fn step_now(&self, actions: Actions<'_>, deferred: bool) -> Result<(), Self::Error>;
+}
+
+/// The dict of numpy views of `slf`'s output buffers: `obs [E,N,D]`, `rewards`, `terminated`,
+/// `truncated`, `shield [E,N]`, `final_obs [E,N,D]`, `final_mask [E]`, and `state [E,S]` and
+/// `patch [E,N,P,P,3]` where the spec has them. Each view keeps `slf` alive.
+pub(crate) fn views<'py, A: Arena>(slf: &Bound<'py, A>) -> PyResult<Bound<'py, PyDict>> {
+    let py = slf.py();
+    let owner = slf.as_any();
+    let class = slf.borrow();
+    let me: &A = &class;
     let (Ptrs(bufs), spec) = py.detach(|| {
-        let (bufs, spec) = buffers();
+        let (bufs, spec) = me.buffers();
         (Ptrs(bufs), spec)
     });
     let d = PyDict::new(py);
     let (e, n) = (spec.num_envs, spec.num_agents);
     let obs = vec![e, n, spec.observation.flat_len()];
+    // SAFETY: `Arena`'s contract: the buffers stay where they are while `owner` lives.
     unsafe {
         d.set_item("obs", view(owner, bufs.obs, obs.clone())?)?;
         d.set_item("rewards", view(owner, bufs.rewards, vec![e, n])?)?;
@@ -67,6 +85,53 @@ pub(crate) unsafe fn views<'py>(
         }
     }
     Ok(d)
+}
+
+/// `reset(seed=None, mask=None)`: the seed checked, then the mask (a 1-D bool array of length
+/// num_envs), then the arena reset with the GIL released.
+pub(crate) fn reset<A: Arena>(
+    me: &A,
+    py: Python<'_>,
+    seed: Option<&Bound<'_, PyAny>>,
+    mask: Option<&Bound<'_, PyAny>>,
+) -> PyResult<()> {
+    let seed = opt_seed(seed)?;
+    let mask = args::given(mask)
+        .map(|m| reset_mask(m, me.sizes().0))
+        .transpose()?;
+    py.detach(|| me.reset_now(seed, mask.as_deref()))
+        .map_err(A::py_err)
+}
+
+/// A reset mask: a 1-D bool array (or sequence of bools) of length `e` (num_envs).
+fn reset_mask(m: &Bound<'_, PyAny>, e: usize) -> PyResult<Vec<bool>> {
+    let a: PyReadonlyArrayDyn<'_, bool> = m.extract().map_err(|_| {
+        Kind::ArgumentType.err(format!(
+            "reset mask must be a bool numpy array of shape ({e},), got {}",
+            args::show(m)
+        ))
+    })?;
+    if a.shape() != [e] {
+        return Err(Kind::Task.err(format!(
+            "reset mask must have shape ({e},) = (num_envs,), got shape {:?}",
+            a.shape()
+        )));
+    }
+    Ok(flat(&a))
+}
+
+/// `step(actions)`: the actions checked and copied with the GIL held, then the arena stepped (its
+/// first half only if `deferred`) with it released.
+pub(crate) fn step<A: Arena>(
+    me: &A,
+    py: Python<'_>,
+    actions: &Bound<'_, PyAny>,
+    deferred: bool,
+) -> PyResult<()> {
+    let (e, n, width) = me.sizes();
+    let acts = owned_actions(actions, e, n, width)?;
+    py.detach(|| me.step_now(acts.actions(), deferred))
+        .map_err(A::py_err)
 }
 
 /// Actions copied out of numpy (before the env's lock is taken, with the GIL held).

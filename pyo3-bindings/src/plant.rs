@@ -1,9 +1,10 @@
 //! `colcos._core.Plant`: one arena of a task on the digital twin, the lab's rig or a recorded rig run,
 //! with the buffers, spec and methods of a one-world `VecEnv`, so that the PettingZoo faces run on it
 //! unchanged. The GIL is released around every call that waits on the arena (reset, step).
-use crate::arena_io::{self, action_width, owned_actions};
+use crate::arena_io::{self, action_width};
 use crate::args::{self, Keywords, guard};
 use crate::errors::{Kind, to_py};
+use colcos_env::{Actions, BufferPtrs, EnvSpec};
 use colcos_plant::{LiveEnv, PlantError, PlantKind, PlantOptions, TwinScenario};
 use colcos_sim::scenario::Scenario;
 use pyo3::prelude::*;
@@ -139,15 +140,7 @@ impl PyPlant {
     /// `final_obs [1,N,D]` and `final_mask [1]` (never set: a plant does not reset itself),
     /// `state [1,S]` and `patch [1,N,P,P,3]` if enabled.
     fn views<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
-        guard(|| {
-            let me: &PyPlant = slf.get();
-            let buffers = || {
-                let mut g = me.lock();
-                (g.buffer_ptrs(), g.spec().clone())
-            };
-            // SAFETY: the buffers are allocated once in LiveEnv::new and never reallocated.
-            unsafe { arena_io::views(slf.as_any(), buffers) }
-        })
+        guard(|| arena_io::views(slf))
     }
 
     /// A new episode (on the twin and the rig: the robots driven to its start poses first); a seed
@@ -160,22 +153,18 @@ impl PyPlant {
         mask: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         guard(|| {
+            // Refused before the seed is read, as the one-world rule comes first.
             if args::given(mask).is_some() {
                 return Err(Kind::Task.err("a plant has one world: reset takes no mask"));
             }
-            let seed = arena_io::opt_seed(seed)?;
-            py.detach(|| self.lock().reset(seed)).map_err(plant_err)
+            arena_io::reset(self, py, seed, None)
         })
     }
 
     /// One step (paced to the screen's rate on the twin and the rig): float32 `[1, N, 2 + D]` or
     /// int64 `[1, N]`.
     fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
-        guard(|| {
-            let acts = owned_actions(actions, 1, self.num_agents, self.width)?;
-            py.detach(|| self.lock().step(acts.actions()))
-                .map_err(plant_err)
-        })
+        guard(|| arena_io::step(self, py, actions, false))
     }
 
     /// The screen with the robots drawn at their tracked poses, `(H, W, 3)` uint8.
@@ -272,6 +261,33 @@ impl PyPlant {
     #[getter]
     fn closed(&self, py: Python<'_>) -> bool {
         py.detach(|| self.lock().is_closed())
+    }
+}
+
+// SAFETY: the buffers are allocated once in LiveEnv::new and never reallocated.
+unsafe impl arena_io::Arena for PyPlant {
+    type Error = PlantError;
+    fn py_err(e: Self::Error) -> PyErr {
+        plant_err(e)
+    }
+    fn sizes(&self) -> (usize, usize, Option<usize>) {
+        (1, self.num_agents, self.width)
+    }
+    fn buffers(&self) -> (BufferPtrs, EnvSpec) {
+        let mut g = self.lock();
+        (g.buffer_ptrs(), g.spec().clone())
+    }
+    /// `mask` is always None: `reset` refuses one.
+    fn reset_now(&self, seed: Option<u64>, _mask: Option<&[bool]>) -> Result<(), Self::Error> {
+        self.lock().reset(seed)
+    }
+    fn step_now(&self, actions: Actions<'_>, deferred: bool) -> Result<(), Self::Error> {
+        let mut env = self.lock();
+        if deferred {
+            env.step_deferred(actions)
+        } else {
+            env.step(actions)
+        }
     }
 }
 

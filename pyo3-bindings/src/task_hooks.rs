@@ -2,7 +2,7 @@
 //! worlds move; then the hooks' rewards and terminations end it), the state of every world as numpy
 //! arrays, and the fields sampled at any points, each once per batched step over all worlds.
 //! Functions of the module rather than methods: the env's own class stays about stepping.
-use crate::arena_io::{action_width, flat, owned_actions};
+use crate::arena_io::{self, flat};
 use crate::args::guard;
 use crate::errors::{Kind, to_py};
 use crate::plant::{PyPlant, plant_err};
@@ -46,25 +46,8 @@ fn step_deferred(
     actions: &Bound<'_, PyAny>,
 ) -> PyResult<()> {
     guard(|| match core_of(env)? {
-        Core::Batch(env) => {
-            let (e, n, width) = py.detach(|| {
-                let g = env.lock();
-                let s = g.env.spec();
-                (s.num_envs, s.num_agents, action_width(&s.action))
-            });
-            let acts = owned_actions(actions, e, n, width)?;
-            py.detach(|| env.lock().env.step_deferred(acts.actions()))
-                .map_err(to_py)
-        }
-        Core::Plant(plant) => {
-            let (n, width) = py.detach(|| {
-                let g = plant.lock();
-                (g.spec().num_agents, action_width(&g.spec().action))
-            });
-            let acts = owned_actions(actions, 1, n, width)?;
-            py.detach(|| plant.lock().step_deferred(acts.actions()))
-                .map_err(plant_err)
-        }
+        Core::Batch(env) => arena_io::step(env, py, actions, true),
+        Core::Plant(plant) => arena_io::step(plant, py, actions, true),
     })
 }
 

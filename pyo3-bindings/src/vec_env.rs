@@ -3,12 +3,14 @@
 //! Threads: every call waits for the environment's lock with the GIL released (`py.detach`), so
 //! that a thread stepping (which holds the lock and has released the GIL) and a thread asking for
 //! anything else never wait on each other. Every entry point runs under `args::guard`.
-use crate::arena_io::{self, action_width, owned_actions};
+use crate::arena_io::{self, action_width};
 use crate::args::{self, Keywords, guard};
 use crate::errors::{Kind, to_py};
 use crate::limits;
-use colcos_env::{ActionKind, AutoresetMode, EnvConfig, PatchConfig, ScenarioSource, VecEnv};
-use numpy::{PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use colcos_env::{
+    ActionKind, Actions, AutoresetMode, BufferPtrs, EnvConfig, EnvSpec, PatchConfig,
+    ScenarioSource, VecEnv,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
@@ -179,15 +181,7 @@ impl PyVecEnv {
     /// `state [E,S] float32` (if enabled), `patch [E,N,P,P,3] uint8` (if enabled),
     /// `final_obs [E,N,D]`, `final_mask [E] bool`.
     fn views<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
-        guard(|| {
-            let me: &PyVecEnv = slf.get();
-            let buffers = || {
-                let mut g = me.lock();
-                (g.env.buffer_ptrs(), g.env.spec().clone())
-            };
-            // SAFETY: the buffers are allocated once in VecEnv::new and never reallocated.
-            unsafe { arena_io::views(slf.as_any(), buffers) }
-        })
+        guard(|| arena_io::views(slf))
     }
 
     /// Resets the worlds where `mask` (bool array of length num_envs) is true, all if None; a seed
@@ -199,23 +193,13 @@ impl PyVecEnv {
         seed: Option<&Bound<'_, PyAny>>,
         mask: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        guard(|| {
-            let seed = arena_io::opt_seed(seed)?;
-            let mask = args::given(mask).map(|m| self.mask(m)).transpose()?;
-            py.detach(|| self.lock().env.reset(seed, mask.as_deref()))
-                .map_err(to_py)
-        })
+        guard(|| arena_io::reset(self, py, seed, mask))
     }
 
     /// Steps every world. `actions`: float32 `[E, N, 2 + D]` (continuous: wheels, then a rate per
     /// deposit action) or int64 `[E, N]` (discrete), C-contiguous or not.
     fn step(&self, py: Python<'_>, actions: &Bound<'_, PyAny>) -> PyResult<()> {
-        guard(|| {
-            let (e, n) = (self.num_envs, self.num_agents);
-            let acts = owned_actions(actions, e, n, self.width)?;
-            py.detach(|| self.lock().env.step(acts.actions()))
-                .map_err(to_py)
-        })
+        guard(|| arena_io::step(self, py, actions, false))
     }
 
     /// The screen of world `world` with the robots drawn on it, `(H, W, 3)` uint8, `width` pixels
@@ -325,23 +309,29 @@ impl PyVecEnv {
     }
 }
 
-impl PyVecEnv {
-    /// A reset mask: a 1-D bool array (or sequence of bools) of length num_envs.
-    fn mask(&self, m: &Bound<'_, PyAny>) -> PyResult<Vec<bool>> {
-        let e = self.num_envs;
-        let a: PyReadonlyArrayDyn<'_, bool> = m.extract().map_err(|_| {
-            Kind::ArgumentType.err(format!(
-                "reset mask must be a bool numpy array of shape ({e},), got {}",
-                args::show(m)
-            ))
-        })?;
-        if a.shape() != [e] {
-            return Err(Kind::Task.err(format!(
-                "reset mask must have shape ({e},) = (num_envs,), got shape {:?}",
-                a.shape()
-            )));
+// SAFETY: the buffers are allocated once in VecEnv::new and never reallocated.
+unsafe impl arena_io::Arena for PyVecEnv {
+    type Error = colcos_env::EnvError;
+    fn py_err(e: Self::Error) -> PyErr {
+        to_py(e)
+    }
+    fn sizes(&self) -> (usize, usize, Option<usize>) {
+        (self.num_envs, self.num_agents, self.width)
+    }
+    fn buffers(&self) -> (BufferPtrs, EnvSpec) {
+        let mut g = self.lock();
+        (g.env.buffer_ptrs(), g.env.spec().clone())
+    }
+    fn reset_now(&self, seed: Option<u64>, mask: Option<&[bool]>) -> Result<(), Self::Error> {
+        self.lock().env.reset(seed, mask)
+    }
+    fn step_now(&self, actions: Actions<'_>, deferred: bool) -> Result<(), Self::Error> {
+        let env = &mut self.lock().env;
+        if deferred {
+            env.step_deferred(actions)
+        } else {
+            env.step(actions)
         }
-        Ok(arena_io::flat(&a))
     }
 }
 
