@@ -5,46 +5,10 @@
 // pass says whether the field takes part and which slot it reads. Passes that ping-pong write the other
 // slot; in-place passes write the slot they read.
 
-struct PF {
-    on: u32,
-    src: u32,
-    inj: i32,    // offset of the field's static injection map in `inj`, or -1
-    coef: u32,   // offset of the field's Thomas coefficients in `coef`
-    a: f32,
-    b: f32,
-    r: f32,
-    c: f32,
-};
-
-struct Pass {
-    index: u32,     // row of the plan (plan[index * nfields + f]) or first deposit of a round
-    nfields: u32,
-    nx: u32,
-    ny: u32,
-    groups_x: u32,  // workgroups along x of the dispatch (linear ids fold x and y)
-    count: u32,     // deposits in the round
-    cell: f32,
-    _pad: u32,
-};
-
-struct Dep {
-    field: u32,
-    slot: u32,
-    i0: u32,
-    j0: u32,
-    w: u32,
-    h: u32,
-    kind: u32,      // 0 disc, 1 cone, 2 gaussian
-    _pad: u32,
-    ax: f32,
-    ay: f32,
-    abx: f32,
-    aby: f32,
-    len2: f32,
-    support: f32,
-    param: f32,     // radius or sigma
-    amount: f32,
-};
+// The structs `PF`, `Pass` and `Dep` go in place of the marker below: `shader_struct!` writes them
+// from the Rust structs they are (`PlanEntry`, `PassUniform` in grids/record.rs, `DepRecord` in
+// grids/deposit.rs).
+//STRUCTS//
 
 @group(0) @binding(0) var<storage, read_write> vals: array<f32>;
 @group(0) @binding(1) var<storage, read> plan: array<PF>;

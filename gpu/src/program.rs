@@ -1,5 +1,5 @@
-//! A WGSL compute shader compiled into pipelines that all bind one layout of buffers, and the bind
-//! groups of whole buffers they take.
+//! A WGSL compute shader compiled into pipelines that all bind one layout of buffers, the bind groups
+//! of whole buffers they take, and the structs shared with the shaders ([`shader_struct`]).
 
 /// A buffer binding of a compute shader: its type, and whether it takes a dynamic offset.
 pub(crate) type Binding = (wgpu::BufferBindingType, bool);
@@ -98,3 +98,46 @@ pub(crate) fn bind_buffers(
         entries: &entries,
     })
 }
+
+/// A struct the shaders read, declared once: the Rust struct (`#[repr(C)]`, plain old data) and,
+/// as `WGSL`, the shader's declaration of it (named `$wgsl`), which the shader's source takes in
+/// place of a marker, so that the two layouts cannot drift apart. Fields are `u32`, `i32`, `f32`
+/// or arrays of them, 4-byte aligned in both languages.
+macro_rules! shader_struct {
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $name:ident as $wgsl:ident {
+            $($(#[$field_meta:meta])* $field_vis:vis $field:ident: $ty:tt,)*
+        }
+    ) => {
+        $(#[$meta])*
+        #[repr(C)]
+        #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+        $vis struct $name {
+            $($(#[$field_meta])* $field_vis $field: $ty,)*
+        }
+
+        impl $name {
+            /// The shader's declaration of this struct.
+            pub(crate) const WGSL: &str = concat!(
+                "struct ",
+                stringify!($wgsl),
+                " {\n",
+                $("    ", stringify!($field), ": ", $crate::program::wgsl_type!($ty), ",\n",)*
+                "};\n"
+            );
+        }
+    };
+}
+pub(crate) use shader_struct;
+
+/// The WGSL spelling of a [`shader_struct`] field's type.
+macro_rules! wgsl_type {
+    ([$t:ident; $n:literal]) => {
+        concat!("array<", stringify!($t), ", ", stringify!($n), ">")
+    };
+    ($t:ident) => {
+        stringify!($t)
+    };
+}
+pub(crate) use wgsl_type;

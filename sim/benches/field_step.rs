@@ -71,28 +71,25 @@ struct Case {
     run: Box<dyn FnMut()>,
 }
 
+/// A case that runs `f` on its own `state`.
+fn case<T, U>(name: &'static str, mut state: T, f: fn(&mut U)) -> Case
+where
+    T: AsMut<U> + 'static,
+    U: ?Sized + 'static,
+{
+    Case {
+        name,
+        run: Box::new(move || f(black_box(&mut state).as_mut())),
+    }
+}
+
 fn cases() -> Vec<Case> {
-    let mut a = fields(3840, 2160, DiffusionScheme::Auto);
-    let mut b = fields(3840, 2160, DiffusionScheme::Implicit);
-    let mut c = floor_arrays();
-    let mut d = fields(640, 480, DiffusionScheme::Auto);
+    use DiffusionScheme::{Auto, Implicit};
     vec![
-        Case {
-            name: "4k_x3_auto_explicit",
-            run: Box::new(move || step_all(black_box(&mut a))),
-        },
-        Case {
-            name: "4k_x3_implicit",
-            run: Box::new(move || step_all(black_box(&mut b))),
-        },
-        Case {
-            name: "memory_floor_4k_x3",
-            run: Box::new(move || floor_pass(black_box(&mut c))),
-        },
-        Case {
-            name: "640x480_x3_auto",
-            run: Box::new(move || step_all(black_box(&mut d))),
-        },
+        case("4k_x3_auto_explicit", fields(3840, 2160, Auto), step_all),
+        case("4k_x3_implicit", fields(3840, 2160, Implicit), step_all),
+        case("memory_floor_4k_x3", floor_arrays(), floor_pass),
+        case("640x480_x3_auto", fields(640, 480, Auto), step_all),
     ]
 }
 

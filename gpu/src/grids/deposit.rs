@@ -2,8 +2,8 @@
 //! deposits are summed in the order given.
 use super::record::{Dispatch, Grown, Kind, MAX_GROUPS, PassUniform, groups};
 use super::{GpuGrids, Scratch};
+use crate::program::shader_struct;
 use crate::{GpuError, Result};
-use bytemuck::{Pod, Zeroable};
 use colcos_sim::field::{GridSpec, Kernel};
 use glam::Vec2;
 use rayon::prelude::*;
@@ -23,26 +23,28 @@ pub struct Deposit {
     pub amount: f32,
 }
 
-/// One deposit as the shader reads it: the cells of its box and the kernel's segment.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub(crate) struct DepRecord {
-    field: u32,
-    slot: u32,
-    i0: u32,
-    j0: u32,
-    w: u32,
-    h: u32,
-    kind: u32,
-    _pad: u32,
-    ax: f32,
-    ay: f32,
-    abx: f32,
-    aby: f32,
-    len2: f32,
-    support: f32,
-    param: f32,
-    amount: f32,
+shader_struct! {
+    /// One deposit as the shader reads it: the cells of its box and the kernel's segment.
+    pub(crate) struct DepRecord as Dep {
+        field: u32,
+        slot: u32,
+        i0: u32,
+        j0: u32,
+        w: u32,
+        h: u32,
+        /// 0 disc, 1 cone, 2 Gaussian.
+        kind: u32,
+        _pad: u32,
+        ax: f32,
+        ay: f32,
+        abx: f32,
+        aby: f32,
+        len2: f32,
+        support: f32,
+        /// Radius or sigma.
+        param: f32,
+        amount: f32,
+    }
 }
 
 const _: () = assert!(std::mem::size_of::<DepRecord>() == 64);

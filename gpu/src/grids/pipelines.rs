@@ -1,5 +1,6 @@
 //! The field shader, compiled once per device into one compute pipeline per pass kind.
-use super::record::Kind;
+use super::deposit::DepRecord;
+use super::record::{Kind, PassUniform, PlanEntry};
 use crate::program::{ComputeProgram, READ, WRITE};
 use crate::{GpuContext, Result};
 use std::sync::Arc;
@@ -30,7 +31,10 @@ fn field_source(f64: bool) -> String {
     } else {
         "fn kexp(x: f32) -> f32 { return exp(x); }".to_string()
     };
-    include_str!("../field.wgsl").replace("//KEXP//", &kexp)
+    let structs = [PlanEntry::WGSL, PassUniform::WGSL, DepRecord::WGSL].concat();
+    include_str!("../field.wgsl")
+        .replace("//STRUCTS//", &structs)
+        .replace("//KEXP//", &kexp)
 }
 
 impl FieldPipelines {

@@ -1,40 +1,45 @@
 //! Recording passes: the per-pass uniforms, the plan and deposit buffers, the bind group, and the one
 //! function that turns a list of dispatches into a submission.
 use super::GpuGrids;
+use crate::program::shader_struct;
 use crate::storage;
-use bytemuck::{Pod, Zeroable};
 
 /// Bytes between two dispatch uniforms (the dynamic-offset alignment wgpu guarantees to accept).
 pub(super) const UNIFORM_STRIDE: u64 = 256;
 /// Most workgroups along one dispatch dimension.
 pub(super) const MAX_GROUPS: u32 = 65535;
 
-/// What one field does in one pass (`on = 0`: nothing), as the shader reads it.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub(super) struct PlanEntry {
-    pub(super) on: u32,
-    pub(super) src: u32,
-    pub(super) inj: i32,
-    pub(super) coef: u32,
-    pub(super) a: f32,
-    pub(super) b: f32,
-    pub(super) r: f32,
-    pub(super) c: f32,
+shader_struct! {
+    /// What one field does in one pass (`on = 0`: nothing), as the shader reads it.
+    pub(super) struct PlanEntry as PF {
+        pub(super) on: u32,
+        pub(super) src: u32,
+        /// Offset of the field's static injection map in `inj`, or -1.
+        pub(super) inj: i32,
+        /// Offset of the field's Thomas coefficients in `coef`.
+        pub(super) coef: u32,
+        pub(super) a: f32,
+        pub(super) b: f32,
+        pub(super) r: f32,
+        pub(super) c: f32,
+    }
 }
 
-/// The uniform of one dispatch, at its own [`UNIFORM_STRIDE`] offset.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub(super) struct PassUniform {
-    pub(super) index: u32,
-    pub(super) nfields: u32,
-    pub(super) nx: u32,
-    pub(super) ny: u32,
-    pub(super) groups_x: u32,
-    pub(super) count: u32,
-    pub(super) cell: f32,
-    pub(super) _pad: u32,
+shader_struct! {
+    /// The uniform of one dispatch, at its own [`UNIFORM_STRIDE`] offset.
+    pub(super) struct PassUniform as Pass {
+        /// Row of the plan (`plan[index * nfields + f]`) or first deposit of a round.
+        pub(super) index: u32,
+        pub(super) nfields: u32,
+        pub(super) nx: u32,
+        pub(super) ny: u32,
+        /// Workgroups along x of the dispatch (linear ids fold x and y).
+        pub(super) groups_x: u32,
+        /// Deposits in the round.
+        pub(super) count: u32,
+        pub(super) cell: f32,
+        pub(super) _pad: u32,
+    }
 }
 
 // The shader's structs, byte for byte.

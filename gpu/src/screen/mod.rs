@@ -16,9 +16,8 @@ mod sense;
 pub use batch::{FootprintSets, SensorBatch};
 pub use sense::mean_levels;
 
-use crate::program::{ComputeProgram, READ, UNIFORM, WRITE, bind_buffers};
+use crate::program::{ComputeProgram, READ, UNIFORM, WRITE, bind_buffers, shader_struct};
 use crate::{GpuContext, GpuGrids, Result, storage};
-use bytemuck::{Pod, Zeroable};
 use colcos_sim::field::{FieldModel, GaussianSource, Pheromone};
 use colcos_sim::screen::ScreenSpec;
 use colcos_sim::sensors::RING_POINTS;
@@ -82,57 +81,68 @@ pub struct SensorQuery {
     pub points: [Vec2; POINTS_PER_SENSOR],
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-struct LayerRec {
-    kind: u32,
-    offset: u32,
-    count: u32,
-    _pad: u32,
-    k: [f32; 3],
-    time: f32,
+shader_struct! {
+    /// One pheromone layer of a world as the shader reads it.
+    struct LayerRec as Layer {
+        /// 0 grid, 1 Gaussian.
+        kind: u32,
+        /// Grid: offset of the field's values in `vals`; Gaussian: its first source.
+        offset: u32,
+        /// Gaussian: number of sources.
+        count: u32,
+        _pad: u32,
+        k: [f32; 3],
+        /// Gaussian: the field's clock.
+        time: f32,
+    }
+}
+
+shader_struct! {
+    /// One Gaussian source as the shader reads it.
+    struct SrcRec as Src {
+        k: f32,
+        sx: f32,
+        sy: f32,
+        rho: f32,
+        e: f32,
+        cx: f32,
+        cy: f32,
+        start: f32,
+        e_inf: u32,
+        _p: [u32; 3],
+    }
+}
+
+shader_struct! {
+    /// The uniform of a render or sensing dispatch.
+    struct Uni as U {
+        width: u32,
+        height: u32,
+        nlayers: u32,
+        nx: u32,
+        ny: u32,
+        groups_x: u32,
+        /// Sensors.
+        count: u32,
+        /// Render: which world's layers.
+        world: u32,
+        cell: f32,
+        /// Render: pixel size of the image, m.
+        px: f32,
+        py: f32,
+        /// Sensors: pixel size of the panel, m.
+        ps_x: f32,
+        ps_y: f32,
+        res_x: u32,
+        res_y: u32,
+        _pad: u32,
+    }
 }
 
 // The shader's structs, byte for byte.
 const _: () = assert!(std::mem::size_of::<LayerRec>() == 32);
 const _: () = assert!(std::mem::size_of::<SrcRec>() == 48);
 const _: () = assert!(std::mem::size_of::<Uni>() == 64);
-
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-struct SrcRec {
-    k: f32,
-    sx: f32,
-    sy: f32,
-    rho: f32,
-    e: f32,
-    cx: f32,
-    cy: f32,
-    start: f32,
-    e_inf: u32,
-    _p: [u32; 3],
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-struct Uni {
-    width: u32,
-    height: u32,
-    nlayers: u32,
-    nx: u32,
-    ny: u32,
-    groups_x: u32,
-    count: u32,
-    world: u32,
-    cell: f32,
-    px: f32,
-    py: f32,
-    ps_x: f32,
-    ps_y: f32,
-    res_x: u32,
-    res_y: u32,
-    _pad: u32,
-}
 
 /// exp in f64 arithmetic (WGSL's `exp` is f32/f16 only): Cody-Waite reduction, Taylor series to r^14;
 /// within a few f64 ulps, so rounded to f32 it is the correctly rounded `expf` (as glibc's, nearly always).
@@ -218,14 +228,15 @@ impl GpuScreen {
     }
 
     fn build(ctx: Arc<GpuContext>) -> Self {
-        let src = include_str!("screen.wgsl").replace(
-            "//GAUSS//",
-            &if ctx.f64 {
-                format!("{EXP64}{GAUSS_F64}")
-            } else {
-                GAUSS_F32.to_string()
-            },
-        );
+        let structs = [LayerRec::WGSL, SrcRec::WGSL, Uni::WGSL].concat();
+        let gauss = if ctx.f64 {
+            format!("{EXP64}{GAUSS_F64}")
+        } else {
+            GAUSS_F32.to_string()
+        };
+        let src = include_str!("screen.wgsl")
+            .replace("//STRUCTS//", &structs)
+            .replace("//GAUSS//", &gauss);
         let device = &ctx.device;
         let program = ComputeProgram::new(
             device,

@@ -2,50 +2,9 @@
 // sampling, with the same f32 operations as sim/src/screen.rs (`render`, `pixel_at`). Gaussian sources
 // (eq. 5) are evaluated in f64 like the CPU when the device has SHADER_F64 (GAUSS_F64 below).
 
-struct Layer {
-    kind: u32,      // 0 grid, 1 gaussian
-    offset: u32,    // grid: offset of the field's values in `vals`; gaussian: first source
-    count: u32,     // gaussian: number of sources
-    _pad: u32,
-    k0: f32,
-    k1: f32,
-    k2: f32,
-    time: f32,      // gaussian: the field's clock
-};
-
-struct Src {
-    k: f32,
-    sx: f32,
-    sy: f32,
-    rho: f32,
-    e: f32,
-    cx: f32,
-    cy: f32,
-    start: f32,
-    e_inf: u32,
-    _p0: u32,
-    _p1: u32,
-    _p2: u32,
-};
-
-struct U {
-    width: u32,
-    height: u32,
-    nlayers: u32,
-    nx: u32,
-    ny: u32,
-    groups_x: u32,
-    count: u32,     // sensors
-    world: u32,     // render: which world's layers
-    cell: f32,
-    px: f32,        // render: pixel size of the image, m
-    py: f32,
-    ps_x: f32,      // sensors: pixel size of the panel, m
-    ps_y: f32,
-    res_x: u32,
-    res_y: u32,
-    _pad: u32,
-};
+// The structs `Layer`, `Src` and `U` go in place of the marker below: `shader_struct!` writes them
+// from the Rust structs they are (`LayerRec`, `SrcRec`, `Uni` in screen/mod.rs).
+//STRUCTS//
 
 @group(0) @binding(0) var<storage, read> vals: array<f32>;
 @group(0) @binding(1) var<storage, read> layers: array<Layer>;
@@ -116,9 +75,9 @@ fn compose(first: u32, x: f32, y: f32) -> vec3<u32> {
     for (var j = 0u; j < u.nlayers; j = j + 1u) {
         let l = layers[first + j];
         let v = layer_value(l, x, y);
-        a0 = a0 + exact(l.k0 * v);
-        a1 = a1 + exact(l.k1 * v);
-        a2 = a2 + exact(l.k2 * v);
+        a0 = a0 + exact(l.k[0] * v);
+        a1 = a1 + exact(l.k[1] * v);
+        a2 = a2 + exact(l.k[2] * v);
     }
     return vec3<u32>(to_level(a0), to_level(a1), to_level(a2));
 }

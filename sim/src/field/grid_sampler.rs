@@ -95,48 +95,53 @@ impl<const N: usize> GridSampler<N> {
         const LANES: usize = 8;
         let whole = N / LANES * LANES;
         let p = v.as_ptr();
+        // Lanes `k..` of the points with one width's intrinsics: loads, corner indices, gathers,
+        // `bilinear_mix`'s three blends, store.
+        macro_rules! interpolate {
+            (
+                $k:expr; load = $load_i:ident, $load_f:ident, add = $add_i:ident,
+                gather = $gather:ident, blend = $add:ident, $sub:ident, $mul:ident,
+                store = $store:ident
+            ) => {{
+                let k = $k;
+                let load_i = |a: &[i32; N]| $load_i(a.as_ptr().add(k).cast());
+                let load_f = |a: &[f32; N]| $load_f(a.as_ptr().add(k));
+                let b = load_i(&self.base);
+                let b10 = $add_i(b, load_i(&self.step_x));
+                let b01 = $add_i(b, load_i(&self.step_y));
+                let b11 = $add_i(b01, load_i(&self.step_x));
+                let v00 = $gather::<4>(p, b);
+                let v10 = $gather::<4>(p, b10);
+                let v01 = $gather::<4>(p, b01);
+                let v11 = $gather::<4>(p, b11);
+                let (tx, ty) = (load_f(&self.tx), load_f(&self.ty));
+                let lo = $add(v00, $mul($sub(v10, v00), tx));
+                let hi = $add(v01, $mul($sub(v11, v01), tx));
+                let r = $add(lo, $mul($sub(hi, lo), ty));
+                $store(out.as_mut_ptr().add(k), r);
+            }};
+        }
         for k in (0..whole).step_by(LANES) {
             // SAFETY: `k + 8 <= N` for every array read and written; the corner indices are in
             // bounds (the caller's contract).
             unsafe {
-                let load_i = |a: &[i32; N]| _mm256_loadu_si256(a.as_ptr().add(k).cast());
-                let load_f = |a: &[f32; N]| _mm256_loadu_ps(a.as_ptr().add(k));
-                let b = load_i(&self.base);
-                let b10 = _mm256_add_epi32(b, load_i(&self.step_x));
-                let b01 = _mm256_add_epi32(b, load_i(&self.step_y));
-                let b11 = _mm256_add_epi32(b01, load_i(&self.step_x));
-                let v00 = _mm256_i32gather_ps::<4>(p, b);
-                let v10 = _mm256_i32gather_ps::<4>(p, b10);
-                let v01 = _mm256_i32gather_ps::<4>(p, b01);
-                let v11 = _mm256_i32gather_ps::<4>(p, b11);
-                let (tx, ty) = (load_f(&self.tx), load_f(&self.ty));
-                let lo = _mm256_add_ps(v00, _mm256_mul_ps(_mm256_sub_ps(v10, v00), tx));
-                let hi = _mm256_add_ps(v01, _mm256_mul_ps(_mm256_sub_ps(v11, v01), tx));
-                let r = _mm256_add_ps(lo, _mm256_mul_ps(_mm256_sub_ps(hi, lo), ty));
-                _mm256_storeu_ps(out.as_mut_ptr().add(k), r);
+                interpolate! {
+                    k; load = _mm256_loadu_si256, _mm256_loadu_ps, add = _mm256_add_epi32,
+                    gather = _mm256_i32gather_ps, blend = _mm256_add_ps, _mm256_sub_ps,
+                    _mm256_mul_ps, store = _mm256_storeu_ps
+                }
             }
         }
         // A four-point remainder (a robot's 36 footprint samples) in one 128-bit gather.
         let mut done = whole;
         if N - whole >= 4 {
-            let k = whole;
-            // SAFETY: as above, with `k + 4 <= N`.
+            // SAFETY: as above, with `whole + 4 <= N`.
             unsafe {
-                let load_i = |a: &[i32; N]| _mm_loadu_si128(a.as_ptr().add(k).cast());
-                let load_f = |a: &[f32; N]| _mm_loadu_ps(a.as_ptr().add(k));
-                let b = load_i(&self.base);
-                let b10 = _mm_add_epi32(b, load_i(&self.step_x));
-                let b01 = _mm_add_epi32(b, load_i(&self.step_y));
-                let b11 = _mm_add_epi32(b01, load_i(&self.step_x));
-                let v00 = _mm_i32gather_ps::<4>(p, b);
-                let v10 = _mm_i32gather_ps::<4>(p, b10);
-                let v01 = _mm_i32gather_ps::<4>(p, b01);
-                let v11 = _mm_i32gather_ps::<4>(p, b11);
-                let (tx, ty) = (load_f(&self.tx), load_f(&self.ty));
-                let lo = _mm_add_ps(v00, _mm_mul_ps(_mm_sub_ps(v10, v00), tx));
-                let hi = _mm_add_ps(v01, _mm_mul_ps(_mm_sub_ps(v11, v01), tx));
-                let r = _mm_add_ps(lo, _mm_mul_ps(_mm_sub_ps(hi, lo), ty));
-                _mm_storeu_ps(out.as_mut_ptr().add(k), r);
+                interpolate! {
+                    whole; load = _mm_loadu_si128, _mm_loadu_ps, add = _mm_add_epi32,
+                    gather = _mm_i32gather_ps, blend = _mm_add_ps, _mm_sub_ps, _mm_mul_ps,
+                    store = _mm_storeu_ps
+                }
             }
             done += 4;
         }

@@ -29,6 +29,8 @@ pub use grid_prefetch::GridPrefetcher;
 pub(crate) use grid_sampler::GridSampler;
 pub use kernel::Kernel;
 pub use nearby::NearbyPoints;
+#[cfg(test)]
+pub(crate) use pheromone::grid_and_gaussian;
 pub use pheromone::{FieldModel, Pheromone};
 pub use static_map::{image_map, polyline_map};
 pub use step_plan::{Diffusion, EXPLICIT_MAX_R, ONE_SIDED_MAX_S, StepPlan, WIND_MAX_CFL, Wind};

@@ -28,3 +28,25 @@ impl Pheromone {
         }
     }
 }
+
+/// A grid pheromone ("grid") and a Gaussian one ("gauss") drawn in `colours`: the pair of fields
+/// the screen's and the sensors' fast paths are checked on.
+#[cfg(test)]
+pub(crate) fn grid_and_gaussian(
+    grid: GridField,
+    gaussian: GaussianField,
+    colours: [[f32; 3]; 2],
+) -> [Pheromone; 2] {
+    [
+        Pheromone {
+            name: "grid".into(),
+            colour: colours[0],
+            model: FieldModel::Grid(grid),
+        },
+        Pheromone {
+            name: "gauss".into(),
+            colour: colours[1],
+            model: FieldModel::Gaussian(gaussian),
+        },
+    ]
+}

@@ -283,18 +283,8 @@ mod tests {
             ],
             time: 0.7,
         };
-        let ph = [
-            Pheromone {
-                name: "grid".into(),
-                colour: [180.0, 20.0, 0.0],
-                model: FieldModel::Grid(g),
-            },
-            Pheromone {
-                name: "gauss".into(),
-                colour: [0.0, 255.0, 0.0],
-                model: FieldModel::Gaussian(gaussian),
-            },
-        ];
+        let ph =
+            crate::field::grid_and_gaussian(g, gaussian, [[180.0, 20.0, 0.0], [0.0, 255.0, 0.0]]);
         let screen = ScreenSpec::default();
         let frozen = FrozenSources::new(&ph);
         let offsets: [Vec2; 9] = std::array::from_fn(|k| {

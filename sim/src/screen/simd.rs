@@ -233,63 +233,83 @@ unsafe fn row<L: Lanes>(terms: &[Term], products: &Products, out: &mut [MaybeUni
     }
 }
 
-struct Avx2;
+/// A [`Lanes`] of `$n` lanes in register `$f`: each operation one intrinsic (the AVX2 and AVX-512
+/// kinds differ only in their widths and in `$store`, their packing of the levels).
+macro_rules! lanes {
+    (
+        $name:ident: $n:literal of $f:ty, zero = $zero:ident, splat = $splat:ident,
+        load = $load:ident, add = $add:ident, sub = $sub:ident, mul = $mul:ident, store = $store:ident
+    ) => {
+        struct $name;
 
-impl Lanes for Avx2 {
-    const N: usize = 8;
-    type F = __m256;
-    #[inline(always)]
-    unsafe fn zero() -> __m256 {
-        unsafe { _mm256_setzero_ps() }
-    }
-    #[inline(always)]
-    unsafe fn splat(x: f32) -> __m256 {
-        unsafe { _mm256_set1_ps(x) }
-    }
-    #[inline(always)]
-    unsafe fn load(p: *const f32) -> __m256 {
-        unsafe { _mm256_loadu_ps(p) }
-    }
-    #[inline(always)]
-    unsafe fn add(a: __m256, b: __m256) -> __m256 {
-        unsafe { _mm256_add_ps(a, b) }
-    }
-    #[inline(always)]
-    unsafe fn sub(a: __m256, b: __m256) -> __m256 {
-        unsafe { _mm256_sub_ps(a, b) }
-    }
-    #[inline(always)]
-    unsafe fn mul(a: __m256, b: __m256) -> __m256 {
-        unsafe { _mm256_mul_ps(a, b) }
-    }
-    #[inline(always)]
-    unsafe fn store_rgb(acc: [__m256; 3], out: *mut u8, n: usize) {
-        unsafe {
-            let (r, g, b) = (
-                levels_avx2(acc[0]),
-                levels_avx2(acc[1]),
-                levels_avx2(acc[2]),
-            );
-            // Unsigned-saturating packs clip the levels to 0..=255 (negatives and NaN's i32::MIN to 0).
-            let rg = _mm256_packus_epi32(r, g);
-            let bytes = _mm256_packus_epi16(rg, _mm256_packus_epi32(b, b));
-            // Per 128-bit half: r0..r3 g0..g3 b0..b3 b0..b3 -> r0 g0 b0 r1 ... b3 and 4 spare bytes.
-            let shuffle = _mm256_setr_epi8(
-                0, 4, 8, 1, 5, 9, 2, 6, 10, 3, 7, 11, -1, -1, -1, -1, 0, 4, 8, 1, 5, 9, 2, 6, 10,
-                3, 7, 11, -1, -1, -1, -1,
-            );
-            let rgb = _mm256_shuffle_epi8(bytes, shuffle);
-            let mut tmp = [0u8; 32];
-            let to = if n == 8 { out } else { tmp.as_mut_ptr() };
-            _mm_storeu_si128(to.cast(), _mm256_castsi256_si128(rgb));
-            // 12 bytes only: the spare bytes of the first store get overwritten, nothing past.
-            let second = _mm256_extracti128_si256::<1>(rgb);
-            _mm_storel_epi64(to.add(12).cast(), second);
-            let last = _mm_extract_epi32::<2>(second) as u32;
-            std::ptr::copy_nonoverlapping(last.to_le_bytes().as_ptr(), to.add(20), 4);
-            if n < 8 {
-                std::ptr::copy_nonoverlapping(tmp.as_ptr(), out, 3 * n);
+        impl Lanes for $name {
+            const N: usize = $n;
+            type F = $f;
+            #[inline(always)]
+            unsafe fn zero() -> $f {
+                unsafe { $zero() }
             }
+            #[inline(always)]
+            unsafe fn splat(x: f32) -> $f {
+                unsafe { $splat(x) }
+            }
+            #[inline(always)]
+            unsafe fn load(p: *const f32) -> $f {
+                unsafe { $load(p) }
+            }
+            #[inline(always)]
+            unsafe fn add(a: $f, b: $f) -> $f {
+                unsafe { $add(a, b) }
+            }
+            #[inline(always)]
+            unsafe fn sub(a: $f, b: $f) -> $f {
+                unsafe { $sub(a, b) }
+            }
+            #[inline(always)]
+            unsafe fn mul(a: $f, b: $f) -> $f {
+                unsafe { $mul(a, b) }
+            }
+            #[inline(always)]
+            unsafe fn store_rgb(acc: [$f; 3], out: *mut u8, n: usize) {
+                unsafe { $store(acc, out, n) }
+            }
+        }
+    };
+}
+
+lanes! {
+    Avx2: 8 of __m256, zero = _mm256_setzero_ps, splat = _mm256_set1_ps, load = _mm256_loadu_ps,
+    add = _mm256_add_ps, sub = _mm256_sub_ps, mul = _mm256_mul_ps, store = store_rgb_avx2
+}
+
+/// [`Lanes::store_rgb`] of eight pixels.
+#[inline(always)]
+unsafe fn store_rgb_avx2(acc: [__m256; 3], out: *mut u8, n: usize) {
+    unsafe {
+        let (r, g, b) = (
+            levels_avx2(acc[0]),
+            levels_avx2(acc[1]),
+            levels_avx2(acc[2]),
+        );
+        // Unsigned-saturating packs clip the levels to 0..=255 (negatives and NaN's i32::MIN to 0).
+        let rg = _mm256_packus_epi32(r, g);
+        let bytes = _mm256_packus_epi16(rg, _mm256_packus_epi32(b, b));
+        // Per 128-bit half: r0..r3 g0..g3 b0..b3 b0..b3 -> r0 g0 b0 r1 ... b3 and 4 spare bytes.
+        let shuffle = _mm256_setr_epi8(
+            0, 4, 8, 1, 5, 9, 2, 6, 10, 3, 7, 11, -1, -1, -1, -1, 0, 4, 8, 1, 5, 9, 2, 6, 10, 3, 7,
+            11, -1, -1, -1, -1,
+        );
+        let rgb = _mm256_shuffle_epi8(bytes, shuffle);
+        let mut tmp = [0u8; 32];
+        let to = if n == 8 { out } else { tmp.as_mut_ptr() };
+        _mm_storeu_si128(to.cast(), _mm256_castsi256_si128(rgb));
+        // 12 bytes only: the spare bytes of the first store get overwritten, nothing past.
+        let second = _mm256_extracti128_si256::<1>(rgb);
+        _mm_storel_epi64(to.add(12).cast(), second);
+        let last = _mm_extract_epi32::<2>(second) as u32;
+        std::ptr::copy_nonoverlapping(last.to_le_bytes().as_ptr(), to.add(20), 4);
+        if n < 8 {
+            std::ptr::copy_nonoverlapping(tmp.as_ptr(), out, 3 * n);
         }
     }
 }
@@ -309,55 +329,32 @@ unsafe fn levels_avx2(x: __m256) -> __m256i {
     }
 }
 
-struct Avx512;
+lanes! {
+    Avx512: 16 of __m512, zero = _mm512_setzero_ps, splat = _mm512_set1_ps,
+    load = _mm512_loadu_ps, add = _mm512_add_ps, sub = _mm512_sub_ps, mul = _mm512_mul_ps,
+    store = store_rgb_avx512
+}
 
-impl Lanes for Avx512 {
-    const N: usize = 16;
-    type F = __m512;
-    #[inline(always)]
-    unsafe fn zero() -> __m512 {
-        unsafe { _mm512_setzero_ps() }
-    }
-    #[inline(always)]
-    unsafe fn splat(x: f32) -> __m512 {
-        unsafe { _mm512_set1_ps(x) }
-    }
-    #[inline(always)]
-    unsafe fn load(p: *const f32) -> __m512 {
-        unsafe { _mm512_loadu_ps(p) }
-    }
-    #[inline(always)]
-    unsafe fn add(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_add_ps(a, b) }
-    }
-    #[inline(always)]
-    unsafe fn sub(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_sub_ps(a, b) }
-    }
-    #[inline(always)]
-    unsafe fn mul(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_mul_ps(a, b) }
-    }
-    #[inline(always)]
-    unsafe fn store_rgb(acc: [__m512; 3], out: *mut u8, n: usize) {
-        unsafe {
-            // One byte a level: r, g, b, 16 apiece.
-            let r = _mm512_cvtepi32_epi8(levels_avx512(acc[0]));
-            let g = _mm512_cvtepi32_epi8(levels_avx512(acc[1]));
-            let b = _mm512_cvtepi32_epi8(levels_avx512(acc[2]));
-            let planes =
-                _mm512_inserti32x4::<2>(_mm512_inserti32x4::<1>(_mm512_castsi128_si512(r), g), b);
-            // Byte 3 i + c of the pixels is byte 16 c + i of the planes.
-            let index = _mm512_set_epi8(
-                0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, //
-                47, 31, 15, 46, 30, 14, 45, 29, 13, 44, 28, 12, 43, 27, 11, 42, //
-                26, 10, 41, 25, 9, 40, 24, 8, 39, 23, 7, 38, 22, 6, 37, 21, //
-                5, 36, 20, 4, 35, 19, 3, 34, 18, 2, 33, 17, 1, 32, 16, 0,
-            );
-            let rgb = _mm512_permutexvar_epi8(index, planes);
-            let mask = (1u64 << (3 * n)) - 1;
-            _mm512_mask_storeu_epi8(out.cast(), mask, rgb);
-        }
+/// [`Lanes::store_rgb`] of sixteen pixels.
+#[inline(always)]
+unsafe fn store_rgb_avx512(acc: [__m512; 3], out: *mut u8, n: usize) {
+    unsafe {
+        // One byte a level: r, g, b, 16 apiece.
+        let r = _mm512_cvtepi32_epi8(levels_avx512(acc[0]));
+        let g = _mm512_cvtepi32_epi8(levels_avx512(acc[1]));
+        let b = _mm512_cvtepi32_epi8(levels_avx512(acc[2]));
+        let planes =
+            _mm512_inserti32x4::<2>(_mm512_inserti32x4::<1>(_mm512_castsi128_si512(r), g), b);
+        // Byte 3 i + c of the pixels is byte 16 c + i of the planes.
+        let index = _mm512_set_epi8(
+            0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, //
+            47, 31, 15, 46, 30, 14, 45, 29, 13, 44, 28, 12, 43, 27, 11, 42, //
+            26, 10, 41, 25, 9, 40, 24, 8, 39, 23, 7, 38, 22, 6, 37, 21, //
+            5, 36, 20, 4, 35, 19, 3, 34, 18, 2, 33, 17, 1, 32, 16, 0,
+        );
+        let rgb = _mm512_permutexvar_epi8(index, planes);
+        let mask = (1u64 << (3 * n)) - 1;
+        _mm512_mask_storeu_epi8(out.cast(), mask, rgb);
     }
 }
 

@@ -15,12 +15,13 @@ use lanes::{LANES, matrix_lanes};
 
 mod lanes;
 mod robot;
+mod view;
+pub use view::ScreenView;
+
 use crate::arena::Printed;
 use crate::field::{FrozenSources, Pheromone};
 use crate::rng::SimRng;
-use crate::screen::{
-    FOOTPRINT_LANES, FootprintLevels, FootprintSamples, ScreenSpec, footprint_levels,
-};
+use crate::screen::{FOOTPRINT_LANES, FootprintLevels, FootprintSamples, ScreenSpec};
 use glam::Vec2;
 use serde::{Deserialize, Serialize};
 use std::sync::{Arc, Mutex};
@@ -228,18 +229,30 @@ impl ColourSensor {
         printed: Option<&Printed>,
         sensors: &[Vec2; S],
     ) -> [[u32; 3]; S] {
-        let levels =
-            |samples: &FootprintSamples| footprint_levels(pheromones, frozen, screen, samples);
-        self.footprint_sums_with(screen, printed, sensors, levels)
+        let view = ScreenView {
+            pheromones,
+            frozen,
+            screen,
+            printed,
+        };
+        self.footprint_sums_in(&view, sensors)
     }
 
-    /// [`ColourSensor::footprint_sums_printed`] with the screen's levels from `levels` (one of
-    /// [`footprint_levels`]'s implementations), inlined into its caller.
+    /// [`ColourSensor::footprint_sums_printed`] of the screen `view` shows.
+    #[inline]
+    pub fn footprint_sums_in<const S: usize>(
+        &self,
+        view: &ScreenView,
+        sensors: &[Vec2; S],
+    ) -> [[u32; 3]; S] {
+        self.footprint_sums_with(sensors, |samples| view.levels(samples))
+    }
+
+    /// [`ColourSensor::footprint_sums_in`] with the screen's levels from `levels` (one of
+    /// [`ScreenView::levels`]'s implementations), inlined into its caller.
     #[inline(always)]
     fn footprint_sums_with<const S: usize>(
         &self,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
         sensors: &[Vec2; S],
         levels: impl Fn(&FootprintSamples) -> FootprintLevels,
     ) -> [[u32; 3]; S] {
@@ -248,11 +261,7 @@ impl ColourSensor {
         const BATCH: usize = 4;
         let mut sums = [[0u32; 3]; S];
         for (sensors, sums) in sensors.chunks(BATCH).zip(sums.chunks_mut(BATCH)) {
-            let samples = self.footprint_samples(sensors);
-            let mut levels = levels(&samples);
-            if let Some(printed) = printed {
-                paint_printed(screen, printed, &samples, &mut levels);
-            }
+            let levels = levels(&self.footprint_samples(sensors));
             // A footprint's nine levels as eight (one vector reduction) and one.
             for (c, levels) in levels.iter().enumerate() {
                 for (s, sum) in sums.iter_mut().enumerate() {
@@ -336,7 +345,24 @@ impl ColourSensor {
         sensors: &[Vec2; S],
         rng: &mut SimRng,
     ) -> [[u16; 3]; S] {
-        let sums = self.footprint_sums_printed(pheromones, frozen, screen, printed, sensors);
+        let view = ScreenView {
+            pheromones,
+            frozen,
+            screen,
+            printed,
+        };
+        self.read_all_in(&view, sensors, rng)
+    }
+
+    /// [`ColourSensor::read_all_printed`] of the screen `view` shows.
+    #[inline(always)]
+    pub fn read_all_in<const S: usize>(
+        &self,
+        view: &ScreenView,
+        sensors: &[Vec2; S],
+        rng: &mut SimRng,
+    ) -> [[u16; 3]; S] {
+        let sums = self.footprint_sums_in(view, sensors);
         let lut = &self.light_by_sum;
         let light = sums.map(|sum| sum.map(|s| lut[s as usize]));
         self.counts_for_lights(&light, rng)
@@ -359,27 +385,6 @@ impl ColourSensor {
     /// saturation at 65535.
     pub fn counts(&self, levels: [f32; 3], rng: &mut SimRng) -> [u16; 3] {
         self.counts_for_lights(&[self.light(levels)], rng)[0]
-    }
-}
-
-/// Printed obstacles drawn over the pheromones at the footprints' 36 samples.
-fn paint_printed(
-    screen: &ScreenSpec,
-    printed: &Printed,
-    samples: &FootprintSamples,
-    levels: &mut FootprintLevels,
-) {
-    let points = samples
-        .xs
-        .iter()
-        .zip(&samples.ys)
-        .take(4 * FOOTPRINT_POINTS);
-    for (k, (&x, &y)) in points.enumerate() {
-        if let Some(c) = printed.colour_at(screen, Vec2::new(x, y)) {
-            for (ch, v) in c.iter().enumerate() {
-                levels[ch][k] = *v as u32;
-            }
-        }
     }
 }
 
@@ -468,7 +473,7 @@ mod tests {
     /// A grid field and two Gaussian sources, one narrow enough that footprints take their own `exp`:
     /// the fields the batched reads are checked on (here and in `robot`).
     pub(super) fn grid_and_gaussians(g: crate::field::GridField) -> [Pheromone; 2] {
-        use crate::field::{FieldModel, GaussianField, GaussianSource};
+        use crate::field::{GaussianField, GaussianSource};
         let source = |sigma: f32, centre: Vec2| GaussianSource {
             k: 0.3,
             sigma_x: sigma,
@@ -485,18 +490,7 @@ mod tests {
             ],
             time: 1.0,
         };
-        [
-            Pheromone {
-                name: "grid".into(),
-                colour: [200.0, 0.0, 60.0],
-                model: FieldModel::Grid(g),
-            },
-            Pheromone {
-                name: "gauss".into(),
-                colour: [0.0, 255.0, 90.0],
-                model: FieldModel::Gaussian(gaussian),
-            },
-        ]
+        crate::field::grid_and_gaussian(g, gaussian, [[200.0, 0.0, 60.0], [0.0, 255.0, 90.0]])
     }
 
     /// A robot's four sensors read together give what four single reads give, random draws included,

@@ -11,7 +11,9 @@ mod pow_unit;
 pub use crate::spatial::NeighbourIndex;
 pub use bumper::{BumperParams, BumperRays, ray_disc, ray_walls, reading_for_distance};
 pub use calibration::{ColourCalibration, RobotColour, SensorFit};
-pub use colour::{ColourSensor, ColourSensorParams, RING_FRACTION, RING_POINTS, invert3};
+pub use colour::{
+    ColourSensor, ColourSensorParams, RING_FRACTION, RING_POINTS, ScreenView, invert3,
+};
 pub use frame::frame_pixel;
 pub use layout::{SENSOR_RADIUS, sensor_positions, sensor_positions_facing};
 pub use pow_unit::pow_unit;

@@ -8,7 +8,7 @@ use crate::robot::Pose;
 use crate::screen::ScreenSpec;
 use crate::sensors::{
     BumperParams, BumperRays, ColourCalibration, ColourSensor, ColourSensorParams, NeighbourIndex,
-    SENSOR_RADIUS, sensor_positions_facing,
+    SENSOR_RADIUS, ScreenView, sensor_positions_facing,
 };
 use glam::Vec2;
 use rayon::prelude::*;
@@ -213,7 +213,12 @@ fn sense_with(
     let colour_unread = &sensing.colour_unread;
     let (radius, arena) = (sensing.radius, sensing.arena);
     let obstacles = &*sensing.obstacles;
-    let printed = obstacles.printed();
+    let view = ScreenView {
+        pheromones,
+        frozen,
+        screen,
+        printed: obstacles.printed(),
+    };
     let prefetcher = GridPrefetcher::new(pheromones);
     let sense = |(i, (slot, obs)): (usize, (&mut RobotSlot, &mut Observation))| {
         // The grid cells under the next robot's sensors are scattered over large fields: ask for
@@ -233,15 +238,8 @@ fn sense_with(
             Some(own) => {
                 // The four footprints in one batched pass (they are all the drawn `[sensor]`
                 // section's), then each sensor's own model in order: the same draws as `read_all`'s.
-                let sums = given.unwrap_or_else(|| {
-                    own.truth[0].footprint_sums_printed(
-                        pheromones,
-                        frozen,
-                        screen,
-                        printed,
-                        &sensor_points[i],
-                    )
-                });
+                let sums = given
+                    .unwrap_or_else(|| own.truth[0].footprint_sums_in(&view, &sensor_points[i]));
                 for (k, sum) in sums.into_iter().enumerate() {
                     let c = own.truth[k].counts_of_sum(sum, &mut slot.rng);
                     o.counts[k] = c;
@@ -252,14 +250,7 @@ fn sense_with(
             None => {
                 (o.counts, o.intensity) = match &given {
                     Some(sums) => sensor.read_robot_from_sums(sums, &mut slot.rng),
-                    None => sensor.read_robot(
-                        pheromones,
-                        frozen,
-                        screen,
-                        printed,
-                        &sensor_points[i],
-                        &mut slot.rng,
-                    ),
+                    None => sensor.read_robot(&view, &sensor_points[i], &mut slot.rng),
                 };
             }
         }

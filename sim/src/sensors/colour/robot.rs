@@ -4,11 +4,9 @@
 //! reductions before), the table read by gathers, the light laid out in the counts' lanes directly.
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{LANE_SENSORS, LANES, lane};
-use super::{ColourSensor, FOOTPRINT_POINTS};
-use crate::arena::Printed;
-use crate::field::{FrozenSources, Pheromone};
+use super::{ColourSensor, FOOTPRINT_POINTS, ScreenView};
 use crate::rng::SimRng;
-use crate::screen::{FootprintLevels, FootprintSamples, ScreenSpec, footprint_levels};
+use crate::screen::{FootprintLevels, FootprintSamples};
 use glam::Vec2;
 
 impl ColourSensor {
@@ -18,39 +16,26 @@ impl ColourSensor {
     /// in wider registers.
     pub fn read_robot(
         &self,
-        pheromones: &[Pheromone],
-        frozen: &FrozenSources,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
+        view: &ScreenView,
         sensors: &[Vec2; 4],
         rng: &mut SimRng,
     ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2.
-            return unsafe {
-                self.read_robot_avx2(pheromones, frozen, screen, printed, sensors, rng)
-            };
+            return unsafe { self.read_robot_avx2(view, sensors, rng) };
         }
-        self.read_robot_portable(pheromones, frozen, screen, printed, sensors, rng)
+        self.read_robot_portable(view, sensors, rng)
     }
 
     /// [`ColourSensor::read_robot`] for any processor.
     fn read_robot_portable(
         &self,
-        pheromones: &[Pheromone],
-        frozen: &FrozenSources,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
+        view: &ScreenView,
         sensors: &[Vec2; 4],
         rng: &mut SimRng,
     ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
-        let levels =
-            |samples: &FootprintSamples| footprint_levels(pheromones, frozen, screen, samples);
-        let sums = self.footprint_sums_with(screen, printed, sensors, levels);
-        let lut = &self.light_by_sum;
-        let light = sums.map(|sum| sum.map(|s| lut[s as usize]));
-        let counts = self.counts_for_lights(&light, rng);
+        let counts = self.read_all_in(view, sensors, rng);
         (counts, self.intensities_inline(&counts))
     }
 
@@ -62,10 +47,7 @@ impl ColourSensor {
     #[target_feature(enable = "avx2")]
     unsafe fn read_robot_avx2(
         &self,
-        pheromones: &[Pheromone],
-        frozen: &FrozenSources,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
+        view: &ScreenView,
         sensors: &[Vec2; 4],
         rng: &mut SimRng,
     ) -> ([[u16; 3]; 4], [[f32; 3]; 4]) {
@@ -73,11 +55,7 @@ impl ColourSensor {
         // SAFETY: the CPU has AVX2.
         let samples = unsafe { self.footprint_samples_avx2(sensors) };
         // SAFETY: the CPU has AVX2 (this function's contract).
-        let mut levels =
-            unsafe { crate::screen::footprint_levels_avx2(pheromones, frozen, screen, &samples) };
-        if let Some(printed) = printed {
-            super::paint_printed(screen, printed, &samples, &mut levels);
-        }
+        let levels = unsafe { view.levels_avx2(&samples) };
         // SAFETY: the CPU has AVX2.
         let sums = unsafe { footprint_sums_avx2(&levels) };
         // The light of each channel's four sums from the table, repeated in every channel's lanes
@@ -203,8 +181,14 @@ mod tests {
             0.024,
             |k| (k as f32 * 0.37).sin().abs() * 1.2,
         ));
-        let screen = ScreenSpec::default();
-        let frozen = FrozenSources::new(&ph);
+        let screen = crate::screen::ScreenSpec::default();
+        let frozen = crate::field::FrozenSources::new(&ph);
+        let view = ScreenView {
+            pheromones: &ph,
+            frozen: &frozen,
+            screen: &screen,
+            printed: None,
+        };
         let s = ColourSensor::new(super::super::ColourSensorParams {
             noise: 3.0,
             ..Default::default()
@@ -225,8 +209,8 @@ mod tests {
             let want = s.footprint_samples(&sensors);
             assert_eq!((lanes.xs, lanes.ys), (want.xs, want.ys));
             // SAFETY: the CPU has AVX2 (checked above).
-            let got = unsafe { s.read_robot_avx2(&ph, &frozen, &screen, None, &sensors, &mut a) };
-            let want = s.read_robot_portable(&ph, &frozen, &screen, None, &sensors, &mut b);
+            let got = unsafe { s.read_robot_avx2(&view, &sensors, &mut a) };
+            let want = s.read_robot_portable(&view, &sensors, &mut b);
             assert_eq!(got.0, want.0, "at {c}");
             assert_eq!(
                 got.1.map(|v| v.map(f32::to_bits)),
