@@ -2,6 +2,7 @@
 use colcos::run::{RunOptions, run};
 use colcos::sim::prelude::*;
 use colcos_testkit::scenarios::large_swarm;
+use colcos_testkit::threads::on_threads;
 
 /// Enough robots and a large enough grid that the parallel paths (robots and field rows) are taken.
 fn scenario() -> Scenario {
@@ -15,11 +16,7 @@ fn scenario() -> Scenario {
 fn run_with_threads(threads: usize) -> (Vec<u8>, Vec<u8>) {
     let sc = scenario();
     let dir = tempfile::tempdir().unwrap();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    on_threads(threads, || {
         run(
             &sc,
             dir.path(),

@@ -1,6 +1,7 @@
 //! `colcos experiment all` through the library with a few short trials: every file is written and the
 //! numbers have the right shape.
 use colcos::experiment::{Options, Which, run};
+use colcos_testkit::threads::on_threads;
 
 #[test]
 fn a_few_trials_of_each_case_write_every_file() {
@@ -69,11 +70,7 @@ fn results_do_not_depend_on_the_thread_count() {
     let mut opts = Options::new(Which::Case1, dir.path());
     opts.trials = 3;
     let a = run(&opts).unwrap().case1.unwrap();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap();
-    let b = pool.install(|| run(&opts).unwrap().case1.unwrap());
+    let b = on_threads(1, || run(&opts).unwrap().case1.unwrap());
     for (x, y) in a.groups.iter().zip(&b.groups) {
         assert_eq!(x.counts, y.counts);
     }
