@@ -14,6 +14,8 @@ wall time and the references. Needs `benchmarl` (python-tests/requirements-bench
 PPO (`examples/ppo.py`) instead of BenchMARL's defaults: batches of `--horizon` 64 steps of every
 world, 4 passes of 4 minibatches over each, learning rate 1e-3, gamma 0.98, GAE lambda 0.95,
 gradients clipped at 0.5 (docs/training.md: on `aggregation` MAPPO learned no better with them).
+`--set KEY=VALUE` sets any field of the algorithm's BenchMARL config (`--set use_tanh_normal=false
+--set entropy_coef=0.01`), typed as its default; an unknown field is refused, listing the known ones.
 """
 
 from __future__ import annotations
@@ -116,6 +118,24 @@ def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> Experiment
     return cfg
 
 
+def algorithm_setting(algorithm: str, text: str) -> tuple[str, Any]:
+    """`KEY=VALUE` for a field of the algorithm's BenchMARL config, the value parsed as the field's
+    default is typed; an unknown field or a value of the wrong kind is refused, naming it."""
+    key, sep, value = text.partition("=")
+    defaults = vars(ALGORITHMS[algorithm].get_from_yaml())
+    if not sep or key not in defaults:
+        raise ValueError(f"--set {text!r}: expected KEY=VALUE with KEY one of {algorithm}'s settings {sorted(defaults)}")
+    default = defaults[key]
+    if isinstance(default, bool):
+        if value.lower() not in ("true", "false"):
+            raise ValueError(f"--set {text!r}: {key} takes true or false")
+        return key, value.lower() == "true"
+    try:
+        return key, type(default)(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"--set {text!r}: {key} takes a {type(default).__name__} like {default!r}") from None
+
+
 def ppo_settings(args: argparse.Namespace) -> bool:
     """Whether this run takes examples/ppo.py's settings instead of BenchMARL's defaults."""
     return args.algorithm in ON_POLICY and args.ppo_settings and not args.tiny
@@ -127,6 +147,8 @@ def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any
     algorithm = ALGORITHMS[args.algorithm].get_from_yaml()
     if ppo_settings(args):
         algorithm.lmbda = 0.95
+    for key, value in args.set:
+        setattr(algorithm, key, value)
     t0 = time.time()
     experiment = Experiment(
         task=task,
@@ -169,12 +191,18 @@ def main() -> None:
     p.add_argument("--tiny", action="store_true", help="one small iteration (a check that it runs)")
     p.add_argument("--threads", type=int, default=1, help="torch threads")
     p.add_argument("--lr", type=float, default=None, help="learning rate (BenchMARL's default: 5e-5)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="a setting of the algorithm's BenchMARL config, e.g. use_tanh_normal=false or entropy_coef=0.01 (repeatable)")
     p.add_argument("--out", default="runs/benchmarl")
     args = p.parse_args()
     if args.algorithm not in ALGORITHMS:
         p.error(f"--algorithm {args.algorithm!r}: one of {sorted(ALGORITHMS)}")
     if args.task not in colcos.tasks():
         p.error(f"--task {args.task!r}: one of {sorted(colcos.tasks())}")
+    try:
+        args.set = [algorithm_setting(args.algorithm, kv) for kv in args.set]
+    except ValueError as e:
+        p.error(str(e))
     if args.tiny:
         args.worlds, args.max_steps, args.eval_episodes = 2, 20, 1
     if args.horizon < 1:
@@ -196,7 +224,7 @@ def main() -> None:
     finals = [r["final_return"] for r in runs if r["final_return"] is not None]
     summary = {"algorithm": args.algorithm, "task": args.task, "continuous": not args.discrete,
                "settings": "examples/ppo.py" if ppo_settings(args) else "BenchMARL defaults",
-               "frames": args.frames, "runs": runs, "references": refs}
+               "algorithm_settings": dict(args.set), "frames": args.frames, "runs": runs, "references": refs}
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     print(f"{args.algorithm} on {args.task} ({'discrete' if args.discrete else 'continuous'}), {args.frames} frames:")
     for r in runs:

@@ -96,3 +96,15 @@ def test_ppo_settings_replace_benchmarls_defaults_for_on_policy_runs(tmp_path):
     assert example.experiment_config(args, tmp_path).lr == 3e-4
     args.lr, args.algorithm = None, "masac"  # off-policy: BenchMARL's own settings
     assert not example.ppo_settings(args) and example.experiment_config(args, tmp_path).lr == 5e-5
+
+
+def test_algorithm_settings_are_typed_and_unknown_ones_refused():
+    example = _example()
+    assert example.algorithm_setting("mappo", "use_tanh_normal=false") == ("use_tanh_normal", False)
+    assert example.algorithm_setting("mappo", "entropy_coef=0.01") == ("entropy_coef", 0.01)
+    for bad, named in (("use_tanh=false", "use_tanh"), ("use_tanh_normal=maybe", "true or false"),
+                       ("clip_epsilon=wide", "float"), ("entropy_coef", "KEY=VALUE")):
+        with pytest.raises(ValueError, match=named):
+            example.algorithm_setting("mappo", bad)
+    done = subprocess.run([sys.executable, str(EXAMPLE), "--set", "nope=1", "--tiny"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and "nope" in done.stderr and "clip_epsilon" in done.stderr, done.stderr
