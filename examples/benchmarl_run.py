@@ -126,6 +126,13 @@ def algorithm_setting(algorithm: str, text: str) -> tuple[str, Any]:
     if not sep or key not in defaults:
         raise ValueError(f"--set {text!r}: expected KEY=VALUE with KEY one of {algorithm}'s settings {sorted(defaults)}")
     default = defaults[key]
+    if default is None:  # an optional number (MASAC's min_alpha, max_alpha)
+        if value.lower() in ("null", "none"):
+            return key, None
+        try:
+            return key, float(value)
+        except ValueError:
+            raise ValueError(f"--set {text!r}: {key} takes a number or null") from None
     if isinstance(default, bool):
         if value.lower() not in ("true", "false"):
             raise ValueError(f"--set {text!r}: {key} takes true or false")

@@ -102,6 +102,10 @@ def test_algorithm_settings_are_typed_and_unknown_ones_refused():
     example = _example()
     assert example.algorithm_setting("mappo", "use_tanh_normal=false") == ("use_tanh_normal", False)
     assert example.algorithm_setting("mappo", "entropy_coef=0.01") == ("entropy_coef", 0.01)
+    assert example.algorithm_setting("masac", "min_alpha=0.05") == ("min_alpha", 0.05)
+    assert example.algorithm_setting("masac", "max_alpha=null") == ("max_alpha", None)
+    with pytest.raises(ValueError, match="number or null"):
+        example.algorithm_setting("masac", "min_alpha=low")
     for bad, named in (("use_tanh=false", "use_tanh"), ("use_tanh_normal=maybe", "true or false"),
                        ("clip_epsilon=wide", "float"), ("entropy_coef", "KEY=VALUE")):
         with pytest.raises(ValueError, match=named):

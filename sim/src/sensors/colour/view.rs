@@ -41,8 +41,7 @@ impl ScreenView<'_> {
         self.painted(samples, levels)
     }
 
-    /// `levels` with the printed obstacles drawn over them (the drawing out of line: most arenas
-    /// print none).
+    /// `levels` with the printed obstacles drawn over them, if the arena prints any.
     #[inline(always)]
     fn painted(&self, samples: &FootprintSamples, mut levels: FootprintLevels) -> FootprintLevels {
         if let Some(printed) = self.printed {
