@@ -211,6 +211,9 @@ class Config:
     anchor: float = 0.0  # weight of a term keeping the actor's mean near the one `Trainer.set_anchor` froze
     actor_warmup: int = 0  # the first N updates train only the critic (an actor that starts good, e.g. kickstarted, keeps still)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
+    # Clip the actor's and the critic's gradients to norm 0.5 each, instead of one norm over both (where a
+    # large critic error shrinks the actor's step with it).
+    clip_apart: bool = False
     start_forward: float = 0.0  # the untrained actor's mean for both wheels: > 0 drives forward, an exploration prior
     start_lay: float = 0.0  # the untrained actor's mean for the outputs after the wheels (deposit rates): < 0 lays rarely
     # Biases for learned communication (Eccles et al. 2019, "Biases for emergent communication in multi-agent
@@ -223,6 +226,15 @@ class Config:
     message_inputs: tuple[int, ...] = ()
     message_output: int = 2
     message_threshold: float = 0.5
+
+
+def clip_gradients(model: ActorCritic, apart: bool, norm: float = 0.5) -> None:
+    """Clips the gradients to `norm`: one norm over actor and critic, or (`apart`) each its own."""
+    if apart:
+        nn.utils.clip_grad_norm_([*model.pi.parameters(), model.log_std], norm)
+        nn.utils.clip_grad_norm_(model.v.parameters(), norm)
+    else:
+        nn.utils.clip_grad_norm_(model.parameters(), norm)
 
 
 def clip_wheels(a: np.ndarray) -> np.ndarray:
@@ -372,7 +384,7 @@ class Trainer:
                     loss = 0.5 * vloss
                 self.opt.zero_grad()
                 loss.backward()
-                nn.utils.clip_grad_norm_(model.parameters(), 0.5)
+                clip_gradients(model, cfg.clip_apart)
                 self.opt.step()
 
 

@@ -2,7 +2,8 @@
 
 All followers of all worlds share one policy (`examples/ppo.py`); each (world, follower) pair is one
 sample stream. The actor sees only the follower's own 17 sensor values; the critic (used only in
-training) also sees the global state and which follower it is. The budget is a number of PPO updates,
+training) also sees the global state and which follower it is; the actor's and the critic's
+gradients are clipped each to its own norm (`ppo.Config.clip_apart`). The budget is a number of PPO updates,
 so a loaded machine changes how long a run takes, not what it learns. Every `--eval-every` updates the
 deterministic policy is evaluated on the same 32 seeded episodes as the paper's hand-written follower
 (evaluation time is not counted as training time). With several `--seeds` it trains one policy per
@@ -55,7 +56,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
-                     agent_id=args.agent_id, history=args.history)
+                     agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together)
     trainer = ppo.Trainer(env, cfg, seed)
     evaluate = lambda: round(ppo.evaluate(lambda v: trainer.model.policy(), env_kwargs, args.eval_worlds, args.episode, args.eval_seed), 2)
     curve: list[tuple[float, int, int, float]] = [(0.0, 0, 0, evaluate())]
@@ -136,6 +137,8 @@ def main() -> None:
     p.add_argument("--minibatches", type=int, default=4)
     p.add_argument("--lr", type=float, default=1e-3)
     p.add_argument("--anneal", action="store_true", help="the learning rate falls linearly to 0 over --updates")
+    p.add_argument("--clip-together", action="store_true",
+                   help="clip actor and critic gradients as one norm (by default each its own: ppo.Config.clip_apart)")
     p.add_argument("--team-critic", action="store_true", help="the critic also sees every follower's observation")
     p.add_argument("--agent-id", action="store_true",
                    help="the actor also sees which follower it drives (a one-hot): one policy, each robot its own way")

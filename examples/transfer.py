@@ -88,6 +88,7 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     flags = ["--anneal"] if args.anneal and args.updates else []
     flags += ["--agent-id"] if args.agent_id else []
     flags += ["--history", str(args.history)]
+    flags += ["--clip-together"]  # the study in docs/transfer.md trained with one gradient norm
     for seed in args.seeds:
         for name in VARIANTS:
             d = os.path.join(args.out, f"{name}-s{seed}")

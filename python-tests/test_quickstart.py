@@ -63,6 +63,25 @@ def test_the_team_critic_sees_every_agents_observation():
     assert trainer.c == ppo.critic_dim(env, team=True) == ppo.critic_dim(env) + env.num_agents * 17
 
 
+def test_clipping_apart_keeps_a_large_critic_gradient_from_shrinking_the_actors():
+    torch = pytest.importorskip("torch")
+    ppo = load_ppo()
+    actor_norm = {}
+    for apart in (False, True):
+        model = ppo.ActorCritic(17, 20)
+        for q in model.parameters():
+            q.grad = torch.zeros_like(q)
+        model.log_std.grad = torch.tensor([0.3, 0.0])  # the actor's gradient: norm 0.3
+        first = next(model.v.parameters())
+        first.grad = torch.zeros_like(first)
+        first.grad.view(-1)[0] = 100.0  # the critic's: norm 100
+        ppo.clip_gradients(model, apart)
+        actor_norm[apart] = float(torch.cat([q.grad.flatten() for q in [*model.pi.parameters(), model.log_std]]).norm())
+        assert float(first.grad.norm()) == pytest.approx(0.5, rel=1e-3)
+    assert actor_norm[True] == pytest.approx(0.3, rel=1e-5)
+    assert actor_norm[False] == pytest.approx(0.3 * 0.5 / (100**2 + 0.3**2) ** 0.5, rel=1e-3)
+
+
 def test_start_forward_and_start_lay_set_the_untrained_means_of_their_outputs():
     torch = pytest.importorskip("torch")
     from colcos.vector import VecEnv
