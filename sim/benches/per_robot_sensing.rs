@@ -106,7 +106,7 @@ fn main() {
     let floor = timed(|| {
         let mut s = 0;
         for p in &points {
-            let c = shared.read_all_printed(pheromones, &frozen, screen, None, p, &mut rng);
+            let c = shared.read_all(pheromones, &frozen, screen, p, &mut rng);
             s += c.into_iter().map(sum).sum::<u64>();
         }
         s
@@ -119,8 +119,7 @@ fn main() {
             .map(|i| {
                 std::array::from_fn(|k| {
                     let (q, own) = (points[i][k], own(i));
-                    let c =
-                        own.truth[k].read_all_printed(pheromones, &frozen, screen, None, &[q], rng);
+                    let c = own.truth[k].read_all(pheromones, &frozen, screen, &[q], rng);
                     (c[0], own.inverse[k].intensity(c[0]))
                 })
             })
@@ -130,8 +129,7 @@ fn main() {
         (0..points.len())
             .map(|i| {
                 let own = world.robot_sensors(i).unwrap();
-                let sums = own.truth[0]
-                    .footprint_sums_printed(pheromones, &frozen, screen, None, &points[i]);
+                let sums = own.truth[0].footprint_sums(pheromones, &frozen, screen, &points[i]);
                 std::array::from_fn(|k| {
                     let c = own.truth[k].counts_of_sum(sums[k], rng);
                     (c, own.inverse[k].intensity(c))

@@ -12,7 +12,9 @@ use colcos_sim::field::FrozenSources;
 use colcos_sim::rng::{self, Stream};
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::Scenario;
-use colcos_sim::sensors::{ColourSensor, ColourSensorParams, SENSOR_RADIUS, sensor_positions};
+use colcos_sim::sensors::{
+    ColourSensor, ColourSensorParams, SENSOR_RADIUS, ScreenView, sensor_positions,
+};
 use colcos_sim::world::World;
 use glam::Vec2;
 
@@ -73,21 +75,21 @@ pub fn predict_readings(
         }
         let pheromones = core.host().pheromones();
         let frozen = FrozenSources::new(pheromones);
+        let view = ScreenView {
+            pheromones,
+            frozen: &frozen,
+            screen: &screen,
+            printed,
+        };
         let read = |pose: &Pose, i: usize, rng: &mut colcos_sim::rng::SimRng| -> [[u16; 3]; 4] {
             let points = sensor_positions(pose, SENSOR_RADIUS);
             match world.robot_sensors(i) {
                 // Robots with sensors of their own (`[sensor] per_robot`): each its own model.
                 Some(own) => std::array::from_fn(|k| {
-                    let sum = own.truth[k].footprint_sums_printed(
-                        pheromones,
-                        &frozen,
-                        &screen,
-                        printed,
-                        &[points[k]],
-                    )[0];
+                    let sum = own.truth[k].footprint_sums_in(&view, &[points[k]])[0];
                     own.truth[k].counts_of_sum(sum, rng)
                 }),
-                None => quiet.read_all_printed(pheromones, &frozen, &screen, printed, &points, rng),
+                None => quiet.read_all_in(&view, &points, rng),
             }
         };
         while next < pending.len() && pending[next].0 <= tick.t {

@@ -18,7 +18,6 @@ mod robot;
 mod view;
 pub use view::ScreenView;
 
-use crate::arena::Printed;
 use crate::field::{FrozenSources, Pheromone};
 use crate::rng::SimRng;
 use crate::screen::{FOOTPRINT_LANES, FootprintLevels, FootprintSamples, ScreenSpec};
@@ -216,29 +215,17 @@ impl ColourSensor {
         screen: &ScreenSpec,
         sensors: &[Vec2; S],
     ) -> [[u32; 3]; S] {
-        self.footprint_sums_printed(pheromones, frozen, screen, None, sensors)
-    }
-
-    /// [`ColourSensor::footprint_sums`] of a screen that also shows `printed` obstacles (drawn over
-    /// the pheromones).
-    pub fn footprint_sums_printed<const S: usize>(
-        &self,
-        pheromones: &[Pheromone],
-        frozen: &FrozenSources,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
-        sensors: &[Vec2; S],
-    ) -> [[u32; 3]; S] {
         let view = ScreenView {
             pheromones,
             frozen,
             screen,
-            printed,
+            printed: None,
         };
         self.footprint_sums_in(&view, sensors)
     }
 
-    /// [`ColourSensor::footprint_sums_printed`] of the screen `view` shows.
+    /// [`ColourSensor::footprint_sums`] of the screen `view` shows (printed obstacles drawn over the
+    /// pheromones, if it has any).
     #[inline]
     pub fn footprint_sums_in<const S: usize>(
         &self,
@@ -332,29 +319,16 @@ impl ColourSensor {
         sensors: &[Vec2; S],
         rng: &mut SimRng,
     ) -> [[u16; 3]; S] {
-        self.read_all_printed(pheromones, frozen, screen, None, sensors, rng)
-    }
-
-    /// [`ColourSensor::read_all`] of a screen that also shows `printed` obstacles.
-    pub fn read_all_printed<const S: usize>(
-        &self,
-        pheromones: &[Pheromone],
-        frozen: &FrozenSources,
-        screen: &ScreenSpec,
-        printed: Option<&Printed>,
-        sensors: &[Vec2; S],
-        rng: &mut SimRng,
-    ) -> [[u16; 3]; S] {
         let view = ScreenView {
             pheromones,
             frozen,
             screen,
-            printed,
+            printed: None,
         };
         self.read_all_in(&view, sensors, rng)
     }
 
-    /// [`ColourSensor::read_all_printed`] of the screen `view` shows.
+    /// [`ColourSensor::read_all`] of the screen `view` shows (printed obstacles included).
     #[inline(always)]
     pub fn read_all_in<const S: usize>(
         &self,
@@ -369,7 +343,7 @@ impl ColourSensor {
     }
 
     /// Counts of one sensor whose footprint level sum is `sum` (one of
-    /// [`ColourSensor::footprint_sums_printed`]'s), drawing what `read_all_printed` of that sensor
+    /// [`ColourSensor::footprint_sums_in`]'s), drawing what `read_all_in` of that sensor
     /// draws: sensors with models of their own share one batched footprint pass.
     pub fn counts_of_sum(&self, sum: [u32; 3], rng: &mut SimRng) -> [u16; 3] {
         let lut = &self.light_by_sum;

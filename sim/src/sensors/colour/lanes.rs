@@ -72,7 +72,7 @@ impl ColourSensor {
     }
 
     /// A robot's four sensors read from their footprints' level sums (as
-    /// [`ColourSensor::footprint_sums_printed`] gives them, or a GPU's sensing pass): the same counts,
+    /// [`ColourSensor::footprint_sums_in`] gives them, or a GPU's sensing pass): the same counts,
     /// random draws and intensities as [`ColourSensor::read_robot`] at those footprints. A sum above
     /// the largest a footprint can have reads as that largest.
     pub fn read_robot_from_sums(

@@ -10,7 +10,7 @@ use crate::screen::{FootprintLevels, FootprintSamples};
 use glam::Vec2;
 
 impl ColourSensor {
-    /// A robot's four sensors read as [`ColourSensor::read_all_printed`] does (the same random draws
+    /// A robot's four sensors read as [`ColourSensor::read_all_in`] does (the same random draws
     /// and counts), with their calibrated [`ColourSensor::intensities`]: the whole read compiled for
     /// AVX2 where the processor has it (no fused multiply-add, so the same bits), its twelve channels
     /// in wider registers.
