@@ -206,6 +206,9 @@ class Config:
     ent_coef: float = 0.0
     hidden: int = 64
     anneal: int = 0  # with N > 0, the learning rate falls linearly to 0 over N updates (the budget)
+    # With K > 0, the learning rate adapts to keep each minibatch step's KL divergence near K (rl_games'
+    # "adaptive" schedule): divided by 1.5 above 2 K, multiplied by 1.5 below K / 2, within [1e-5, 1e-2].
+    target_kl: float = 0.0
     agent_id: bool = False  # the actor also sees which agent it drives (a one-hot: ActorCritic's `agents`)
     history: int = 1  # the actor reads the last `history` observations (ActorCritic's `history`)
     anchor: float = 0.0  # weight of a term keeping the actor's mean near the one `Trainer.set_anchor` froze
@@ -265,6 +268,8 @@ class Trainer:
             self.model.pi[-1].bias[:2] = cfg.start_forward
             self.model.pi[-1].bias[2:] = cfg.start_lay
         self.opt = torch.optim.Adam(self.model.parameters(), lr=cfg.lr, eps=1e-5)
+        self.lr = cfg.lr  # the adaptive schedule's current rate (`Config.target_kl`)
+        self.kl = 0.0  # the mean KL divergence of the last update's minibatch steps
         # Rewards are divided by a running std of the discounted return, so that the critic's targets
         # stay O(1) whatever the reward's scale.
         self.ret_norm = RunningNorm(1)
@@ -360,14 +365,15 @@ class Trainer:
         m = fo.shape[0]
         size = max(1, -(-m // cfg.minibatches))
         if cfg.anneal:
-            for group in self.opt.param_groups:
-                group["lr"] = cfg.lr * max(0.0, 1.0 - self.updates / cfg.anneal)
+            self._set_lr(cfg.lr * max(0.0, 1.0 - self.updates / cfg.anneal))
+        kls: list[float] = []
         for _ in range(cfg.epochs):
             perm = torch.randperm(m)
             for k in range(0, m, size):
                 idx = perm[k : k + size]
                 mu = model.mean(fo[idx])
-                ratio = (model.log_prob(fo[idx], fa[idx], mu) - fl[idx]).exp()
+                log_ratio = model.log_prob(fo[idx], fa[idx], mu) - fl[idx]
+                ratio = log_ratio.exp()
                 pg = -torch.min(ratio * fadv[idx], ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * fadv[idx]).mean()
                 vloss = 0.5 * (model.value(fc[idx]) - fret[idx]).pow(2).mean()
                 # The Gaussian's entropy is sum(log_std) + const: the same for every sample.
@@ -386,6 +392,27 @@ class Trainer:
                 loss.backward()
                 clip_gradients(model, cfg.clip_apart)
                 self.opt.step()
+                with torch.no_grad():  # the k3 estimate of KL(old || new), as rl_games and CleanRL compute it
+                    kl = float(((ratio - 1) - log_ratio).mean())
+                kls.append(kl)
+                if cfg.target_kl:
+                    self.lr = adapt_lr(self.lr, kl, cfg.target_kl)
+                    self._set_lr(self.lr)
+        self.kl = float(np.mean(kls))
+
+    def _set_lr(self, lr: float) -> None:
+        for group in self.opt.param_groups:
+            group["lr"] = lr
+
+
+def adapt_lr(lr: float, kl: float, target: float, low: float = 1e-5, high: float = 1e-2) -> float:
+    """rl_games' adaptive schedule: a step that moved the policy by more than twice the target KL slows the
+    next one, one that moved it by less than half speeds it up."""
+    if kl > 2.0 * target:
+        return max(lr / 1.5, low)
+    if kl < 0.5 * target:
+        return min(lr * 1.5, high)
+    return lr
 
 
 def listening(model: ActorCritic, obs: torch.Tensor, mu: torch.Tensor, inputs: tuple[int, ...]) -> torch.Tensor:

@@ -32,6 +32,7 @@ import numpy as np
 import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import kickstart
 import ppo
 from colcos.baselines import Baseline, RandomPolicy
 from colcos.vector import VecEnv
@@ -56,14 +57,26 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
-                     agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together)
+                     agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
+                     target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup)
     trainer = ppo.Trainer(env, cfg, seed)
-    evaluate = lambda: round(ppo.evaluate(lambda v: trainer.model.policy(), env_kwargs, args.eval_worlds, args.episode, args.eval_seed), 2)
-    curve: list[tuple[float, int, int, float]] = [(0.0, 0, 0, evaluate())]
-    budget = args.minutes * 60 if args.minutes else None
     train_seconds, cpu_start = 0.0, time.process_time()
+    if args.kickstart:
+        # Imitation is training: its seconds count in the budget's clock.
+        t0 = time.perf_counter()
+        follower = lambda v: Baseline(v, "aggregation_follower").act
+        obs, acts = kickstart.demonstrations(follower, env_kwargs, args.num_envs, args.kickstart, seed + 1000, ppo.clip_wheels)
+        space = env.single_action_space
+        kickstart.imitate(trainer.model, obs, acts, space.low, space.high, std=args.kickstart_std, seed=seed)
+        trainer.set_anchor()
+        train_seconds += time.perf_counter() - t0
+    kickstart_seconds = train_seconds
+    evaluate = lambda: round(ppo.evaluate(lambda v: trainer.model.policy(), env_kwargs, args.eval_worlds, args.episode, args.eval_seed), 2)
+    curve: list[tuple[float, int, int, float]] = [(round(train_seconds, 1), 0, 0, evaluate())]
+    budget = args.minutes * 60 if args.minutes else None
     what = f"{args.minutes:.1f} min" if budget else f"{args.updates} updates"
-    print(f"seed {seed}: {env.num_envs} worlds x {env.num_agents} followers, rollouts of {cfg.horizon} steps, {what}", flush=True)
+    print(f"seed {seed}: {env.num_envs} worlds x {env.num_agents} followers, rollouts of {cfg.horizon} steps, {what};"
+          f" evaluation return at the start {curve[0][3]:.2f} ({curve[0][0]:.1f} s)", flush=True)
     while (train_seconds < budget) if budget else (trainer.updates < args.updates):
         t0 = time.perf_counter()
         trainer.iterate()
@@ -71,7 +84,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
         if trainer.updates % args.eval_every == 0:
             curve.append((round(train_seconds, 1), trainer.updates, trainer.agent_steps, evaluate()))
             print(f"  {train_seconds:6.1f} s  update {trainer.updates:5d}  {trainer.agent_steps:>10,d} agent-steps"
-                  f"  evaluation return {curve[-1][3]:8.2f}", flush=True)
+                  f"  evaluation return {curve[-1][3]:8.2f}  (KL {trainer.kl:.4f}, lr {trainer.opt.param_groups[0]['lr']:.2e})", flush=True)
     if curve[-1][1] != trainer.updates:
         curve.append((round(train_seconds, 1), trainer.updates, trainer.agent_steps, evaluate()))
     os.makedirs(out, exist_ok=True)
@@ -80,6 +93,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     return {
         "seed": seed,
         "train_seconds": round(train_seconds, 1),
+        "kickstart_seconds": round(kickstart_seconds, 3),
         "train_cpu_seconds": round(time.process_time() - cpu_start, 1),
         "updates": trainer.updates,
         "agent_steps": trainer.agent_steps,
@@ -137,6 +151,13 @@ def main() -> None:
     p.add_argument("--minibatches", type=int, default=4)
     p.add_argument("--lr", type=float, default=1e-3)
     p.add_argument("--anneal", action="store_true", help="the learning rate falls linearly to 0 over --updates")
+    p.add_argument("--target-kl", type=float, default=0.0,
+                   help="adapt the learning rate to keep each step's KL divergence near this (ppo.Config.target_kl; 0: off)")
+    p.add_argument("--kickstart", type=int, default=0, metavar="STEPS",
+                   help="first imitate the paper's follower over STEPS agent-steps of it acting (kickstart.py), then PPO")
+    p.add_argument("--kickstart-std", type=float, default=0.3, help="the kickstarted actor's noise (sd)")
+    p.add_argument("--anchor", type=float, default=0.0, help="with --kickstart: weight keeping the actor near the imitated one")
+    p.add_argument("--actor-warmup", type=int, default=0, help="the first N updates train only the critic")
     p.add_argument("--clip-together", action="store_true",
                    help="clip actor and critic gradients as one norm (by default each its own: ppo.Config.clip_apart)")
     p.add_argument("--team-critic", action="store_true", help="the critic also sees every follower's observation")

@@ -191,3 +191,42 @@ def test_an_actor_with_a_history_trains_acts_on_a_stream_and_loads_back(tmp_path
     loaded = ppo.load_model(str(tmp_path / "policy.pt"), 17, history=3)
     assert (loaded.history, loaded.agents) == (3, 0)
     np.testing.assert_array_equal(loaded.act(np.tile(obs, 3)), model.act(np.tile(obs, 3)))
+
+
+def test_the_adaptive_rate_follows_the_kl_divergence():
+    ppo = load_ppo()
+    assert ppo.adapt_lr(1e-3, kl=0.05, target=0.01) == pytest.approx(1e-3 / 1.5)  # above twice the target
+    assert ppo.adapt_lr(1e-3, kl=0.001, target=0.01) == pytest.approx(1.5e-3)  # below half of it
+    assert ppo.adapt_lr(1e-3, kl=0.01, target=0.01) == 1e-3
+    assert ppo.adapt_lr(1.2e-5, kl=1.0, target=0.01) == 1e-5 and ppo.adapt_lr(9e-3, kl=0.0, target=0.01) == 1e-2
+
+
+def test_a_trainer_with_a_target_kl_moves_its_rate_each_step():
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=20, num_threads=1)
+    # Steps this small move the policy by far less than half of a KL of 1: each of the 2 x 2 steps speeds up.
+    trainer = ppo.Trainer(env, ppo.Config(horizon=8, epochs=2, minibatches=2, target_kl=1.0), seed=0)
+    trainer.iterate()
+    assert trainer.lr == pytest.approx(1e-3 * 1.5**4)
+    assert trainer.opt.param_groups[0]["lr"] == trainer.lr
+    assert 0.0 <= trainer.kl < 0.5
+    fixed = ppo.Trainer(env, ppo.Config(horizon=8, epochs=2, minibatches=2), seed=0)
+    fixed.iterate()
+    assert fixed.opt.param_groups[0]["lr"] == 1e-3 and torch.isfinite(torch.tensor(fixed.kl))
+
+
+def test_a_kickstarted_quickstart_counts_its_imitation_as_training(tmp_path):
+    pytest.importorskip("torch")
+    args = ["--updates", "2", "--eval-every", "2", "--num-envs", "2", "--horizon", "8", "--episode", "20",
+            "--eval-worlds", "2", "--threads", "1", "--kickstart", "300", "--anchor", "1", "--actor-warmup", "1",
+            "--out", str(tmp_path)]
+    out = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), *args],
+                         capture_output=True, text=True, timeout=600, check=True).stdout
+    assert "evaluation return at the start" in out
+    run = json.loads((tmp_path / "result.json").read_text())["runs"][0]
+    assert run["kickstart_seconds"] > 0.0  # imitated before the first update, on the training clock
+    assert run["curve"][0][1] == 0 and run["curve"][0][0] == round(run["kickstart_seconds"], 1)
+    assert run["curve"][-1][0] >= run["curve"][0][0]
