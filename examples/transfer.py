@@ -70,6 +70,9 @@ def write_scenarios(out: str, fit: str, truth: str) -> dict[str, str]:
         "generic": base + GENERIC,
         "identified": base + fit_line + AROUND_FIT,
         "host": base + '\n[rig]\nsensors = "robot"\n',
+        # The same rig with the fit undone in the bridge: commands over the wheel scales, counts back
+        # through the sensor gains (`[rig] compensate`).
+        "host_compensated": base + f'\n[rig]\nsensors = "robot"\ncompensate = "{os.path.abspath(fit)}"\n',
         "truth": base + f'\n[individual]\nfile = "{os.path.abspath(truth)}"\n',
     }
     paths = {}
@@ -90,7 +93,7 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     flags += ["--history", str(args.history)]
     flags += ["--clip-together"]  # the study in docs/transfer.md trained with one gradient norm
     for seed in args.seeds:
-        for name in VARIANTS:
+        for name in args.variants:
             d = os.path.join(args.out, f"{name}-s{seed}")
             if os.path.exists(os.path.join(d, "policy.pt")):
                 continue
@@ -105,13 +108,13 @@ def hand_written(env):
     return lambda _env, _obs: follower.actions()
 
 
-def policies(out: str, seeds: list[int], episode: int, history: int = 1) -> dict:
+def policies(out: str, seeds: list[int], episode: int, history: int = 1, variants: tuple[str, ...] = VARIANTS) -> dict:
     """Every policy as (simulator act factory, twin act): PPO per variant and seed, references."""
     v = VecEnv("aggregation", num_envs=1, max_cycles=episode)
     d = v.single_observation_space.shape[0]
     table: dict = {}
     for seed in seeds:
-        for name in VARIANTS:
+        for name in variants:
             model = load_model(os.path.join(out, f"{name}-s{seed}", "policy.pt"), d, history)
             table[f"{name}-s{seed}"] = (lambda _v, m=model: m.policy(), stacked(model.policy))
     table["hand-written"] = (lambda v: Baseline(v, "aggregation_follower").act,
@@ -133,24 +136,34 @@ def ratio(tw: np.ndarray, sim: np.ndarray) -> float:
     return float(tw.mean() / sim.mean())
 
 
+def twin_columns(args) -> dict[str, str]:
+    """The twin's columns and the host scenario of each: as the bridge assumes the nominal robots,
+    and (`--compensate`) with the fit undone in the bridge."""
+    return {"twin": "host", **({"twin_compensated": "host_compensated"} if args.compensate else {})}
+
+
 def evaluate(paths: dict[str, str], args) -> dict:
-    """Every policy's returns: simulator (nominal, truth) per world, twin per episode (interleaved)."""
-    table = policies(args.out, args.seeds, args.episode, args.history)
+    """Every policy's returns: simulator (nominal, truth) per world, twin per episode (interleaved),
+    one twin pass per column of `twin_columns` over the same episodes."""
+    table = policies(args.out, args.seeds, args.episode, args.history, tuple(args.variants))
     res: dict = {k: {} for k in table}
     for k, (sim_act, _) in table.items():
         for col in ("nominal", "truth"):
             res[k][f"sim_{col}"] = sim_returns(sim_act, paths[col], args.eval_worlds, args.episode, 12345)
-        res[k]["twin"] = []
+    out: dict = {"returns": res}
     t0 = time.time()
-    with colcos.parallel_env(task="aggregation", scenario=paths["host"], plant="twin", twin_scenario=paths["truth"],
-                             max_cycles=args.episode) as env:
-        for ep in range(args.twin_episodes):
-            for k, (_, twin_act) in table.items():  # interleaved: a drift in the machine's load hits all alike
-                res[k]["twin"].append(twin_episode(env, twin_act, 100 + ep))
-            print(f"  twin episode {ep + 1}/{args.twin_episodes} ({time.time() - t0:.0f} s): "
-                  + ", ".join(f"{k} {v['twin'][-1]:.1f}" for k, v in res.items()), flush=True)
-        stats = env.plant_info()
-    return {"returns": res, "twin_stats": stats}
+    for col, host in twin_columns(args).items():
+        for k in table:
+            res[k][col] = []
+        with colcos.parallel_env(task="aggregation", scenario=paths[host], plant="twin", twin_scenario=paths["truth"],
+                                 max_cycles=args.episode) as env:
+            for ep in range(args.twin_episodes):
+                for k, (_, twin_act) in table.items():  # interleaved: a drift in the machine's load hits all alike
+                    res[k][col].append(twin_episode(env, twin_act, 100 + ep))
+                print(f"  {col} episode {ep + 1}/{args.twin_episodes} ({time.time() - t0:.0f} s): "
+                      + ", ".join(f"{k} {v[col][-1]:.1f}" for k, v in res.items()), flush=True)
+            out[f"{col}_stats"] = env.plant_info()
+    return out
 
 
 def report(result: dict, args) -> str:
@@ -158,33 +171,42 @@ def report(result: dict, args) -> str:
     starts each twin episode, and each simulator world, from the same seed); transfer ratios and
     differences with bootstrap 5-95 % intervals."""
     res, rng = result["returns"], np.random.default_rng(0)
-    floor = {c: np.array(res["standing still"][c]) for c in ("sim_nominal", "twin")}
+    twins = list(twin_columns(args))
+    floor = {c: np.array(res["standing still"][c]) for c in ("sim_nominal", *twins)}
     gain = {k: {c: np.array(r[c]) - floor[c] for c in floor} for k, r in res.items()}
-    lines = [f"| policy | simulator, nominal ({args.eval_worlds} worlds) | simulator, truth ({args.eval_worlds} worlds) "
-             f"| twin, truth ({args.twin_episodes} episodes) | twin gain over standing still | transfer ratio (5-95 %) |",
-             "| --- | --- | --- | --- | --- | --- |"]
-    result["ratios"], result["differences"] = {}, {}
+    named = {"twin": "twin, truth", "twin_compensated": "twin, truth, compensated"}
+    header = [f"simulator, nominal ({args.eval_worlds} worlds)", f"simulator, truth ({args.eval_worlds} worlds)"]
+    header += [f"{named[c]} ({args.twin_episodes} episodes)" for c in twins]
+    for c in twins:
+        header += [f"{named[c]}: gain over standing still", f"{named[c]}: transfer ratio (5-95 %)"]
+    lines = ["| policy | " + " | ".join(header) + " |", "| --- " * (len(header) + 1) + "|"]
+    result["ratios"], result["differences"] = {c: {} for c in twins}, {}
     for k, r in res.items():
-        cells = [f"{np.mean(r[c]):.1f} ± {np.std(r[c], ddof=1):.1f}" for c in ("sim_nominal", "sim_truth", "twin")]
-        g = gain[k]["twin"]
-        cells.append(f"{g.mean():.1f} ± {np.std(g, ddof=1):.1f}")
-        if k == "standing still":
-            cells.append("(floor)")
-        else:
-            pt, lo, hi = boot(rng, ratio, gain[k]["twin"], gain[k]["sim_nominal"])
-            result["ratios"][k] = [pt, lo, hi]
-            cells.append(f"{pt:.2f} ({lo:.2f} to {hi:.2f})")
+        cells = [f"{np.mean(r[c]):.1f} ± {np.std(r[c], ddof=1):.1f}" for c in ("sim_nominal", "sim_truth", *twins)]
+        for c in twins:
+            g = gain[k][c]
+            cells.append(f"{g.mean():.1f} ± {np.std(g, ddof=1):.1f}")
+            if k == "standing still":
+                cells.append("(floor)")
+            else:
+                pt, lo, hi = boot(rng, ratio, g, gain[k]["sim_nominal"])
+                result["ratios"][c][k] = [pt, lo, hi]
+                cells.append(f"{pt:.2f} ({lo:.2f} to {hi:.2f})")
         lines.append(f"| {k} | " + " | ".join(cells) + " |")
-    lines.append("")
-    lines.append("| on the twin, paired by episode | mean difference (5-95 %) |")
-    lines.append("| --- | --- |")
-    for seed in args.seeds:
-        c = np.array(res[f"identified-s{seed}"]["twin"])
-        for other in ("nominal", "generic"):
-            d = c - np.array(res[f"{other}-s{seed}"]["twin"])
-            pt, lo, hi = boot(rng, np.mean, d)
-            result["differences"][f"identified-s{seed} - {other}-s{seed}"] = [pt, lo, hi]
-            lines.append(f"| identified-s{seed} − {other}-s{seed} | {pt:.1f} ({lo:.1f} to {hi:.1f}) |")
+    pairs = []  # (name, a, b, column): a - b on one twin column, or one policy across two columns
+    if set(VARIANTS) <= set(args.variants):
+        pairs += [(f"identified-s{seed} − {other}-s{seed}", f"identified-s{seed}", f"{other}-s{seed}", "twin")
+                  for seed in args.seeds for other in ("nominal", "generic")]
+    if "twin_compensated" in twins:
+        pairs += [(f"{k}: compensated − not", k, k, None) for k in res if k != "standing still"]
+    if pairs:
+        lines += ["", "| on the twin, paired by episode | mean difference (5-95 %) |", "| --- | --- |"]
+    for name, a, b, col in pairs:
+        d = (np.array(res[a][col]) - np.array(res[b][col]) if col
+             else np.array(res[a]["twin_compensated"]) - np.array(res[b]["twin"]))
+        pt, lo, hi = boot(rng, np.mean, d)
+        result["differences"][name.replace("−", "-")] = [pt, lo, hi]
+        lines.append(f"| {name} | {pt:.1f} ({lo:.1f} to {hi:.1f}) |")
     return "\n".join(lines)
 
 
@@ -199,9 +221,12 @@ def figure(result: dict, path: str) -> None:
     names = list(res)
     x = np.arange(len(names))
     fig, ax = plt.subplots(figsize=(8, 3.8))
-    for i, (col, label) in enumerate((("sim_nominal", "simulator, nominal"), ("sim_truth", "simulator, truth"),
-                                      ("twin", "twin, truth (real time)"))):
-        ax.bar(x + (i - 1) * 0.27, [np.mean(res[n][col]) for n in names], 0.27,
+    cols = [("sim_nominal", "simulator, nominal"), ("sim_truth", "simulator, truth"), ("twin", "twin, truth (real time)"),
+            ("twin_compensated", "twin, truth, compensated")]
+    cols = [c for c in cols if c[0] in res[names[0]]]
+    width = 0.8 / len(cols)
+    for i, (col, label) in enumerate(cols):
+        ax.bar(x + (i - (len(cols) - 1) / 2) * width, [np.mean(res[n][col]) for n in names], width,
                yerr=[np.std(res[n][col], ddof=1) for n in names], label=label, capsize=2)
     ax.set_xticks(x, names, rotation=20, fontsize=8)
     ax.set_ylabel("mean return per follower")
@@ -227,6 +252,10 @@ def main() -> None:
                    help="each policy's actor also sees which follower it drives (train_aggregation.py --agent-id)")
     p.add_argument("--history", type=int, default=1,
                    help="each policy's actor reads its last K observations (train_aggregation.py --history)")
+    p.add_argument("--variants", nargs="+", choices=VARIANTS, default=list(VARIANTS),
+                   help="the trained policies to train and evaluate (default: all three)")
+    p.add_argument("--compensate", action="store_true",
+                   help="also evaluate every policy on the twin with the fit undone in the bridge ([rig] compensate)")
     p.add_argument("--train-only", action="store_true")
     p.add_argument("--out", default="runs/transfer")
     args = p.parse_args()
@@ -245,7 +274,8 @@ def main() -> None:
     table = report(result, args)
     print(table)
     budget = f"{args.updates} updates{' (annealed)' if args.anneal else ''}" if args.updates else f"{args.minutes} min"
-    print(f"evaluation {time.time() - t0:.0f} s; training {budget} each; twin {result['twin_stats']}")
+    stats = {k: v for k, v in result.items() if k.endswith("_stats")}
+    print(f"evaluation {time.time() - t0:.0f} s; training {budget} each; twin {stats}")
     with open(os.path.join(args.out, "table.md"), "w") as f:
         f.write(table + "\n")
     trained = {}

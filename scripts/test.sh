@@ -16,7 +16,7 @@ cargo fmt --all -- --check
 cargo fmt --manifest-path pyo3-bindings/Cargo.toml -- --check
 
 say "cargo clippy"
-cargo clippy --workspace --all-targets -- -D warnings
+cargo clippy --workspace --all-targets --features colcos-env/gpu -- -D warnings
 # The Python bindings are a workspace of their own (maturin builds them); sharing the target dir reuses
 # the checked dependencies of the line above. --locked: their committed Cargo.lock must be current
 # (`pip install ./pyo3-bindings` would otherwise rewrite it).
@@ -28,7 +28,8 @@ target/python-lint/bin/pip install -q --no-deps --only-binary=:all: -r python-te
 (cd pyo3-bindings && ../target/python-lint/bin/ruff check python/colcos && ../target/python-lint/bin/mypy)
 
 say "cargo test (release profile, shared with the GPU and Python builds)"
-cargo test --workspace --release
+# gpu/ci.sh runs its tests with this same selection and features: nothing is built twice.
+cargo test --workspace --release --features colcos-env/gpu
 
 if [ "${COLCOS_SKIP_GPU:-0}" != 1 ]; then
     say "GPU backend on lavapipe, display window under Xvfb"

@@ -239,3 +239,26 @@ fn a_map_has_the_keys_of_one_kind() {
         assert_refused(&with_maps(&map), &[key, why]);
     }
 }
+
+#[test]
+fn rig_compensation_needs_a_file_and_no_second_correction() {
+    assert_all_refused(&[
+        (
+            plus("[rig]\ncompensate = \"\""),
+            &["rig.compensate", "must name a file"],
+        ),
+        (
+            plus("[rig]\ncompensate = \"fit.toml\"\ncolour_calibration = \"colour.toml\""),
+            &[
+                "rig.compensate",
+                "fit.toml",
+                "rig.colour_calibration",
+                "name one of the two",
+            ],
+        ),
+        (
+            plus("[rig]\ncompensate = \"fit.toml\"\nonboard = \"policy.json\""),
+            &["rig.compensate", "drives the wheels itself"],
+        ),
+    ]);
+}

@@ -5,6 +5,7 @@
 //! [`CalibrationRig`] and writes a file that the scenario's `[rig]` section names and the bridge
 //! loads ([`RigCalibration`]).
 mod colour;
+mod compensate;
 mod latency;
 mod run_colour;
 mod run_latency;
@@ -13,6 +14,7 @@ mod screen;
 mod session;
 
 pub use colour::ColourCalibration;
+pub use compensate::Compensation;
 pub use latency::{LatencyReport, StageDelays};
 pub use run_colour::{ColourRunOptions, calibrate_colour};
 pub use run_latency::{LatencyRunOptions, calibrate_latency};
@@ -23,6 +25,7 @@ pub use screen::{FiducialSighting, ScreenCalibration};
 pub(crate) use screen::render_fiducials;
 pub use session::{CalibrationRig, RawTracker};
 
+use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;
 use std::path::Path;
 use thiserror::Error;
@@ -66,11 +69,13 @@ impl CalibrationError {
 pub struct RigCalibration {
     pub screen: Option<ScreenCalibration>,
     pub colour: Option<ColourCalibration>,
+    /// `rig.compensate`: the robots' identified wheel scales and sensor gains, undone.
+    pub compensate: Option<Compensation>,
 }
 
 impl RigCalibration {
-    /// Loads `rig.screen_calibration` and `rig.colour_calibration` (relative to the scenario's
-    /// directory); a screen calibration of another panel is refused.
+    /// Loads `rig.screen_calibration`, `rig.colour_calibration` and `rig.compensate` (relative to
+    /// the scenario's directory); a screen calibration of another panel is refused.
     pub fn load(scenario: &Scenario) -> Result<RigCalibration, CalibrationError> {
         let rig = &scenario.spec.rig;
         let resolve = |p: &str| scenario.base_dir.join(p);
@@ -101,21 +106,46 @@ impl RigCalibration {
             }
             None => None,
         };
-        Ok(RigCalibration { screen, colour })
+        let compensate = match &rig.compensate {
+            Some(p) => {
+                let robots = scenario.robot_count();
+                let top = scenario.spec.robot.max_wheel_speed;
+                let c = Compensation::load(&resolve(p), robots, top);
+                Some(c.map_err(keyed("rig.compensate"))?)
+            }
+            None => None,
+        };
+        Ok(RigCalibration {
+            screen,
+            colour,
+            compensate,
+        })
     }
 
-    /// Robot `radio`'s raw counts (simulator sensor order) as the scenario's `nominal` sensor model
-    /// would read the same screen, through the colour calibration's inverse (unchanged without
-    /// one): what the live loop hands the host with `sensors = "robot"`.
+    /// Robot `index`'s (radio `radio`'s) raw counts (simulator sensor order) as the scenario's
+    /// `nominal` sensor model would read the same screen, through the colour calibration's inverse
+    /// or the compensation's gain and offset (the scenario names at most one; unchanged without):
+    /// what the live loop hands the host with `sensors = "robot"`.
     pub fn robot_counts(
         &self,
+        index: usize,
         radio: u8,
         counts: [[u16; 3]; 4],
         nominal: &colcos_sim::sensors::ColourSensor,
     ) -> [[u16; 3]; 4] {
-        match &self.colour {
-            Some(c) => c.to_nominal(radio, counts, nominal),
-            None => counts,
+        match (&self.colour, &self.compensate) {
+            (Some(c), _) => c.to_nominal(radio, counts, nominal),
+            (None, Some(c)) => c.counts(index, counts),
+            (None, None) => counts,
+        }
+    }
+
+    /// What robot `index` is sent for the nominal robot's command `cmd`: divided by its wheel
+    /// scales under `rig.compensate`, `cmd` itself otherwise.
+    pub fn robot_command(&self, index: usize, cmd: WheelCommand) -> WheelCommand {
+        match &self.compensate {
+            Some(c) => c.command(index, cmd),
+            None => cmd,
         }
     }
 

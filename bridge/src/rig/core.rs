@@ -77,7 +77,8 @@ pub struct LoopCore {
     interventions: Vec<Intervention>,
     events: Vec<String>,
     /// The rig's calibrations (`[rig] colour_calibration`: robots' counts through their calibrated
-    /// inverse onto the scenario's sensor model).
+    /// inverse onto the scenario's sensor model; `[rig] compensate`: commands and counts through
+    /// each robot's identified wheel scales and sensor gain).
     calibration: crate::calibrate::RigCalibration,
     nominal: colcos_sim::sensors::ColourSensor,
     /// The robots run a policy of their own (`[rig] onboard`): the host sends only its parameters,
@@ -216,9 +217,12 @@ impl LoopCore {
                 self.silent[i] = false;
                 let bumpers =
                     std::array::from_fn(|k| bumper_reading(tm.tcrt_on[k], tm.tcrt_off[k]));
-                let counts =
-                    self.calibration
-                        .robot_counts(tm.id, colour_to_sim(tm.colour), &self.nominal);
+                let counts = self.calibration.robot_counts(
+                    i,
+                    tm.id,
+                    colour_to_sim(tm.colour),
+                    &self.nominal,
+                );
                 self.host.set_readings(i, counts, bumpers);
                 if let Some(event) = self.onboard.as_mut().and_then(|o| o.take_telemetry(i, tm)) {
                     self.events.push(event);
@@ -302,10 +306,11 @@ impl LoopCore {
             self.sent[i] = cmd;
             let (prev, at) = self.last_sent[i];
             if cmd != prev || t - at >= self.keepalive {
+                // The host models the nominal robot; the radio carries what makes this one drive so.
                 self.packets.push(drive_packet(
                     self.radio[i],
                     stamp,
-                    cmd,
+                    self.calibration.robot_command(i, cmd),
                     self.firmware,
                     &self.legacy,
                 ));

@@ -556,6 +556,8 @@ fn run_metadata(scenario: &Scenario) -> std::collections::BTreeMap<String, Strin
         ),
     ]
     .into_iter()
+    // Named only where set: a log of a run without it keeps the bytes it had before the key existed.
+    .chain(rig.compensate.clone().map(|f| ("compensate", f)))
     .map(|(k, v)| (k.to_string(), v))
     .collect()
 }

@@ -125,6 +125,17 @@ impl IndividualFile {
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_default()
     }
+
+    /// Every robot's values from this file's entries alone (a robot it leaves out: nominal), checked
+    /// for a scenario of `robots` robots (errors name the entry as `robot[n].field`).
+    pub fn resolve(&self, robots: usize) -> Result<Vec<Individual>> {
+        validate_entries(&self.robot, "robot", robots)?;
+        let mut out = vec![Individual::default(); robots];
+        for e in &self.robot {
+            out[e.index].overlay(e);
+        }
+        Ok(out)
+    }
 }
 
 /// One robot's resolved values: what the world builds its actuation and sensing from.
@@ -244,11 +255,9 @@ pub fn resolve(scenario: &super::Scenario, robots: usize) -> Result<Option<Vec<I
         let loaded = IndividualFile::load(&scenario.base_dir.join(file)).map_err(|e| {
             SimError::invalid("individual.file", format!("{file:?}"), e.to_string())
         })?;
-        validate_entries(&loaded.robot, "robot", robots)
+        out = loaded
+            .resolve(robots)
             .map_err(|e| SimError::invalid("individual.file", format!("{file:?}"), inner(e)))?;
-        for e in &loaded.robot {
-            out[e.index].overlay(e);
-        }
     }
     for e in &spec.robot {
         out[e.index].overlay(e);

@@ -160,6 +160,7 @@ impl Scenario {
         spec.rig.screen_calibration.iter_mut().for_each(absolute);
         spec.rig.colour_calibration.iter_mut().for_each(absolute);
         spec.rig.onboard.iter_mut().for_each(absolute);
+        spec.rig.compensate.iter_mut().for_each(absolute);
         spec.individual.file.iter_mut().for_each(absolute);
         toml::to_string_pretty(&spec).unwrap_or_default()
     }

@@ -70,6 +70,12 @@ pub struct RigSpec {
     /// parameters, starts it and sends only stops; the digital twin runs its C.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub onboard: Option<String>,
+    /// The robots' identified values (a file of `[[robot]]` entries, as `colcos rig identify`
+    /// writes), relative to the scenario's directory: each robot's wheel commands are divided by its
+    /// wheel scales and its own colour counts mapped back through its sensor gain and offset, so that
+    /// the robots drive and sense as the scenario's nominal robot (motor lags and latencies stay).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compensate: Option<String>,
 }
 
 impl Default for RigSpec {
@@ -89,6 +95,7 @@ impl Default for RigSpec {
             screen_calibration: None,
             colour_calibration: None,
             onboard: None,
+            compensate: None,
         }
     }
 }
@@ -189,6 +196,7 @@ impl RigSpec {
             ("screen_calibration", &self.screen_calibration),
             ("colour_calibration", &self.colour_calibration),
             ("onboard", &self.onboard),
+            ("compensate", &self.compensate),
         ] {
             if path.as_ref().is_some_and(|p| p.trim().is_empty()) {
                 return Err(SimError::invalid(
@@ -204,6 +212,26 @@ impl RigSpec {
                 "\"motion\"",
                 "an on-board policy (rig.onboard) needs the firmware that runs it: \"wheels\"",
             ));
+        }
+        if let Some(file) = &self.compensate {
+            let clash = if self.onboard.is_some() {
+                Some(
+                    "an on-board policy (rig.onboard) drives the wheels itself: the host cannot scale its commands",
+                )
+            } else if self.colour_calibration.is_some() {
+                Some(
+                    "rig.colour_calibration already maps the robots' counts onto the nominal sensor: name one of the two",
+                )
+            } else {
+                None
+            };
+            if let Some(reason) = clash {
+                return Err(SimError::invalid(
+                    "rig.compensate",
+                    format!("{file:?}"),
+                    reason,
+                ));
+            }
         }
         Ok(())
     }
