@@ -3,31 +3,12 @@
 //! compensated with its identified values. Driven straight ahead by the bridge, the compensated robot
 //! drives as the nominal robot beside them does (straight, as far), the other curves and falls
 //! short; on the dark screen the compensated robot's own counts read as the nominal robot's.
-use colcos_bridge::protocol::swarmcon::{FrameTransform, HeaderForm};
 use colcos_bridge::rig::{LiveOptions, LiveSession};
-use colcos_bridge::twin::{TrackerServer, Twin, UdpChannel};
-use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Pose;
-use colcos_sim::scenario::Scenario;
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
-
-/// Robot 0: compensated; 1: the same robot, not compensated; 2: nominal.
-const SCENARIO: &str = r#"
-name = "twin-compensate"
-duration = 60.0
-seed = 3
-[[robots]]
-count = 3
-behaviour = "wander"
-placement = "explicit"
-poses = [[0.3, 0.2, 90.0], [0.7, 0.2, 90.0], [1.1, 0.2, 90.0]]
-[rig]
-sensors = "robot"
-telemetry_hz = 10.0
-compensate = "fit.toml"
-"#;
+use colcos_sim::scenario::SensorSource;
+use colcos_testkit::scenarios::parked;
+use colcos_testkit::twin::LoopbackTwin;
 
 const ROBOT: &str = "wheel_scale = [0.8, 0.95]\nsensor_gain = 0.8\nsensor_offset = 100.0\n";
 
@@ -41,26 +22,23 @@ fn a_compensated_robot_drives_and_reads_as_the_nominal_one() {
         format!("[[robot]]\nindex = 0\n{ROBOT}"),
     )
     .unwrap();
-    let host = Scenario::from_toml_str(SCENARIO, dir.path()).unwrap();
+    // Robot 0: compensated; 1: the same robot, not compensated; 2: nominal. All face +y.
+    let host = parked(&[[0.3, 0.2, 90.0], [0.7, 0.2, 90.0], [1.1, 0.2, 90.0]])
+        .with(|s| {
+            s.rig.sensors = SensorSource::Robot;
+            s.rig.telemetry_hz = 10.0;
+            s.rig.compensate = Some("fit.toml".into());
+        })
+        .base_dir(dir.path())
+        .build()
+        .unwrap();
     let twin_sc = host.with_truth(&dir.path().join("truth.toml")).unwrap();
 
     let seconds = 3.0;
-    let tracker = TrackerServer::bind("127.0.0.1:0", HeaderForm::Updated).unwrap();
-    let tracker_addr = tracker.local_addr();
-    let channel = UdpChannel::bind("127.0.0.1:0").unwrap();
-    let url = format!("udp://{}", channel.local_addr().unwrap());
-    let mut twin = Twin::new(&twin_sc, tracker, Box::new(channel), None).unwrap();
-    let start: Vec<Pose> = twin.arena().world().poses().to_vec();
-    let stop = Arc::new(AtomicBool::new(false));
-    let ts = stop.clone();
-    let twin = std::thread::spawn(move || {
-        twin.run(Some(seconds + 1.5), &ts);
-        twin
-    });
-
-    let opts = SourceOptions::new(FrameTransform::new(host.arena_size().y as f64));
-    let source = open_pose_source(&format!("swarmcon://{tracker_addr}"), &opts).unwrap();
-    let link = open_robot_link(&url).unwrap();
+    let twin = LoopbackTwin::udp(&twin_sc, false);
+    let start: Vec<Pose> = twin.twin.arena().world().poses().to_vec();
+    let twin = twin.spawn(seconds + 1.5);
+    let (source, link) = (twin.pose_source(&host), twin.robot_link());
     let live_opts = LiveOptions {
         duration: Some(seconds),
         ..LiveOptions::default()
@@ -83,8 +61,7 @@ fn a_compensated_robot_drives_and_reads_as_the_nominal_one() {
     }
     session.stop_all("test over");
     drop(session);
-    let twin = twin.join().unwrap();
-    let end = twin.arena().world().poses().to_vec();
+    let end = twin.join().arena().world().poses().to_vec();
 
     let moved = |i: usize| (end[i].pos - start[i].pos).length();
     let turned = |i: usize| (end[i].heading - start[i].heading).abs();
