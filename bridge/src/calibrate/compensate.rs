@@ -36,17 +36,20 @@ impl Compensation {
     }
 
     /// What robot `i` is sent so that its wheels turn as `cmd` asks of the nominal robot: each
-    /// wheel's speed divided by its scale, within the top speed (a slow wheel saturates there).
+    /// wheel's speed (within the top speed, as the nominal robot takes it) divided by its scale.
+    /// Where a slow wheel would need more than the top speed, both wheels are scaled back together:
+    /// the robot keeps the commanded curvature and gives up speed (clamping the slow wheel alone
+    /// would turn a robot told to drive straight at full speed).
     pub fn command(&self, i: usize, cmd: WheelCommand) -> WheelCommand {
         let Some(r) = self.robots.get(i) else {
             return cmd;
         };
         let max = self.max_wheel_speed;
-        let undo = |v: f32, scale: f32| (v / scale).clamp(-max, max);
-        WheelCommand::new(
-            undo(cmd.left, r.wheel_scale[0]),
-            undo(cmd.right, r.wheel_scale[1]),
-        )
+        let left = cmd.left.clamp(-max, max) / r.wheel_scale[0];
+        let right = cmd.right.clamp(-max, max) / r.wheel_scale[1];
+        let largest = left.abs().max(right.abs());
+        let back = if largest > max { max / largest } else { 1.0 };
+        WheelCommand::new(left * back, right * back)
     }
 
     /// Robot `i`'s own colour counts as the nominal sensor would read them: `(count - offset) /
@@ -79,17 +82,27 @@ mod tests {
         Compensation::load(&path, robots, 0.2).unwrap()
     }
 
-    /// A slow wheel is sent proportionally more, within the top speed; a robot the file leaves out,
-    /// and one beyond the rig's robots, are sent the command as it is.
+    /// A slow wheel is sent proportionally more; where that would pass the top speed both wheels
+    /// are scaled back together, so the robot's wheels still turn alike (straight ahead) at a lower
+    /// speed. A robot the file leaves out, and one beyond the rig's robots, are sent the command.
     #[test]
-    fn wheel_commands_are_divided_by_the_wheel_scales_within_the_top_speed() {
+    fn wheel_commands_are_divided_by_the_wheel_scales_keeping_the_curvature() {
         let c = fit("[[robot]]\nindex = 1\nwheel_scale = [0.8, 1.25]\n", 3);
         let cmd = WheelCommand::new(0.1, -0.1);
         assert_eq!(c.command(0, cmd), cmd);
         let sent = c.command(1, cmd);
         assert!((sent.left - 0.125).abs() < 1e-6 && (sent.right + 0.08).abs() < 1e-6);
-        // The slow wheel's nominal 0.18 m/s needs 0.225, beyond the 0.2 it can be sent.
-        assert_eq!(c.command(1, WheelCommand::new(0.18, 0.0)).left, 0.2);
+        // Straight ahead at 0.18 m/s: the slow wheel would need 0.225, beyond the 0.2 it can be sent.
+        let sent = c.command(1, WheelCommand::new(0.18, 0.18));
+        assert!((sent.left - 0.2).abs() < 1e-6, "{sent:?}");
+        let turns = [sent.left * 0.8, sent.right * 1.25];
+        assert!(
+            (turns[0] - turns[1]).abs() < 1e-6 && turns[0] < 0.18,
+            "{turns:?}"
+        );
+        // A command beyond the top speed counts as the top speed, as the nominal robot takes it.
+        let top = c.command(1, WheelCommand::new(0.2, 0.2));
+        assert_eq!(c.command(1, WheelCommand::new(0.5, 0.5)), top);
         assert_eq!(c.command(7, cmd), cmd);
     }
 
