@@ -174,6 +174,8 @@ def main() -> None:
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="numeric task parameter for training and evaluation, e.g. progress_weight=0 (repeatable)")
     args = p.parse_args()
+    if args.anneal and args.target_kl:
+        p.error("--anneal and --target-kl both set the learning rate: choose one")
     if args.updates < 1 or args.eval_every < 1 or args.history < 1:
         p.error(f"--updates ({args.updates}), --eval-every ({args.eval_every}) and --history ({args.history}) must be at least 1")
     # The policy's tensors are small: one torch thread is fastest (two fight the env's workers).

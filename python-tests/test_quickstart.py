@@ -123,6 +123,9 @@ def test_quickstart_refuses_a_bad_param(tmp_path):
                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert res.returncode == 2
     assert "--param 'progress_weight': expected KEY=VALUE" in res.stderr
+    res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), "--anneal", "--target-kl",
+                          "0.01", "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2 and "--anneal and --target-kl both set the learning rate" in res.stderr
 
 
 def test_an_agent_id_actor_tells_its_agents_apart_and_loads_back(tmp_path):
