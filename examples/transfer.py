@@ -138,7 +138,9 @@ def ratio(tw: np.ndarray, sim: np.ndarray) -> float:
 
 def twin_columns(args) -> dict[str, str]:
     """The twin's columns and the host scenario of each: as the bridge assumes the nominal robots,
-    and (`--compensate`) with the fit undone in the bridge."""
+    and (`--compensate`) with the fit undone in the bridge; `--compensated-only` runs the latter alone."""
+    if args.compensated_only:
+        return {"twin_compensated": "host_compensated"}
     return {"twin": "host", **({"twin_compensated": "host_compensated"} if args.compensate else {})}
 
 
@@ -194,10 +196,10 @@ def report(result: dict, args) -> str:
                 cells.append(f"{pt:.2f} ({lo:.2f} to {hi:.2f})")
         lines.append(f"| {k} | " + " | ".join(cells) + " |")
     pairs = []  # (name, a, b, column): a - b on one twin column, or one policy across two columns
-    if set(VARIANTS) <= set(args.variants):
+    if set(VARIANTS) <= set(args.variants) and "twin" in twins:
         pairs += [(f"identified-s{seed} − {other}-s{seed}", f"identified-s{seed}", f"{other}-s{seed}", "twin")
                   for seed in args.seeds for other in ("nominal", "generic")]
-    if "twin_compensated" in twins:
+    if {"twin", "twin_compensated"} <= set(twins):
         pairs += [(f"{k}: compensated − not", k, k, None) for k in res if k != "standing still"]
     if pairs:
         lines += ["", "| on the twin, paired by episode | mean difference (5-95 %) |", "| --- | --- |"]
@@ -256,6 +258,8 @@ def main() -> None:
                    help="the trained policies to train and evaluate (default: all three)")
     p.add_argument("--compensate", action="store_true",
                    help="also evaluate every policy on the twin with the fit undone in the bridge ([rig] compensate)")
+    p.add_argument("--compensated-only", action="store_true",
+                   help="evaluate on the compensated twin only (the pass --compensate adds, without the other)")
     p.add_argument("--train-only", action="store_true")
     p.add_argument("--out", default="runs/transfer")
     args = p.parse_args()

@@ -48,3 +48,28 @@ def test_tiny_transfer_study_of_one_variant_on_a_compensated_twin_too(tmp_path):
     assert set(result["ratios"]) == {"twin", "twin_compensated"}
     assert set(result["ratios"]["twin_compensated"]) == {"nominal-s0", "hand-written"}
     assert "twin_compensated_stats" in result and "twin_stats" in result
+
+
+def test_the_compensated_twin_alone_is_one_column_without_pairs():
+    pytest.importorskip("torch")
+    import argparse
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("transfer_example", REPO / "examples" / "transfer.py")
+    assert spec is not None and spec.loader is not None
+    transfer = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(transfer)
+    args = argparse.Namespace(compensate=False, compensated_only=True, variants=["nominal"], seeds=[0],
+                              eval_worlds=2, twin_episodes=3)
+    assert transfer.twin_columns(args) == {"twin_compensated": "host_compensated"}
+    both = argparse.Namespace(**{**vars(args), "compensate": True, "compensated_only": False})
+    assert transfer.twin_columns(both) == {"twin": "host", "twin_compensated": "host_compensated"}
+    cols = lambda sim, twin: {"sim_nominal": [sim, sim + 2.0], "sim_truth": [sim, sim], "twin_compensated": [twin] * 3}
+    result = {"returns": {"nominal-s0": cols(-100.0, -200.0), "hand-written": cols(-150.0, -150.0),
+                          "standing still": cols(-300.0, -300.0)}}
+    table = transfer.report(result, args)
+    assert "twin, truth, compensated (3 episodes)" in table and "paired by episode" not in table
+    assert set(result["ratios"]) == {"twin_compensated"} and result["differences"] == {}
+    # The twin keeps half the simulator's gain over standing still (100 of 200), the hand-written follower all.
+    assert result["ratios"]["twin_compensated"]["nominal-s0"][0] == pytest.approx(0.5)
+    assert result["ratios"]["twin_compensated"]["hand-written"][0] == pytest.approx(1.0)
