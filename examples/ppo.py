@@ -268,7 +268,6 @@ class Trainer:
             self.model.pi[-1].bias[:2] = cfg.start_forward
             self.model.pi[-1].bias[2:] = cfg.start_lay
         self.opt = torch.optim.Adam(self.model.parameters(), lr=cfg.lr, eps=1e-5)
-        self.lr = cfg.lr  # the adaptive schedule's current rate (`Config.target_kl`)
         self.kl = 0.0  # the mean KL divergence of the last update's minibatch steps
         # Rewards are divided by a running std of the discounted return, so that the critic's targets
         # stay O(1) whatever the reward's scale.
@@ -396,9 +395,13 @@ class Trainer:
                     kl = float(((ratio - 1) - log_ratio).mean())
                 kls.append(kl)
                 if cfg.target_kl:
-                    self.lr = adapt_lr(self.lr, kl, cfg.target_kl)
-                    self._set_lr(self.lr)
+                    self._set_lr(adapt_lr(self.lr, kl, cfg.target_kl))
         self.kl = float(np.mean(kls))
+
+    @property
+    def lr(self) -> float:
+        """The optimiser's learning rate now (the schedule's: constant, annealed or adaptive)."""
+        return float(self.opt.param_groups[0]["lr"])
 
     def _set_lr(self, lr: float) -> None:
         for group in self.opt.param_groups:

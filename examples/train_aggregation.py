@@ -84,7 +84,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
         if trainer.updates % args.eval_every == 0:
             curve.append((round(train_seconds, 1), trainer.updates, trainer.agent_steps, evaluate()))
             print(f"  {train_seconds:6.1f} s  update {trainer.updates:5d}  {trainer.agent_steps:>10,d} agent-steps"
-                  f"  evaluation return {curve[-1][3]:8.2f}  (KL {trainer.kl:.4f}, lr {trainer.opt.param_groups[0]['lr']:.2e})", flush=True)
+                  f"  evaluation return {curve[-1][3]:8.2f}  (KL {trainer.kl:.4f}, lr {trainer.lr:.2e})", flush=True)
     if curve[-1][1] != trainer.updates:
         curve.append((round(train_seconds, 1), trainer.updates, trainer.agent_steps, evaluate()))
     os.makedirs(out, exist_ok=True)

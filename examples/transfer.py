@@ -195,18 +195,16 @@ def report(result: dict, args) -> str:
                 result["ratios"][c][k] = [pt, lo, hi]
                 cells.append(f"{pt:.2f} ({lo:.2f} to {hi:.2f})")
         lines.append(f"| {k} | " + " | ".join(cells) + " |")
-    pairs = []  # (name, a, b, column): a - b on one twin column, or one policy across two columns
+    pairs = []  # (name, (policy, column), (policy, column)): a - b, paired by episode
     if set(VARIANTS) <= set(args.variants) and "twin" in twins:
-        pairs += [(f"identified-s{seed} − {other}-s{seed}", f"identified-s{seed}", f"{other}-s{seed}", "twin")
+        pairs += [(f"identified-s{seed} − {other}-s{seed}", (f"identified-s{seed}", "twin"), (f"{other}-s{seed}", "twin"))
                   for seed in args.seeds for other in ("nominal", "generic")]
     if {"twin", "twin_compensated"} <= set(twins):
-        pairs += [(f"{k}: compensated − not", k, k, None) for k in res if k != "standing still"]
+        pairs += [(f"{k}: compensated − not", (k, "twin_compensated"), (k, "twin")) for k in res if k != "standing still"]
     if pairs:
         lines += ["", "| on the twin, paired by episode | mean difference (5-95 %) |", "| --- | --- |"]
-    for name, a, b, col in pairs:
-        d = (np.array(res[a][col]) - np.array(res[b][col]) if col
-             else np.array(res[a]["twin_compensated"]) - np.array(res[b]["twin"]))
-        pt, lo, hi = boot(rng, np.mean, d)
+    for name, (a, ca), (b, cb) in pairs:
+        pt, lo, hi = boot(rng, np.mean, np.array(res[a][ca]) - np.array(res[b][cb]))
         result["differences"][name.replace("−", "-")] = [pt, lo, hi]
         lines.append(f"| {name} | {pt:.1f} ({lo:.1f} to {hi:.1f}) |")
     return "\n".join(lines)

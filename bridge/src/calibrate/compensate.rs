@@ -6,6 +6,7 @@
 //! command latencies cannot be undone by scaling and stay as they are.
 use super::CalibrationError;
 use colcos_sim::behaviour::WheelCommand;
+use colcos_sim::scenario::individual::undo_sensor_gain;
 use colcos_sim::scenario::{Individual, IndividualFile};
 use std::path::Path;
 
@@ -61,11 +62,7 @@ impl Compensation {
         if r.senses_nominally() {
             return counts;
         }
-        for c in counts.iter_mut().flatten() {
-            *c = ((*c as f32 - r.sensor_offset) / r.sensor_gain)
-                .round()
-                .clamp(0.0, 65535.0) as u16;
-        }
+        undo_sensor_gain(&mut counts, r.sensor_gain, r.sensor_offset);
         counts
     }
 }

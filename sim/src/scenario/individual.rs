@@ -272,6 +272,14 @@ pub fn apply_sensor_gain(counts: &mut [[u16; 3]; 4], gain: f32, offset: f32) {
     }
 }
 
+/// The inverse of [`apply_sensor_gain`]: counts read through `gain` and `offset` as the nominal
+/// sensor would have read them, `(count - offset) / gain`, kept in `0..=65535`.
+pub fn undo_sensor_gain(counts: &mut [[u16; 3]; 4], gain: f32, offset: f32) {
+    for c in counts.iter_mut().flatten() {
+        *c = ((*c as f32 - offset) / gain).round().clamp(0.0, 65535.0) as u16;
+    }
+}
+
 /// An error about a key inside a file, without the scenario's prefix (the file's key names it).
 pub(super) fn inner(e: SimError) -> String {
     match e {
