@@ -46,11 +46,17 @@ pub fn write_task_obs(
 /// episode's elapsed fraction.
 pub fn write_state(world: &dyn ArenaView, steps: u64, max_cycles: u64, out: &mut [f32]) {
     let arena = world.arena();
-    for (p, o) in world.poses().iter().zip(out.chunks_exact_mut(4)) {
+    for (i, (p, o)) in world
+        .poses()
+        .iter()
+        .zip(out.chunks_exact_mut(4))
+        .enumerate()
+    {
+        let forward = world.forward(i);
         o[0] = (2.0 * p.pos.x / arena.x - 1.0).clamp(-1.0, 1.0);
         o[1] = (2.0 * p.pos.y / arena.y - 1.0).clamp(-1.0, 1.0);
-        o[2] = p.heading.cos();
-        o[3] = p.heading.sin();
+        o[2] = forward.x;
+        o[3] = forward.y;
     }
     if let Some(last) = out.last_mut() {
         *last = (steps as f32 / max_cycles.max(1) as f32).min(1.0);

@@ -99,7 +99,7 @@ pub(crate) fn begin_world(
         slot.overrides[i] = Some(if term {
             colcos_sim::behaviour::WheelCommand::STOP
         } else if let Some(shield) = &ctx.shield {
-            let (cmd, intervention) = shield.apply(&poses[i], *cmd);
+            let (cmd, intervention) = shield.apply_facing(&poses[i], slot.world.forward(i), *cmd);
             *flags = shield_bits(intervention);
             cmd
         } else {

@@ -77,6 +77,16 @@ impl Shield {
 
     /// The command a robot at `pose` may take in place of `cmd` (a non-finite command is a stop).
     pub fn apply(&self, pose: &Pose, cmd: WheelCommand) -> (WheelCommand, Intervention) {
+        self.apply_facing(pose, pose.forward(), cmd)
+    }
+
+    /// [`Self::apply`] for a robot whose heading vector `forward` (`pose.forward()`) is known.
+    pub fn apply_facing(
+        &self,
+        pose: &Pose,
+        forward_dir: Vec2,
+        cmd: WheelCommand,
+    ) -> (WheelCommand, Intervention) {
         let mut out = Intervention::default();
         if !(cmd.left.is_finite() && cmd.right.is_finite()) {
             return (WheelCommand::STOP, out);
@@ -87,7 +97,7 @@ impl Shield {
         out.capped =
             left != cmd.left.clamp(-robot, robot) || right != cmd.right.clamp(-robot, robot);
         let forward = 0.5 * (left + right);
-        let ahead = pose.pos + Vec2::from_angle(pose.heading) * forward * self.params.horizon;
+        let ahead = pose.pos + forward_dir * forward * self.params.horizon;
         let m = self.params.margin.max(0.0);
         let (lo, hi) = (Vec2::splat(m), self.arena - Vec2::splat(m));
         // Which way is inside, per axis, when the command heads out past a virtual wall.
@@ -114,7 +124,7 @@ impl Shield {
             let turn = if turn.abs() >= least {
                 turn
             } else {
-                let motion = Vec2::from_angle(pose.heading) * forward.signum();
+                let motion = forward_dir * forward.signum();
                 least.copysign(motion.perp_dot(inside))
             };
             return (

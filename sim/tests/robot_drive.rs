@@ -123,3 +123,30 @@ fn spinning_in_place_turns_at_the_yaw_rate() {
         (end.pos - start.pos).length()
     );
 }
+
+/// The heading vectors a world shares between its stages (sensing, physics, the shield, rewards)
+/// are its robots' own, bit for bit, as they move and after they are placed by hand.
+#[test]
+fn a_worlds_shared_heading_vectors_are_its_poses_own() {
+    use colcos_sim::world::World;
+    let mut world = World::new(&colcos_testkit::scenarios::wanderers(0.08)).unwrap();
+    let same = |world: &World| {
+        for (i, pose) in world.poses().iter().enumerate() {
+            let (shared, own) = (world.forward(i), pose.forward());
+            assert_eq!(
+                shared.to_array().map(f32::to_bits),
+                own.to_array().map(f32::to_bits),
+                "robot {i}"
+            );
+        }
+    };
+    same(&world);
+    for _ in 0..50 {
+        world.step();
+        same(&world);
+    }
+    let turned = Pose::new(0.7, 0.4, 2.5);
+    world.place_robots(&[(0, turned)]).unwrap();
+    same(&world);
+    assert_eq!(world.forward(0), Vec2::from_angle(2.5));
+}

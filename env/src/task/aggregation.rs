@@ -152,7 +152,7 @@ impl Task for Aggregation {
                 to_leader.normalize_or_zero()
             };
             let (forward, _) = robots[i].drive.body_velocity(params);
-            let velocity = Vec2::from_angle(poses[i].heading) * forward;
+            let velocity = world.forward(i) * forward;
             let free = (1.0 - obs[i].max_bumper()).clamp(0.0, 1.0);
             let progress = (velocity.dot(goal) * inv_max_speed).clamp(-1.0, 1.0) * free;
             let mut reward = self.p.progress_weight * progress

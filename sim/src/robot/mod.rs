@@ -8,7 +8,7 @@ mod physics;
 
 pub use actuation::Actuation;
 pub use colias::ColiasParams;
-pub use drive::DriveState;
+pub use drive::{DriveState, lag_fraction};
 pub use physics::{ArenaPhysics, MAX_HOSTED_ARENAS, PhysicsBackend, RapierHost};
 
 use glam::Vec2;

@@ -50,6 +50,13 @@ impl World {
     pub fn poses(&self) -> &[Pose] {
         self.robots.poses()
     }
+    /// Robot `i`'s heading vector, [`Pose::forward`] of its pose: the one sensing computed at it.
+    ///
+    /// # Panics
+    /// If there is no robot `i`.
+    pub fn forward(&self, i: usize) -> glam::Vec2 {
+        self.sensing.forward(i, self.poses()[i].heading)
+    }
     /// The arena's static obstacles (empty when the scenario has none).
     pub fn obstacles(&self) -> &crate::arena::Obstacles {
         self.sensing.obstacles()

@@ -1,9 +1,10 @@
 //! The robot set: bodies (rapier or discs), and per robot its group, behaviour, random stream, drive
 //! state and last command. Stages `decide_and_drive`, `drive` and `physics`.
 use super::PARALLEL_ROBOTS;
+use super::Sensing;
 use crate::behaviour::{Behaviour, Observation, WheelCommand};
 use crate::rng::SimRng;
-use crate::robot::{ArenaPhysics, ColiasParams, DriveState, Pose, RapierHost};
+use crate::robot::{ArenaPhysics, ColiasParams, DriveState, Pose, RapierHost, lag_fraction};
 use rayon::prelude::*;
 
 /// Per-robot state that the world keeps apart from physics.
@@ -60,12 +61,14 @@ impl RobotSet {
 }
 
 /// Robot `slot` takes wheel command `cmd` (a non-finite one is a stop): its drive's lag advances by
-/// `dt`, and the body velocity (forward, yaw rate) it gives is returned.
+/// `dt` (`alpha`: the nominal lag's [`lag_fraction`] over `dt`), and the body velocity (forward, yaw
+/// rate) it gives is returned.
 fn drive_one(
     slot: &mut RobotSlot,
     cmd: WheelCommand,
     params: &ColiasParams,
     dt: f32,
+    alpha: f32,
 ) -> (f32, f32) {
     let cmd = if cmd.left.is_finite() && cmd.right.is_finite() {
         cmd
@@ -75,7 +78,7 @@ fn drive_one(
     slot.command = cmd;
     match &mut slot.actuation {
         Some(own) => own.drive(&mut slot.drive, cmd, params, dt),
-        None => slot.drive.update(cmd, params, dt),
+        None => slot.drive.approach(cmd, params, [1.0, 1.0], alpha),
     }
     slot.drive.body_velocity(params)
 }
@@ -94,12 +97,13 @@ pub fn decide_and_drive(
     dt: f32,
 ) {
     let params = &robots.params;
+    let alpha = lag_fraction(params.motor_lag, dt);
     let decide_and_drive = |(i, (slot, obs)): (usize, (&mut RobotSlot, &Observation))| {
         let cmd = match overrides.get(i) {
             Some(Some(cmd)) => *cmd,
             _ => slot.behaviour.act(obs, &mut slot.rng),
         };
-        drive_one(slot, cmd, params, dt)
+        drive_one(slot, cmd, params, dt, alpha)
     };
     robots.velocities.clear();
     if robots.slots.len() >= PARALLEL_ROBOTS {
@@ -127,7 +131,9 @@ pub fn decide_and_drive(
 /// reads.
 pub fn drive(robots: &mut RobotSet, commands: &[WheelCommand], dt: f32) {
     let params = &robots.params;
-    let drive = |(slot, cmd): (&mut RobotSlot, &WheelCommand)| drive_one(slot, *cmd, params, dt);
+    let alpha = lag_fraction(params.motor_lag, dt);
+    let drive =
+        |(slot, cmd): (&mut RobotSlot, &WheelCommand)| drive_one(slot, *cmd, params, dt, alpha);
     robots.velocities.clear();
     if robots.slots.len() >= PARALLEL_ROBOTS {
         robots
@@ -145,9 +151,11 @@ pub fn drive(robots: &mut RobotSet, commands: &[WheelCommand], dt: f32) {
 /// Stage `physics`: moves the bodies by `dt` at the velocities the last drive stage set (walls and
 /// contacts included).
 ///
-/// Reads the body velocities; writes the bodies (true poses).
-pub fn physics(robots: &mut RobotSet, dt: f32) {
-    robots.physics.step(&robots.velocities, dt);
+/// Reads the body velocities and the heading vectors sensing computed at the bodies' poses (see
+/// [`Sensing::forward`]); writes the bodies (true poses).
+pub fn physics(robots: &mut RobotSet, sensing: &Sensing, dt: f32) {
+    let forward = |i: usize, heading: f32| sensing.forward(i, heading);
+    robots.physics.step_facing(&robots.velocities, dt, forward);
 }
 
 /// Stage `physics` for a world whose rapier steps run in `host`: the arena's own part (see

@@ -36,8 +36,10 @@ pub struct Sensing {
     /// The four sensor positions of every robot at the indexed poses.
     sensor_points: Vec<[Vec2; 4]>,
     /// Every robot's heading vector at the indexed poses (one `sin_cos` for its colour sensors and
-    /// bumpers).
+    /// bumpers, and for every later stage while its heading stays: [`Sensing::forward`]).
     forwards: Vec<Vec2>,
+    /// The headings `forwards` were computed at.
+    headings: Vec<f32>,
     /// Robots whose colour nobody reads ([`Sensing::set_colour_unread`]): their four sensors are not
     /// evaluated, only their noise drawn. Empty: every robot's are read.
     colour_unread: Vec<bool>,
@@ -45,6 +47,16 @@ pub struct Sensing {
 }
 
 impl Sensing {
+    /// Robot `i`'s heading vector at `heading`: the one [`index`] computed while the heading is
+    /// still the indexed one (the same bits as [`Pose::forward`]), else computed now.
+    #[inline]
+    pub fn forward(&self, i: usize, heading: f32) -> Vec2 {
+        match (self.headings.get(i), self.forwards.get(i)) {
+            (Some(h), Some(f)) if h.to_bits() == heading.to_bits() => *f,
+            _ => Vec2::from_angle(heading),
+        }
+    }
+
     pub fn new(
         sensor: ColourSensor,
         bumper_params: BumperParams,
@@ -65,6 +77,7 @@ impl Sensing {
             positions: Vec::new(),
             sensor_points: Vec::new(),
             forwards: Vec::new(),
+            headings: Vec::new(),
             colour_unread: Vec::new(),
             observations: vec![Observation::default(); robots],
         }
@@ -150,6 +163,8 @@ pub fn index(sensing: &mut Sensing, poses: &[Pose]) {
     // Sensor positions once per robot: sensing reads robot i's, prefetching robot i + 1's.
     sensing.forwards.clear();
     sensing.forwards.extend(poses.iter().map(Pose::forward));
+    sensing.headings.clear();
+    sensing.headings.extend(poses.iter().map(|p| p.heading));
     sensing.sensor_points.clear();
     sensing.sensor_points.extend(
         poses

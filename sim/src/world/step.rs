@@ -99,7 +99,7 @@ impl World {
         let parallel = self.robots.len() >= PARALLEL_ROBOTS;
         let (robots, tracking, sensing) = (&mut self.robots, &mut self.tracking, &mut self.sensing);
         let mut move_robots = || {
-            physics(robots, dt);
+            physics(robots, sensing, dt);
             track(tracking, time, robots.poses());
             index(sensing, robots.poses());
         };

@@ -32,6 +32,11 @@ pub trait ArenaView {
     fn robot_count(&self) -> usize {
         self.poses().len()
     }
+    /// Robot `i`'s heading vector (`poses()[i].forward()`; a world returns the one its sensing
+    /// computed, not a second `sin_cos`).
+    fn forward(&self, i: usize) -> Vec2 {
+        self.poses()[i].forward()
+    }
     /// The arena's static obstacles (none unless the view has some).
     fn obstacles(&self) -> &crate::arena::Obstacles {
         static NONE: std::sync::LazyLock<crate::arena::Obstacles> =
@@ -41,6 +46,9 @@ pub trait ArenaView {
 }
 
 impl ArenaView for World {
+    fn forward(&self, i: usize) -> Vec2 {
+        World::forward(self, i)
+    }
     fn obstacles(&self) -> &crate::arena::Obstacles {
         World::obstacles(self)
     }

@@ -26,6 +26,7 @@ impl DiscState {
         &mut self,
         poses: &mut [Pose],
         velocity: impl Fn(usize) -> (f32, f32),
+        facing: impl Fn(usize, f32) -> Vec2,
         step: Step,
         size: Vec2,
     ) {
@@ -34,7 +35,7 @@ impl DiscState {
         self.positions.clear();
         for (i, pose) in poses.iter_mut().enumerate() {
             let (forward, yaw) = velocity(i);
-            let p = (pose.pos + pose.forward() * (forward * dt)).clamp(lo, hi);
+            let p = (pose.pos + facing(i, pose.heading) * (forward * dt)).clamp(lo, hi);
             pose.heading = wrap_angle(pose.heading + yaw * dt);
             self.positions.push(p);
         }

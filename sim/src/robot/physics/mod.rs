@@ -143,6 +143,17 @@ impl ArenaPhysics {
     /// contacts with walls and each other. Robots without an entry in `velocities` (or with a
     /// non-finite one) are commanded to stand still.
     pub fn step(&mut self, velocities: &[(f32, f32)], dt: f32) {
+        self.step_facing(velocities, dt, |_, heading| Vec2::from_angle(heading));
+    }
+
+    /// [`Self::step`] where `forward(i, heading)` gives robot `i`'s heading vector at `heading` (a
+    /// world passes the ones its sensing already computed; they must equal `Vec2::from_angle`).
+    pub fn step_facing(
+        &mut self,
+        velocities: &[(f32, f32)],
+        dt: f32,
+        forward: impl Fn(usize, f32) -> Vec2,
+    ) {
         if dt.is_nan() || dt <= 0.0 {
             return;
         }
@@ -151,7 +162,7 @@ impl ArenaPhysics {
         match &mut self.solver {
             Solver::Rapier(state) => state.step(&mut self.poses, velocity, step, &self.obstacles),
             Solver::Discs(state) => {
-                state.step(&mut self.poses, velocity, step, self.size);
+                state.step(&mut self.poses, velocity, forward, step, self.size);
                 let Step { lo, hi, radius, .. } = step;
                 obstacle_contacts::push_out(&mut self.poses, radius, &self.obstacles, lo, hi);
             }
