@@ -27,6 +27,7 @@ import json
 import os
 import sys
 import time
+from collections.abc import Callable
 
 import numpy as np
 import torch
@@ -50,6 +51,44 @@ def references(env_kwargs: dict, args: argparse.Namespace) -> dict[str, float]:
         "random": ev(lambda v: RandomPolicy(v, seed=1).act),
         "standing_still": ev(lambda v: (lambda o: np.zeros((v.num_envs, v.num_agents, 2), np.float32))),
     }
+
+
+def sees_the_leader(v: VecEnv) -> Callable[[np.ndarray], np.ndarray]:
+    """A controller that reads the true positions (the global state; the default scenario's robot 0 is
+    the leader, 1 to 3 the followers) and drives each follower straight at the leader: what a policy
+    with full information scores, as a reference for one that only senses."""
+    size = np.array([1.439, 0.809], np.float32)  # the default scenario's arena, m
+
+    def act(_obs: np.ndarray) -> np.ndarray:
+        s = np.asarray(v.state)[:, :20].reshape(v.num_envs, 5, 4)
+        xy = (s[..., :2] + 1) / 2 * size
+        d = xy[:, :1] - xy[:, 1:4]
+        turn = np.arctan2(d[..., 1], d[..., 0]) - np.arctan2(s[:, 1:4, 3], s[:, 1:4, 2])
+        turn = (turn + np.pi) % (2 * np.pi) - np.pi
+        forward = np.clip(np.cos(turn), 0, 1) * np.clip(np.linalg.norm(d, axis=-1) / 0.1, 0, 1)
+        steer = np.clip(2 * turn, -1, 1)
+        return np.stack([forward - steer, forward + steer], -1).clip(-1, 1).astype(np.float32)
+
+    return act
+
+
+def holdout(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict, args: argparse.Namespace) -> dict:
+    """Mean return per follower and its standard error over the held-out episodes (`--holdout-worlds`
+    seeded `--holdout-seed`): the test set no choice was made on."""
+    r = np.array(ppo.episode_returns(policy, env_kwargs, args.holdout_worlds, args.episode, args.holdout_seed))
+    return {"mean": round(float(r.mean()), 2), "se": round(float(r.std(ddof=1) / np.sqrt(len(r))), 2)}
+
+
+def holdout_references(env_kwargs: dict, args: argparse.Namespace) -> dict[str, dict]:
+    """The paper's follower, standing still and (default scenario only) `sees_the_leader` on the
+    held-out episodes."""
+    refs = {
+        "paper_follower": holdout(lambda v: Baseline(v, "aggregation_follower").act, env_kwargs, args),
+        "standing_still": holdout(lambda v: (lambda o: np.zeros((v.num_envs, v.num_agents, 2), np.float32)), env_kwargs, args),
+    }
+    if not args.scenario:
+        refs["sees_the_leader"] = holdout(sees_the_leader, env_kwargs, args)
+    return refs
 
 
 def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> dict:
@@ -77,6 +116,15 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     what = f"{args.minutes:.1f} min" if budget else f"{args.updates} updates"
     print(f"seed {seed}: {env.num_envs} worlds x {env.num_agents} followers, rollouts of {cfg.horizon} steps, {what};"
           f" evaluation return at the start {curve[0][3]:.2f} ({curve[0][0]:.1f} s)", flush=True)
+    held: dict[str, dict] = {}
+
+    def hold(when: str) -> None:
+        if args.holdout_worlds:
+            held[when] = {"seconds": round(train_seconds, 1), "updates": trainer.updates,
+                          **holdout(lambda v: trainer.model.policy(), env_kwargs, args)}  # fmt: skip
+            h = held[when]
+            print(f"  held-out return at {when} ({h['updates']} updates): {h['mean']:.2f} ± {h['se']:.2f}", flush=True)
+
     while (train_seconds < budget) if budget else (trainer.updates < args.updates):
         t0 = time.perf_counter()
         trainer.iterate()
@@ -85,8 +133,12 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
             curve.append((round(train_seconds, 1), trainer.updates, trainer.agent_steps, evaluate()))
             print(f"  {train_seconds:6.1f} s  update {trainer.updates:5d}  {trainer.agent_steps:>10,d} agent-steps"
                   f"  evaluation return {curve[-1][3]:8.2f}  (KL {trainer.kl:.4f}, lr {trainer.lr:.2e})", flush=True)
+        past_half = (train_seconds >= budget / 2) if budget else (2 * trainer.updates >= args.updates)
+        if past_half and "half" not in held:
+            hold("half")
     if curve[-1][1] != trainer.updates:
         curve.append((round(train_seconds, 1), trainer.updates, trainer.agent_steps, evaluate()))
+    hold("end")
     os.makedirs(out, exist_ok=True)
     torch.save(trainer.model.state_dict(), os.path.join(out, "policy.pt"))
     s = trainer.seconds
@@ -100,6 +152,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
         "agent_steps_per_second": round(trainer.agent_steps / train_seconds),
         "seconds_env_act_learn": [round(s["env"], 1), round(s["act"], 1), round(s["learn"], 1)],
         "return_learned": curve[-1][3],
+        "holdout": held,
         "curve": curve,
     }
 
@@ -111,7 +164,35 @@ def at_half(run: dict) -> tuple[float, float]:
     return t, r
 
 
-def plot(runs: list[dict], refs: dict[str, float], out: str) -> None:
+def holdout_summary(runs: list[dict], held_refs: dict[str, dict], args: argparse.Namespace) -> dict:
+    """The held-out evaluation: its episodes, the references and the medians over seeds at half the
+    budget and at the end, and whether every seed's interval (mean ± 2 se) is above the follower's."""
+    if not held_refs:
+        return {}
+    follower = held_refs["paper_follower"]["mean"]
+    out: dict = {"worlds": args.holdout_worlds, "seed": args.holdout_seed, "references": held_refs}
+    for when in ("half", "end"):
+        got = [r["holdout"][when] for r in runs if when in r["holdout"]]
+        if got:
+            out[f"median_{when}"] = float(np.median([g["mean"] for g in got]))
+            out[f"every_seed_above_follower_{when}"] = all(g["mean"] - 2 * g["se"] > follower for g in got)
+    return out
+
+
+def print_holdout(runs: list[dict], h: dict) -> None:
+    refs = h["references"]
+    print(f"\n| seed | held-out return at half the budget | at the end |  ({h['worlds']} episodes seeded {h['seed']}; mean ± se)")
+    print("| ---: | ---: | ---: |")
+    for r in runs:
+        cells = [f"{r['holdout'][w]['mean']:.1f} ± {r['holdout'][w]['se']:.1f}" if w in r["holdout"] else "" for w in ("half", "end")]
+        print(f"| {r['seed']} | {cells[0]} | {cells[1]} |")
+    print(f"| median | {h.get('median_half', float('nan')):.1f} | {h.get('median_end', float('nan')):.1f} |")
+    print("held out: " + ", ".join(f"{k.replace('_', ' ')} {v['mean']:.1f} ± {v['se']:.1f}" for k, v in refs.items())
+          + f"; every seed above the follower (mean - 2 se) at half the budget: {h.get('every_seed_above_follower_half')},"
+          f" at the end: {h.get('every_seed_above_follower_end')}")
+
+
+def plot(runs: list[dict], refs: dict[str, float], held_refs: dict[str, dict], out: str) -> None:
     try:
         import matplotlib
 
@@ -124,14 +205,23 @@ def plot(runs: list[dict], refs: dict[str, float], out: str) -> None:
     for k, run in enumerate(runs):
         c = np.array(run["curve"])
         ax.plot(c[:, 0], c[:, 3], color=f"C{k % 10}", lw=1.2, marker="o", ms=2.5, label=f"PPO, seed {run['seed']}")
+        held = list(run["holdout"].values())
+        if held:
+            ax.errorbar([h["seconds"] for h in held], [h["mean"] for h in held], yerr=[2 * h["se"] for h in held],
+                        color=f"C{k % 10}", ls="none", marker="s", ms=5, mfc="none", capsize=2)
     ax.axhline(refs["paper_follower"], color="green", ls=":", label="paper's follower")
+    if held_refs:
+        ax.axhline(held_refs["paper_follower"]["mean"], color="green", ls="-.", lw=0.8, label="paper's follower, held out")
     ax.axhline(refs["random"], color="grey", ls="--", label="random")
     ax.set_xlabel("training wall-clock seconds (evaluation not counted)")
     rate = runs[0]["updates"] / max(runs[0]["train_seconds"], 1e-9)  # updates per second, for the top axis
     top = ax.secondary_xaxis("top", functions=(lambda t: t * rate, lambda u: u / rate))
     top.set_xlabel(f"PPO updates (seed {runs[0]['seed']}'s pace)", fontsize=8)
-    ax.set_ylabel("mean return per follower (32 episodes)")
-    ax.set_title("colcos aggregation: PPO quick start", fontsize=10)
+    ax.set_ylabel("mean return per follower")
+    if held_refs:
+        ax.set_title("colcos aggregation: PPO quick start\n(lines: the 32 evaluation episodes; squares: held out, ± 2 se)", fontsize=9)
+    else:
+        ax.set_title("colcos aggregation: PPO quick start", fontsize=10)
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "learning_curve.png"), dpi=120)
@@ -169,6 +259,9 @@ def main() -> None:
     p.add_argument("--threads", type=int, default=None, help="env worker threads (default: one per core)")
     p.add_argument("--eval-worlds", type=int, default=32)
     p.add_argument("--eval-seed", type=int, default=12345)
+    p.add_argument("--holdout-worlds", type=int, default=1024,
+                   help="held-out episodes evaluated at half the budget and at the end (0: none)")
+    p.add_argument("--holdout-seed", type=int, default=777)
     p.add_argument("--out", default="runs/aggregation")
     p.add_argument("--scenario", default=None, help="scenario file for training and evaluation (e.g. with a [randomize] section)")
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
@@ -178,6 +271,10 @@ def main() -> None:
         p.error("--anneal and --target-kl both set the learning rate: choose one")
     if args.updates < 1 or args.eval_every < 1 or args.history < 1:
         p.error(f"--updates ({args.updates}), --eval-every ({args.eval_every}) and --history ({args.history}) must be at least 1")
+    if args.holdout_worlds < 0 or args.holdout_worlds == 1:
+        p.error(f"--holdout-worlds ({args.holdout_worlds}) must be 0 (none) or at least 2 (a standard error needs two)")
+    if args.holdout_seed == args.eval_seed:
+        p.error(f"--holdout-seed ({args.holdout_seed}) must differ from --eval-seed: the held-out episodes are other episodes")
     # The policy's tensors are small: one torch thread is fastest (two fight the env's workers).
     torch.set_num_threads(1)
     os.makedirs(args.out, exist_ok=True)
@@ -192,6 +289,9 @@ def main() -> None:
     seeds = args.seeds or [args.seed]
     refs = references(env_kwargs, args)
     print("references on the evaluation episodes:", json.dumps(refs), flush=True)
+    held_refs = holdout_references(env_kwargs, args) if args.holdout_worlds else {}
+    if held_refs:
+        print(f"references on the {args.holdout_worlds} held-out episodes:", json.dumps(held_refs), flush=True)
     runs = []
     for seed in seeds:
         out = args.out if len(seeds) == 1 else os.path.join(args.out, f"seed{seed}")
@@ -212,6 +312,7 @@ def main() -> None:
         "median_end": {"seconds": float(np.median([r["train_seconds"] for r in runs])),
                        "return": float(np.median([r["return_learned"] for r in runs]))},
         "every_seed_beats_follower_at_half": all(h[1] > refs["paper_follower"] for h in half),
+        "holdout": holdout_summary(runs, held_refs, args),
         "runs": runs,
     }  # fmt: skip
     with open(os.path.join(args.out, "result.json"), "w") as f:
@@ -224,7 +325,9 @@ def main() -> None:
     print(f"| median | {mh['seconds']:.0f} | {mh['return']:.1f} | {me['seconds']:.0f} | | {me['return']:.1f} |")
     print(f"paper's follower {refs['paper_follower']:.1f}, random {refs['random']:.1f}, standing still {refs['standing_still']:.1f};"
           f" every seed above the follower at half the budget: {result['every_seed_beats_follower_at_half']}")
-    plot(runs, refs, args.out)
+    if held_refs:
+        print_holdout(runs, result["holdout"])
+    plot(runs, refs, held_refs, args.out)
     print(f"saved {args.out}/result.json, policy.pt and learning_curve.png")
 
 

@@ -92,6 +92,7 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     flags += ["--agent-id"] if args.agent_id else []
     flags += ["--history", str(args.history)]
     flags += ["--clip-together"]  # the study in docs/transfer.md trained with one gradient norm
+    flags += ["--holdout-worlds", "0"]  # this study evaluates every policy itself, on its own episodes
     for seed in args.seeds:
         for name in args.variants:
             d = os.path.join(args.out, f"{name}-s{seed}")

@@ -103,18 +103,26 @@ def test_start_forward_and_start_lay_set_the_untrained_means_of_their_outputs():
 def test_quickstart_runs_and_reports(tmp_path):
     pytest.importorskip("torch")
     args = ["--updates", "4", "--eval-every", "2", "--seeds", "0", "1", "--num-envs", "2", "--horizon", "8",
-            "--episode", "20", "--eval-worlds", "2", "--threads", "1", "--out", str(tmp_path)]
+            "--episode", "20", "--eval-worlds", "2", "--holdout-worlds", "6", "--threads", "1", "--out", str(tmp_path)]
     out = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), *args],
                          capture_output=True, text=True, timeout=600, check=True).stdout
-    assert "| median |" in out
+    assert "| median |" in out and "held out: paper follower" in out
     result = json.loads((tmp_path / "result.json").read_text())
     assert [r["seed"] for r in result["runs"]] == [0, 1]
     for run in result["runs"]:
         assert run["updates"] == 4
         assert [c[1] for c in run["curve"]] == [0, 2, 4]  # evaluated before training and every 2 updates
         assert (tmp_path / f"seed{run['seed']}" / "policy.pt").exists()
+        # The held-out episodes at half the budget and at the end, each with its standard error.
+        assert [(h["updates"], h["se"] > 0) for h in run["holdout"].values()] == [(2, True), (4, True)]
     assert (tmp_path / "policy.pt").exists()
     assert set(result["references"]) == {"paper_follower", "random", "standing_still"}
+    held = result["holdout"]
+    assert (held["worlds"], held["seed"]) == (6, 777)
+    assert set(held["references"]) == {"paper_follower", "standing_still", "sees_the_leader"}
+    assert held["median_end"] == float(np.median([r["holdout"]["end"]["mean"] for r in result["runs"]]))
+    # A controller that reads the true positions outscores one that only senses, on the same episodes.
+    assert held["references"]["sees_the_leader"]["mean"] > held["references"]["standing_still"]["mean"]
 
 
 def test_quickstart_refuses_a_bad_param(tmp_path):
@@ -126,6 +134,9 @@ def test_quickstart_refuses_a_bad_param(tmp_path):
     res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), "--anneal", "--target-kl",
                           "0.01", "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert res.returncode == 2 and "--anneal and --target-kl both set the learning rate" in res.stderr
+    res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), "--holdout-seed", "12345",
+                          "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2 and "--holdout-seed (12345) must differ from --eval-seed" in res.stderr
 
 
 def test_an_agent_id_actor_tells_its_agents_apart_and_loads_back(tmp_path):
