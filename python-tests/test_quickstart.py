@@ -123,6 +123,12 @@ def test_quickstart_runs_and_reports(tmp_path):
     assert held["median_end"] == float(np.median([r["holdout"]["end"]["mean"] for r in result["runs"]]))
     # A controller that reads the true positions outscores one that only senses, on the same episodes.
     assert held["references"]["sees_the_leader"]["mean"] > held["references"]["standing_still"]["mean"]
+    # The saved policy through the evaluation-noise check: its perturbed copies' spread and held-out mean.
+    noise = subprocess.run([sys.executable, str(REPO / "examples" / "evaluation_noise.py"), str(tmp_path / "policy.pt"),
+                            "--times", "3", "--eval-worlds", "2", "--holdout-worlds", "4", "--episode", "10"],
+                           capture_output=True, text=True, timeout=600, check=True).stdout.splitlines()
+    assert noise[0].startswith("paper's follower: 2 evaluation episodes") and len(noise) == 2
+    assert "perturbed by 0.001, 3 times: sd" in noise[1] and "4 held-out episodes" in noise[1]
 
 
 def test_quickstart_refuses_a_bad_param(tmp_path):
