@@ -71,16 +71,49 @@ def reference_policy(task: str) -> str | None:
     return None
 
 
-def episode_return(task: str, make_policy: Any, max_steps: int, episodes: int, seed: int) -> float:
-    """Mean over agents and episodes of an agent's summed reward over an episode of `max_steps` steps."""
-    venv = VecEnv(task, num_envs=episodes, max_cycles=max_steps, autoreset_mode="disabled")
+def episode_returns(task: str, make_policy: Any, max_steps: int, episodes: int, seed: int, continuous: bool = True) -> np.ndarray:
+    """Each episode's return averaged over its agents: an agent's summed reward over `max_steps` steps."""
+    venv = VecEnv(task, num_envs=episodes, max_cycles=max_steps, autoreset_mode="disabled", continuous=continuous)
     venv.reset(seed=seed)
     policy = make_policy(venv)
     total = np.zeros((episodes, venv.num_agents))
     for _ in range(max_steps):
         _, rewards, _, _, _ = venv.step(policy())
         total += rewards
-    return float(total.mean())
+    return total.mean(axis=1)
+
+
+def episode_return(task: str, make_policy: Any, max_steps: int, episodes: int, seed: int) -> float:
+    """Mean over agents and episodes of an agent's summed reward over an episode of `max_steps` steps."""
+    return float(episode_returns(task, make_policy, max_steps, episodes, seed).mean())
+
+
+def held_out(task: str, make_policy: Any, args: argparse.Namespace, continuous: bool = True) -> dict[str, float]:
+    """Mean and standard error over the `--holdout-worlds` held-out episodes (seed `--holdout-seed`;
+    the same worlds whether the actions are continuous or not)."""
+    r = episode_returns(task, make_policy, args.max_steps, args.holdout_worlds, args.holdout_seed, continuous)
+    return {"mean": round(float(r.mean()), 2), "se": round(float(r.std(ddof=1) / np.sqrt(len(r))), 2)}
+
+
+def trained_policy(experiment: Experiment) -> Any:
+    """The trained policy acting in a colcos `VecEnv` as BenchMARL evaluates it (deterministic: its
+    distribution's mode, or the greedy action): `make(venv)()` gives the actions for `venv.obs`."""
+    from tensordict import TensorDict
+    from torchrl.envs.utils import ExplorationType, set_exploration_type
+
+    policy = experiment.policy
+
+    def make(venv: VecEnv) -> Any:
+        def act() -> np.ndarray:
+            obs = torch.as_tensor(np.array(venv.obs), device=experiment.config.sampling_device)
+            group = TensorDict({"observation": obs}, batch_size=obs.shape[:2])
+            with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
+                out = policy(TensorDict({"robot": group}, batch_size=obs.shape[:1]))
+            return np.ascontiguousarray(out.get(("robot", "action")).cpu().numpy())
+
+        return act
+
+    return make
 
 
 def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> ExperimentConfig:
@@ -167,6 +200,7 @@ def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any
     )
     experiment.run()
     wall = time.time() - t0
+    held = held_out(args.task, trained_policy(experiment), args, continuous=not args.discrete)
     files = sorted(pathlib.Path(experiment.folder_name).rglob("*.json"))
     final = None
     if files:
@@ -175,7 +209,8 @@ def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any
         last = max((k for k in steps if k.startswith("step_")), key=lambda k: int(k.split("_")[1]))
         # "return": per evaluation episode, an agent's summed reward averaged over the agents.
         final = float(np.mean(steps[last]["return"]))
-    return {"seed": seed, "final_return": final, "wall_s": wall, "frames": experiment.total_frames, "folder": str(experiment.folder_name)}
+    return {"seed": seed, "final_return": final, "held_out": held, "wall_s": wall, "frames": experiment.total_frames,
+            "folder": str(experiment.folder_name)}  # fmt: skip
 
 
 def main() -> None:
@@ -194,6 +229,9 @@ def main() -> None:
     p.add_argument("--eval-every", type=int, default=None,
                    help="evaluate every this many collected batches (default 60 with the PPO settings, else 5)")
     p.add_argument("--eval-episodes", type=int, default=8)
+    p.add_argument("--holdout-worlds", type=int, default=1024,
+                   help="after training, the policy and the references on this many held-out episodes (standard errors)")
+    p.add_argument("--holdout-seed", type=int, default=777)
     p.add_argument("--discrete", action="store_true", help="the discrete action variant (continuous=False)")
     p.add_argument("--tiny", action="store_true", help="one small iteration (a check that it runs)")
     p.add_argument("--threads", type=int, default=1, help="torch threads")
@@ -211,7 +249,9 @@ def main() -> None:
     except ValueError as e:
         p.error(str(e))
     if args.tiny:
-        args.worlds, args.max_steps, args.eval_episodes = 2, 20, 1
+        args.worlds, args.max_steps, args.eval_episodes, args.holdout_worlds = 2, 20, 1, 4
+    if args.holdout_worlds < 2:
+        p.error(f"--holdout-worlds {args.holdout_worlds}: at least 2 (a standard error needs two)")
     if args.horizon < 1:
         p.error(f"--horizon {args.horizon}: at least 1")
     if args.frames is None:
@@ -228,18 +268,26 @@ def main() -> None:
     if name is not None:
         refs[name] = episode_return(args.task, lambda v: Baseline(v, name).act, args.max_steps, episodes, 12345)
     refs["random"] = episode_return(args.task, lambda v: RandomPolicy(v, seed=1).act, args.max_steps, episodes, 12345)
+    held_refs: dict[str, dict[str, float]] = {}
+    if name is not None:
+        held_refs[name] = held_out(args.task, lambda v: Baseline(v, name).act, args)
     finals = [r["final_return"] for r in runs if r["final_return"] is not None]
     summary = {"algorithm": args.algorithm, "task": args.task, "continuous": not args.discrete,
                "settings": "examples/ppo.py" if ppo_settings(args) else "BenchMARL defaults",
-               "algorithm_settings": dict(args.set), "frames": args.frames, "runs": runs, "references": refs}
+               "algorithm_settings": dict(args.set), "frames": args.frames, "runs": runs, "references": refs,
+               "held_out": {"worlds": args.holdout_worlds, "seed": args.holdout_seed, "references": held_refs}}
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     print(f"{args.algorithm} on {args.task} ({'discrete' if args.discrete else 'continuous'}), {args.frames} frames:")
     for r in runs:
-        print(f"  seed {r['seed']}: final evaluation return {r['final_return']}, {r['wall_s']:.0f} s")
+        h = r["held_out"]
+        print(f"  seed {r['seed']}: final evaluation return {r['final_return']}, {r['wall_s']:.0f} s;"
+              f" {args.holdout_worlds} held-out episodes {h['mean']:.1f} ± {h['se']:.1f}")  # fmt: skip
     if finals:
         print(f"  median {np.median(finals):.1f}, spread {np.min(finals):.1f} .. {np.max(finals):.1f}")
     for k, v in refs.items():
         print(f"  {k}: {v:.1f} (same measure, {episodes} episodes)")
+    for k, h in held_refs.items():
+        print(f"  {k}: {h['mean']:.1f} ± {h['se']:.1f} on the held-out episodes")
 
 
 if __name__ == "__main__":

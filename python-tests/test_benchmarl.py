@@ -9,6 +9,7 @@ import pathlib
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 benchmarl = pytest.importorskip("benchmarl")
@@ -59,6 +60,11 @@ def test_one_tiny_iteration_of_each_algorithm(tmp_path, algorithm, extra):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["runs"][0]["final_return"] is not None
     assert set(summary["references"]) == {"aggregation_follower", "random"}
+    # The trained policy and the follower on the same held-out episodes, through colcos's own env.
+    held = summary["runs"][0]["held_out"]
+    assert np.isfinite(held["mean"]) and held["se"] > 0
+    assert (summary["held_out"]["worlds"], summary["held_out"]["seed"]) == (4, 777)
+    assert set(summary["held_out"]["references"]) == {"aggregation_follower"}
     # BenchMARL's own marl-eval JSON, which its plotting reads.
     assert list(out.rglob("*.json"))
 
