@@ -94,7 +94,7 @@ def holdout_references(env_kwargs: dict, args: argparse.Namespace) -> dict[str, 
 def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> dict:
     """One training run: its evaluation curve (training seconds, updates, agent-steps, return)."""
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
-    cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr,
+    cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr, gamma=args.gamma,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
                      agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
                      target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup)
@@ -240,6 +240,7 @@ def main() -> None:
     p.add_argument("--epochs", type=int, default=4)
     p.add_argument("--minibatches", type=int, default=4)
     p.add_argument("--lr", type=float, default=1e-3)
+    p.add_argument("--gamma", type=float, default=ppo.Config.gamma, help="discount per step (of 20 ms)")
     p.add_argument("--anneal", action="store_true", help="the learning rate falls linearly to 0 over --updates")
     p.add_argument("--target-kl", type=float, default=0.0,
                    help="adapt the learning rate to keep each step's KL divergence near this (ppo.Config.target_kl; 0: off)")
@@ -271,6 +272,8 @@ def main() -> None:
         p.error("--anneal and --target-kl both set the learning rate: choose one")
     if args.updates < 1 or args.eval_every < 1 or args.history < 1:
         p.error(f"--updates ({args.updates}), --eval-every ({args.eval_every}) and --history ({args.history}) must be at least 1")
+    if not 0.0 < args.gamma <= 1.0:
+        p.error(f"--gamma ({args.gamma}) must be in (0, 1]")
     if args.holdout_worlds < 0 or args.holdout_worlds == 1:
         p.error(f"--holdout-worlds ({args.holdout_worlds}) must be 0 (none) or at least 2 (a standard error needs two)")
     if args.holdout_seed == args.eval_seed:

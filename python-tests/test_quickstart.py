@@ -143,6 +143,9 @@ def test_quickstart_refuses_a_bad_param(tmp_path):
     res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), "--holdout-seed", "12345",
                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert res.returncode == 2 and "--holdout-seed (12345) must differ from --eval-seed" in res.stderr
+    res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), "--gamma", "0",
+                          "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2 and "--gamma (0.0) must be in (0, 1]" in res.stderr
 
 
 def test_an_agent_id_actor_tells_its_agents_apart_and_loads_back(tmp_path):
