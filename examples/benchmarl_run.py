@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import pathlib
+import sys
 import time
 from typing import Any
 
@@ -45,6 +47,9 @@ from benchmarl.models.mlp import MlpConfig
 from colcos.baselines import Baseline, RandomPolicy
 from colcos.benchmarl import task as benchmarl_task
 from colcos.vector import VecEnv
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ppo  # noqa: E402  (examples/ppo.py, beside this file)
 
 ON_POLICY = ("mappo", "ippo")
 ALGORITHMS: dict[str, Any] = {
@@ -91,8 +96,7 @@ def episode_return(task: str, make_policy: Any, max_steps: int, episodes: int, s
 def held_out(task: str, make_policy: Any, args: argparse.Namespace, continuous: bool = True) -> dict[str, float]:
     """Mean and standard error over the `--holdout-worlds` held-out episodes (seed `--holdout-seed`;
     the same worlds whether the actions are continuous or not)."""
-    r = episode_returns(task, make_policy, args.max_steps, args.holdout_worlds, args.holdout_seed, continuous)
-    return {"mean": round(float(r.mean()), 2), "se": round(float(r.std(ddof=1) / np.sqrt(len(r))), 2)}
+    return ppo.mean_and_se(episode_returns(task, make_policy, args.max_steps, args.holdout_worlds, args.holdout_seed, continuous))
 
 
 def trained_policy(experiment: Experiment) -> Any:

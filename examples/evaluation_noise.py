@@ -52,9 +52,9 @@ def main() -> None:
         return np.array(ppo.episode_returns(policy, kw, worlds, args.episode, seed))
 
     def line(name: str, evaluation: float, held: np.ndarray, extra: str = "") -> None:
-        se = held.std(ddof=1) / np.sqrt(len(held))
+        h = ppo.mean_and_se(held)
         print(f"{name}: {args.eval_worlds} evaluation episodes {evaluation:.1f}{extra};"
-              f" {len(held)} held-out episodes {held.mean():.1f} ± {se:.1f} (se)", flush=True)  # fmt: skip
+              f" {len(held)} held-out episodes {h['mean']:.1f} ± {h['se']:.1f} (se)", flush=True)  # fmt: skip
 
     follower = lambda v: Baseline(v, "aggregation_follower").act
     line("paper's follower", returns(follower, args.eval_worlds, args.eval_seed).mean(),

@@ -15,7 +15,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import torch
@@ -455,6 +455,12 @@ def episode_returns(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray
         obs, rew, _, _, _ = v.step(act(obs))
         total += rew
     return total.mean(axis=1).tolist()
+
+
+def mean_and_se(returns: Sequence[float] | np.ndarray) -> dict[str, float]:
+    """Episode returns as their mean and the standard error of that mean, to 0.01 (at least two)."""
+    r = np.asarray(returns, dtype=np.float64)
+    return {"mean": round(float(r.mean()), 2), "se": round(float(r.std(ddof=1) / np.sqrt(len(r))), 2)}
 
 
 def evaluate(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict, worlds: int,

@@ -27,12 +27,14 @@ import json
 import os
 import sys
 import time
+import tomllib
 from collections.abc import Callable
 
 import numpy as np
 import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import colcos
 import kickstart
 import ppo
 from colcos.baselines import Baseline, RandomPolicy
@@ -54,16 +56,20 @@ def references(env_kwargs: dict, args: argparse.Namespace) -> dict[str, float]:
 
 
 def sees_the_leader(v: VecEnv) -> Callable[[np.ndarray], np.ndarray]:
-    """A controller that reads the true positions (the global state; the default scenario's robot 0 is
-    the leader, 1 to 3 the followers) and drives each follower straight at the leader: what a policy
-    with full information scores, as a reference for one that only senses."""
-    size = np.array([1.439, 0.809], np.float32)  # the default scenario's arena, m
+    """A controller that reads the true positions (the global state: four values a robot, in the
+    default scenario's order of robots) and drives each follower straight at the leader: what a
+    policy with full information scores, as a reference for one that only senses."""
+    spec = tomllib.loads(colcos.default_scenario("aggregation"))
+    size = np.array(spec.get("arena", {}).get("size", spec["screen"]["size"]), np.float32)  # as Scenario::arena_size
+    roles = [g["role"] for g in spec["robots"] for _ in range(g["count"])]
+    leader, followers = roles.index("leader"), [i for i, r in enumerate(roles) if r == "follower"]
 
     def act(_obs: np.ndarray) -> np.ndarray:
-        s = np.asarray(v.state)[:, :20].reshape(v.num_envs, 5, 4)
+        s = np.asarray(v.state)[:, : 4 * len(roles)].reshape(v.num_envs, len(roles), 4)
         xy = (s[..., :2] + 1) / 2 * size
-        d = xy[:, :1] - xy[:, 1:4]
-        turn = np.arctan2(d[..., 1], d[..., 0]) - np.arctan2(s[:, 1:4, 3], s[:, 1:4, 2])
+        me = s[:, followers]
+        d = xy[:, leader : leader + 1] - xy[:, followers]
+        turn = np.arctan2(d[..., 1], d[..., 0]) - np.arctan2(me[..., 3], me[..., 2])
         turn = (turn + np.pi) % (2 * np.pi) - np.pi
         forward = np.clip(np.cos(turn), 0, 1) * np.clip(np.linalg.norm(d, axis=-1) / 0.1, 0, 1)
         steer = np.clip(2 * turn, -1, 1)
@@ -75,8 +81,7 @@ def sees_the_leader(v: VecEnv) -> Callable[[np.ndarray], np.ndarray]:
 def holdout(policy: Callable[[VecEnv], Callable[[np.ndarray], np.ndarray]], env_kwargs: dict, args: argparse.Namespace) -> dict:
     """Mean return per follower and its standard error over the held-out episodes (`--holdout-worlds`
     seeded `--holdout-seed`): the test set no choice was made on."""
-    r = np.array(ppo.episode_returns(policy, env_kwargs, args.holdout_worlds, args.episode, args.holdout_seed))
-    return {"mean": round(float(r.mean()), 2), "se": round(float(r.std(ddof=1) / np.sqrt(len(r))), 2)}
+    return ppo.mean_and_se(ppo.episode_returns(policy, env_kwargs, args.holdout_worlds, args.episode, args.holdout_seed))
 
 
 def holdout_references(env_kwargs: dict, args: argparse.Namespace) -> dict[str, dict]:
