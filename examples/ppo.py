@@ -173,11 +173,14 @@ def load_model(path: str, obs_dim: int, history: int = 1) -> ActorCritic:
     return model
 
 
-def critic_input(obs: np.ndarray, state: np.ndarray, team: bool = False) -> np.ndarray:
+def critic_input(obs: np.ndarray, state: np.ndarray, team: bool = False, own: bool = False) -> np.ndarray:
     """(E, N, obs) and (E, S) -> (E * N, obs + S + N): own observation, global state, one-hot agent id;
     with `team`, then every agent's observation too (+ N * obs: what the whole team senses, such as
-    who stands where a task pays, which the poses alone do not say)."""
+    who stands where a task pays, which the poses alone do not say). With `own`, the own observation
+    only (E * N, obs): an independent learner's critic, as IPPO's."""
     e, n, d = obs.shape
+    if own:
+        return np.ascontiguousarray(obs, dtype=np.float32).reshape(e * n, d)
     s = np.broadcast_to(state[:, None, :], (e, n, state.shape[-1]))
     ids = np.broadcast_to(np.eye(n, dtype=np.float32)[None], (e, n, n))
     parts = [obs, s, ids]
@@ -186,9 +189,11 @@ def critic_input(obs: np.ndarray, state: np.ndarray, team: bool = False) -> np.n
     return np.concatenate(parts, axis=-1, dtype=np.float32).reshape(e * n, -1)
 
 
-def critic_dim(env: VecEnv, team: bool = False) -> int:
+def critic_dim(env: VecEnv, team: bool = False, own: bool = False) -> int:
     """The width of `critic_input` for `env`'s observations and state."""
     n, d = env.num_agents, env.single_observation_space.shape[0]
+    if own:
+        return d
     return d + env.state_space.shape[0] + n + (n * d if team else 0)
 
 
@@ -214,6 +219,7 @@ class Config:
     anchor: float = 0.0  # weight of a term keeping the actor's mean near the one `Trainer.set_anchor` froze
     actor_warmup: int = 0  # the first N updates train only the critic (an actor that starts good, e.g. kickstarted, keeps still)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
+    own_critic: bool = False  # the critic sees only the agent's own observation (critic_input's `own`)
     # Clip the actor's and the critic's gradients to norm 0.5 each, instead of one norm over both (where a
     # large critic error shrinks the actor's step with it).
     clip_apart: bool = False
@@ -258,7 +264,7 @@ class Trainer:
         e, n, d = env.num_envs, env.num_agents, env.single_observation_space.shape[0]
         self.e, self.n, self.d, self.b = e, n, d, e * n
         self.w = env.single_action_space.shape[0]
-        self.c = critic_dim(env, cfg.team_critic)
+        self.c = critic_dim(env, cfg.team_critic, cfg.own_critic)
         self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden, agents=n if cfg.agent_id else 0,
                                  history=cfg.history)
         # The actor's input: the observations it remembers (and the agent's one-hot).
@@ -304,7 +310,7 @@ class Trainer:
         for t in range(T):
             t0 = time.perf_counter()
             obs_buf[t] = model.actor_input(self.view).reshape(b, self.d_in)
-            cri_buf[t] = critic_input(self.obs, self.state, self.cfg.team_critic)
+            cri_buf[t] = critic_input(self.obs, self.state, self.cfg.team_critic, self.cfg.own_critic)
             with torch.no_grad():
                 noise = torch.randn(b, self.w)
                 act_buf[t] = model.pi(model.obs_norm(torch.from_numpy(obs_buf[t]))) + noise * model.log_std.exp()
@@ -332,7 +338,7 @@ class Trainer:
             self.prev_done = done
             self.agent_steps += b
         t0 = time.perf_counter()
-        cri_buf[T] = critic_input(self.obs, self.state, self.cfg.team_critic)
+        cri_buf[T] = critic_input(self.obs, self.state, self.cfg.team_critic, self.cfg.own_critic)
         self._learn(obs_buf, cri_buf, act_buf, logp_buf, rew_buf, done_buf, valid_buf)
         self.seconds["learn"] += time.perf_counter() - t0
         self.updates += 1

@@ -100,6 +100,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     """One training run: its evaluation curve (training seconds, updates, agent-steps, return)."""
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr, gamma=args.gamma,
+                     lam=args.lam, hidden=args.hidden, own_critic=args.own_critic,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
                      agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
                      target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup)
@@ -246,6 +247,8 @@ def main() -> None:
     p.add_argument("--minibatches", type=int, default=4)
     p.add_argument("--lr", type=float, default=1e-3)
     p.add_argument("--gamma", type=float, default=ppo.Config.gamma, help="discount per step (of 20 ms)")
+    p.add_argument("--lam", type=float, default=ppo.Config.lam, help="GAE's lambda")
+    p.add_argument("--hidden", type=int, default=ppo.Config.hidden, help="units in each of the two hidden layers (actor and critic)")
     p.add_argument("--anneal", action="store_true", help="the learning rate falls linearly to 0 over --updates")
     p.add_argument("--target-kl", type=float, default=0.0,
                    help="adapt the learning rate to keep each step's KL divergence near this (ppo.Config.target_kl; 0: off)")
@@ -257,6 +260,7 @@ def main() -> None:
     p.add_argument("--clip-together", action="store_true",
                    help="clip actor and critic gradients as one norm (by default each its own: ppo.Config.clip_apart)")
     p.add_argument("--team-critic", action="store_true", help="the critic also sees every follower's observation")
+    p.add_argument("--own-critic", action="store_true", help="the critic sees only the agent's own observation (as IPPO's)")
     p.add_argument("--agent-id", action="store_true",
                    help="the actor also sees which follower it drives (a one-hot): one policy, each robot its own way")
     p.add_argument("--history", type=int, default=1,
@@ -279,6 +283,12 @@ def main() -> None:
         p.error(f"--updates ({args.updates}), --eval-every ({args.eval_every}) and --history ({args.history}) must be at least 1")
     if not 0.0 < args.gamma <= 1.0:
         p.error(f"--gamma ({args.gamma}) must be in (0, 1]")
+    if not 0.0 <= args.lam <= 1.0:
+        p.error(f"--lam ({args.lam}) must be in [0, 1]")
+    if args.hidden < 1:
+        p.error(f"--hidden ({args.hidden}) must be at least 1")
+    if args.own_critic and args.team_critic:
+        p.error("--own-critic and --team-critic choose the critic's input: choose one")
     if args.holdout_worlds < 0 or args.holdout_worlds == 1:
         p.error(f"--holdout-worlds ({args.holdout_worlds}) must be 0 (none) or at least 2 (a standard error needs two)")
     if args.holdout_seed == args.eval_seed:

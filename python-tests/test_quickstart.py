@@ -63,6 +63,23 @@ def test_the_team_critic_sees_every_agents_observation():
     assert trainer.c == ppo.critic_dim(env, team=True) == ppo.critic_dim(env) + env.num_agents * 17
 
 
+def test_the_own_critic_sees_only_the_agents_observation():
+    pytest.importorskip("torch")
+    ppo = load_ppo()
+    rng = np.random.default_rng(1)
+    obs, state = rng.normal(size=(2, 3, 5)).astype(np.float32), rng.normal(size=(2, 4)).astype(np.float32)
+    own = ppo.critic_input(obs, state, own=True)
+    assert own.shape == (6, 5) and own.dtype == np.float32
+    np.testing.assert_array_equal(own, obs.reshape(6, 5))
+    from colcos.vector import VecEnv
+
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=20, num_threads=1)
+    trainer = ppo.Trainer(env, ppo.Config(horizon=4, epochs=1, minibatches=1, own_critic=True, hidden=16), seed=0)
+    trainer.iterate()
+    assert trainer.c == ppo.critic_dim(env, own=True) == 17
+    assert trainer.model.v[0].weight.shape == (16, 17) and trainer.model.pi[0].weight.shape == (16, 17)
+
+
 def test_clipping_apart_keeps_a_large_critic_gradient_from_shrinking_the_actors():
     torch = pytest.importorskip("torch")
     ppo = load_ppo()
@@ -146,6 +163,11 @@ def test_quickstart_refuses_a_bad_param(tmp_path):
     res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), "--gamma", "0",
                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert res.returncode == 2 and "--gamma (0.0) must be in (0, 1]" in res.stderr
+    for flags, text in ((["--lam", "1.5"], "--lam (1.5) must be in [0, 1]"), (["--hidden", "0"], "--hidden (0) must be at least 1"),
+                        (["--own-critic", "--team-critic"], "--own-critic and --team-critic choose the critic's input")):  # fmt: skip
+        res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), *flags, "--out", str(tmp_path)],
+                             capture_output=True, text=True, timeout=120)  # fmt: skip
+        assert res.returncode == 2 and text in res.stderr, flags
 
 
 def test_an_agent_id_actor_tells_its_agents_apart_and_loads_back(tmp_path):
