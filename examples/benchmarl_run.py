@@ -4,11 +4,17 @@ and random actions on the same measure (mean over agents and episodes of an agen
     python examples/benchmarl_run.py --algorithm mappo --task aggregation --frames 600000 --seeds 0 1 2
     python examples/benchmarl_run.py --algorithm qmix --task aggregation --discrete --frames 300000
     python examples/benchmarl_run.py --algorithm masac --task colony --tiny          # one small iteration
+    python examples/benchmarl_run.py --evaluate CHECKPOINT --scenario truth.toml     # a trained policy again
 
 Algorithms: BenchMARL's (`mappo`, `ippo`, `masac`, `isac`, `maddpg`, `iddpg`, `qmix`, `vdn`, `iql`,
 ...); tasks: `colcos.tasks()`. Each run writes BenchMARL's own outputs (CSV logs, marl-eval JSON,
-checkpoints) under `--out`, and `summary.json` there with every run's final evaluation return, its
-wall time and the references. Needs `benchmarl` (python-tests/requirements-benchmarl.txt).
+the trained experiment's checkpoint without its replay buffer) under `--out`, and `summary.json` there
+with every run's final evaluation return, its held-out return, its checkpoint, its wall time and the
+references. Needs `benchmarl` (python-tests/requirements-benchmarl.txt).
+
+`--evaluate CHECKPOINT` trains nothing: it reloads a run's checkpoint (`runs[i].checkpoint` in its
+`summary.json`) and plays its policy and the task's hand-written reference on the held-out episodes,
+of the task's scenario or of `--scenario FILE` (robots that differ, for instance), and prints both.
 
 `--ppo-settings` trains the on-policy algorithms (`mappo`, `ippo`) with the settings of colcos's own
 PPO (`examples/ppo.py`) instead of BenchMARL's defaults: batches of `--horizon` 64 steps of every
@@ -76,9 +82,12 @@ def reference_policy(task: str) -> str | None:
     return None
 
 
-def episode_returns(task: str, make_policy: Any, max_steps: int, episodes: int, seed: int, continuous: bool = True) -> np.ndarray:
-    """Each episode's return averaged over its agents: an agent's summed reward over `max_steps` steps."""
-    venv = VecEnv(task, num_envs=episodes, max_cycles=max_steps, autoreset_mode="disabled", continuous=continuous)
+def episode_returns(task: str, make_policy: Any, max_steps: int, episodes: int, seed: int, continuous: bool = True,
+                    scenario: str | None = None) -> np.ndarray:  # fmt: skip
+    """Each episode's return averaged over its agents: an agent's summed reward over `max_steps` steps
+    (on the task's own scenario, or `scenario`, a file)."""
+    extra = {"scenario": scenario} if scenario else {}
+    venv = VecEnv(task, num_envs=episodes, max_cycles=max_steps, autoreset_mode="disabled", continuous=continuous, **extra)
     venv.reset(seed=seed)
     policy = make_policy(venv)
     total = np.zeros((episodes, venv.num_agents))
@@ -96,7 +105,8 @@ def episode_return(task: str, make_policy: Any, max_steps: int, episodes: int, s
 def held_out(task: str, make_policy: Any, args: argparse.Namespace, continuous: bool = True) -> dict[str, float]:
     """Mean and standard error over the `--holdout-worlds` held-out episodes (seed `--holdout-seed`;
     the same worlds whether the actions are continuous or not)."""
-    return ppo.mean_and_se(episode_returns(task, make_policy, args.max_steps, args.holdout_worlds, args.holdout_seed, continuous))
+    return ppo.mean_and_se(episode_returns(task, make_policy, args.max_steps, args.holdout_worlds, args.holdout_seed, continuous,
+                                           args.scenario))  # fmt: skip
 
 
 def trained_policy(experiment: Experiment) -> Any:
@@ -126,8 +136,11 @@ def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> Experiment
     cfg.loggers = ["csv"]
     cfg.create_json = True  # marl-eval's JSON, which BenchMARL's plotting reads
     cfg.save_folder = str(out)
-    cfg.checkpoint_at_end = False
+    # The trained policy (and critic and optimiser) at the end, for `--evaluate`: no replay buffer.
+    cfg.checkpoint_at_end = True
     cfg.checkpoint_interval = 0
+    cfg.exclude_buffer_from_checkpoint = True
+    cfg.keep_checkpoints_num = 1
     cfg.prefer_continuous_actions = not args.discrete
     cfg.evaluation_episodes = args.eval_episodes
     # colcos steps all worlds of a batch in Rust: large batches of worlds, one collector.
@@ -213,8 +226,25 @@ def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any
         last = max((k for k in steps if k.startswith("step_")), key=lambda k: int(k.split("_")[1]))
         # "return": per evaluation episode, an agent's summed reward averaged over the agents.
         final = float(np.mean(steps[last]["return"]))
+    checkpoints = sorted((pathlib.Path(experiment.folder_name) / "checkpoints").glob("*.pt"))
     return {"seed": seed, "final_return": final, "held_out": held, "wall_s": wall, "frames": experiment.total_frames,
-            "folder": str(experiment.folder_name)}  # fmt: skip
+            "folder": str(experiment.folder_name), "checkpoint": str(checkpoints[-1]) if checkpoints else None}  # fmt: skip
+
+
+def evaluate(args: argparse.Namespace) -> None:
+    """`--evaluate`: a trained run's policy and the task's reference on the held-out episodes."""
+    experiment = Experiment.reload_from_file(args.evaluate)
+    task = experiment.task_name
+    args.max_steps = int(experiment.task.config.get("max_steps", args.max_steps))
+    continuous = experiment.continuous_actions
+    where = args.scenario or f"the {task} scenario"
+    policy = held_out(task, trained_policy(experiment), args, continuous=continuous)
+    print(f"{experiment.algorithm_name} ({args.evaluate}) on {args.holdout_worlds} held-out episodes of {where}"
+          f" (seed {args.holdout_seed}): {policy['mean']:.1f} ± {policy['se']:.1f}")  # fmt: skip
+    name = reference_policy(task)
+    if name is not None:
+        ref = held_out(task, lambda v: Baseline(v, name).act, args)
+        print(f"  {name}: {ref['mean']:.1f} ± {ref['se']:.1f} on the same episodes")
 
 
 def main() -> None:
@@ -243,7 +273,22 @@ def main() -> None:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a setting of the algorithm's BenchMARL config, e.g. use_tanh_normal=false or entropy_coef=0.01 (repeatable)")
     p.add_argument("--out", default="runs/benchmarl")
+    p.add_argument("--evaluate", default=None, metavar="CHECKPOINT",
+                   help="train nothing: play a run's checkpoint (summary.json's runs[i].checkpoint) on the held-out episodes")
+    p.add_argument("--scenario", default=None, help="with --evaluate: a scenario file to evaluate on instead of the task's own")
     args = p.parse_args()
+    if args.scenario and not args.evaluate:
+        p.error("--scenario is for --evaluate (training takes the task's own scenario)")
+    if args.evaluate:
+        if not os.path.isfile(args.evaluate):
+            p.error(f"--evaluate {args.evaluate!r}: no such checkpoint file")
+        if args.scenario and not os.path.isfile(args.scenario):
+            p.error(f"--scenario {args.scenario!r}: no such file")
+        if args.holdout_worlds < 2:
+            p.error(f"--holdout-worlds {args.holdout_worlds}: at least 2 (a standard error needs two)")
+        torch.set_num_threads(args.threads)
+        evaluate(args)
+        return
     if args.algorithm not in ALGORITHMS:
         p.error(f"--algorithm {args.algorithm!r}: one of {sorted(ALGORITHMS)}")
     if args.task not in colcos.tasks():

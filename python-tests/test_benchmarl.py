@@ -67,6 +67,17 @@ def test_one_tiny_iteration_of_each_algorithm(tmp_path, algorithm, extra):
     assert set(summary["held_out"]["references"]) == {"aggregation_follower"}
     # BenchMARL's own marl-eval JSON, which its plotting reads.
     assert list(out.rglob("*.json"))
+    if algorithm in ("mappo", "qmix"):
+        # The checkpoint reloads as the same policy: the same held-out return, on the task's scenario
+        # given as a file too.
+        checkpoint = summary["runs"][0]["checkpoint"]
+        scenario = tmp_path / "aggregation.toml"
+        scenario.write_text(colcos.default_scenario("aggregation"))
+        again = subprocess.run([sys.executable, str(EXAMPLE), "--evaluate", checkpoint, "--scenario", str(scenario),
+                                "--holdout-worlds", "4"], capture_output=True, text=True, timeout=600)  # fmt: skip
+        assert again.returncode == 0, again.stderr[-3000:]
+        assert f"held-out episodes of {scenario} (seed 777): {held['mean']:.1f} ± {held['se']:.1f}" in again.stdout, again.stdout
+        assert "aggregation_follower:" in again.stdout
 
 
 def test_the_example_refuses_unknown_algorithms_and_tasks():
