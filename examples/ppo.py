@@ -223,6 +223,7 @@ class Config:
     # Clip the actor's and the critic's gradients to norm 0.5 each, instead of one norm over both (where a
     # large critic error shrinks the actor's step with it).
     clip_apart: bool = False
+    grad_norm: float = 0.5  # the gradient norm clipping keeps (each, with `clip_apart`)
     start_forward: float = 0.0  # the untrained actor's mean for both wheels: > 0 drives forward, an exploration prior
     start_lay: float = 0.0  # the untrained actor's mean for the outputs after the wheels (deposit rates): < 0 lays rarely
     # Biases for learned communication (Eccles et al. 2019, "Biases for emergent communication in multi-agent
@@ -395,7 +396,7 @@ class Trainer:
                     loss = 0.5 * vloss
                 self.opt.zero_grad()
                 loss.backward()
-                clip_gradients(model, cfg.clip_apart)
+                clip_gradients(model, cfg.clip_apart, cfg.grad_norm)
                 self.opt.step()
                 with torch.no_grad():  # the k3 estimate of KL(old || new), as rl_games and CleanRL compute it
                     kl = float(((ratio - 1) - log_ratio).mean())

@@ -100,7 +100,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     """One training run: its evaluation curve (training seconds, updates, agent-steps, return)."""
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr, gamma=args.gamma,
-                     lam=args.lam, hidden=args.hidden, own_critic=args.own_critic,
+                     lam=args.lam, hidden=args.hidden, own_critic=args.own_critic, grad_norm=args.grad_norm,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
                      agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
                      target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup)
@@ -260,6 +260,7 @@ def main() -> None:
     p.add_argument("--clip-together", action="store_true",
                    help="clip actor and critic gradients as one norm (by default each its own: ppo.Config.clip_apart)")
     p.add_argument("--team-critic", action="store_true", help="the critic also sees every follower's observation")
+    p.add_argument("--grad-norm", type=float, default=ppo.Config.grad_norm, help="gradients are clipped to this norm")
     p.add_argument("--own-critic", action="store_true", help="the critic sees only the agent's own observation (as IPPO's)")
     p.add_argument("--agent-id", action="store_true",
                    help="the actor also sees which follower it drives (a one-hot): one policy, each robot its own way")
@@ -285,6 +286,8 @@ def main() -> None:
         p.error(f"--gamma ({args.gamma}) must be in (0, 1]")
     if not 0.0 <= args.lam <= 1.0:
         p.error(f"--lam ({args.lam}) must be in [0, 1]")
+    if not args.grad_norm > 0.0:
+        p.error(f"--grad-norm ({args.grad_norm}) must be above 0")
     if args.hidden < 1:
         p.error(f"--hidden ({args.hidden}) must be at least 1")
     if args.own_critic and args.team_critic:

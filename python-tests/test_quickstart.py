@@ -164,6 +164,7 @@ def test_quickstart_refuses_a_bad_param(tmp_path):
                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert res.returncode == 2 and "--gamma (0.0) must be in (0, 1]" in res.stderr
     for flags, text in ((["--lam", "1.5"], "--lam (1.5) must be in [0, 1]"), (["--hidden", "0"], "--hidden (0) must be at least 1"),
+                        (["--grad-norm", "0"], "--grad-norm (0.0) must be above 0"),
                         (["--own-critic", "--team-critic"], "--own-critic and --team-critic choose the critic's input")):  # fmt: skip
         res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), *flags, "--out", str(tmp_path)],
                              capture_output=True, text=True, timeout=120)  # fmt: skip
