@@ -220,7 +220,7 @@ class Config:
     actor_warmup: int = 0  # the first N updates train only the critic (an actor that starts good, e.g. kickstarted, keeps still)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     own_critic: bool = False  # the critic sees only the agent's own observation (critic_input's `own`)
-    # Clip the actor's and the critic's gradients to norm 0.5 each, instead of one norm over both (where a
+    # Clip the actor's and the critic's gradients to `grad_norm` each, instead of one norm over both (where a
     # large critic error shrinks the actor's step with it).
     clip_apart: bool = False
     grad_norm: float = 0.5  # the gradient norm clipping keeps (each, with `clip_apart`)
