@@ -84,6 +84,10 @@ def test_the_example_refuses_unknown_algorithms_and_tasks():
     for args in (["--algorithm", "mapo"], ["--task", "nope"]):
         done = subprocess.run([sys.executable, str(EXAMPLE), *args, "--tiny"], capture_output=True, text=True, timeout=120)
         assert done.returncode == 2 and args[1] in done.stderr, done.stderr
+    for args, text in ((["--scenario", "x.toml"], "--scenario is for --evaluate"),
+                       (["--evaluate", "no/such.pt"], "--evaluate 'no/such.pt': no such checkpoint file")):  # fmt: skip
+        done = subprocess.run([sys.executable, str(EXAMPLE), *args], capture_output=True, text=True, timeout=120)
+        assert done.returncode == 2 and text in done.stderr, done.stderr
 
 
 def _example():
