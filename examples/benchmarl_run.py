@@ -279,13 +279,15 @@ def main() -> None:
     args = p.parse_args()
     if args.scenario and not args.evaluate:
         p.error("--scenario is for --evaluate (training takes the task's own scenario)")
+    if args.tiny and not args.evaluate:
+        args.worlds, args.max_steps, args.eval_episodes, args.holdout_worlds = 2, 20, 1, 4
+    if args.holdout_worlds < 2:
+        p.error(f"--holdout-worlds {args.holdout_worlds}: at least 2 (a standard error needs two)")
     if args.evaluate:
         if not os.path.isfile(args.evaluate):
             p.error(f"--evaluate {args.evaluate!r}: no such checkpoint file")
         if args.scenario and not os.path.isfile(args.scenario):
             p.error(f"--scenario {args.scenario!r}: no such file")
-        if args.holdout_worlds < 2:
-            p.error(f"--holdout-worlds {args.holdout_worlds}: at least 2 (a standard error needs two)")
         torch.set_num_threads(args.threads)
         evaluate(args)
         return
@@ -297,10 +299,6 @@ def main() -> None:
         args.set = [algorithm_setting(args.algorithm, kv) for kv in args.set]
     except ValueError as e:
         p.error(str(e))
-    if args.tiny:
-        args.worlds, args.max_steps, args.eval_episodes, args.holdout_worlds = 2, 20, 1, 4
-    if args.holdout_worlds < 2:
-        p.error(f"--holdout-worlds {args.holdout_worlds}: at least 2 (a standard error needs two)")
     if args.horizon < 1:
         p.error(f"--horizon {args.horizon}: at least 1")
     if args.frames is None:
