@@ -4,6 +4,7 @@ and random actions on the same measure (mean over agents and episodes of an agen
     python examples/benchmarl_run.py --algorithm mappo --task aggregation --frames 600000 --seeds 0 1 2
     python examples/benchmarl_run.py --algorithm qmix --task aggregation --discrete --frames 300000
     python examples/benchmarl_run.py --algorithm masac --task colony --tiny          # one small iteration
+    python examples/benchmarl_run.py --algorithm ippo --scenario robots.toml --lr 3e-4 # another scenario of the task
     python examples/benchmarl_run.py --evaluate CHECKPOINT --scenario truth.toml     # a trained policy again
 
 Algorithms: BenchMARL's (`mappo`, `ippo`, `masac`, `isac`, `maddpg`, `iddpg`, `qmix`, `vdn`, `iql`,
@@ -14,7 +15,9 @@ references. Needs `benchmarl` (python-tests/requirements-benchmarl.txt).
 
 `--evaluate CHECKPOINT` trains nothing: it reloads a run's checkpoint (`runs[i].checkpoint` in its
 `summary.json`) and plays its policy and the task's hand-written reference on the held-out episodes,
-of the task's scenario or of `--scenario FILE` (robots that differ, for instance), and prints both.
+of the scenario it trained on or of `--scenario FILE` (robots that differ, for instance), and prints
+both. Without `--evaluate`, `--scenario FILE` trains and evaluates on that file in place of the task's
+own scenario (the task's rewards and observations on other robots, fields or arenas).
 
 `--ppo-settings` trains the on-policy algorithms (`mappo`, `ippo`) with the settings of colcos's own
 PPO (`examples/ppo.py`) instead of BenchMARL's defaults: batches of `--horizon` 64 steps of every
@@ -97,9 +100,9 @@ def episode_returns(task: str, make_policy: Any, max_steps: int, episodes: int, 
     return total.mean(axis=1)
 
 
-def episode_return(task: str, make_policy: Any, max_steps: int, episodes: int, seed: int) -> float:
+def episode_return(task: str, make_policy: Any, max_steps: int, episodes: int, seed: int, scenario: str | None = None) -> float:
     """Mean over agents and episodes of an agent's summed reward over an episode of `max_steps` steps."""
-    return float(episode_returns(task, make_policy, max_steps, episodes, seed).mean())
+    return float(episode_returns(task, make_policy, max_steps, episodes, seed, scenario=scenario).mean())
 
 
 def held_out(task: str, make_policy: Any, args: argparse.Namespace, continuous: bool = True) -> dict[str, float]:
@@ -109,25 +112,28 @@ def held_out(task: str, make_policy: Any, args: argparse.Namespace, continuous: 
                                            args.scenario))  # fmt: skip
 
 
-def trained_policy(experiment: Experiment) -> Any:
-    """The trained policy acting in a colcos `VecEnv` as BenchMARL evaluates it (deterministic: its
-    distribution's mode, or the greedy action): `make(venv)()` gives the actions for `venv.obs`."""
+def observation_policy(experiment: Experiment) -> Any:
+    """The trained policy as BenchMARL evaluates it (deterministic: its distribution's mode, or the
+    greedy action), as a function from observations `(worlds, agents, obs)` to actions."""
     from tensordict import TensorDict
     from torchrl.envs.utils import ExplorationType, set_exploration_type
 
     policy = experiment.policy
 
-    def make(venv: VecEnv) -> Any:
-        def act() -> np.ndarray:
-            obs = torch.as_tensor(np.array(venv.obs), device=experiment.config.sampling_device)
-            group = TensorDict({"observation": obs}, batch_size=obs.shape[:2])
-            with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
-                out = policy(TensorDict({"robot": group}, batch_size=obs.shape[:1]))
-            return np.ascontiguousarray(out.get(("robot", "action")).cpu().numpy())
+    def act(observations: np.ndarray) -> np.ndarray:
+        obs = torch.as_tensor(np.asarray(observations, dtype=np.float32), device=experiment.config.sampling_device)
+        group = TensorDict({"observation": obs}, batch_size=obs.shape[:2])
+        with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
+            out = policy(TensorDict({"robot": group}, batch_size=obs.shape[:1]))
+        return np.ascontiguousarray(out.get(("robot", "action")).cpu().numpy())
 
-        return act
+    return act
 
-    return make
+
+def trained_policy(experiment: Experiment) -> Any:
+    """The trained policy acting in a colcos `VecEnv`: `make(venv)()` gives the actions for `venv.obs`."""
+    act = observation_policy(experiment)
+    return lambda venv: (lambda: act(np.array(venv.obs)))
 
 
 def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> ExperimentConfig:
@@ -201,6 +207,8 @@ def ppo_settings(args: argparse.Namespace) -> bool:
 def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any]:
     task = benchmarl_task(args.task)
     task.config["max_steps"] = args.max_steps
+    if args.scenario:
+        task.config["scenario"] = os.path.abspath(args.scenario)
     algorithm = ALGORITHMS[args.algorithm].get_from_yaml()
     if ppo_settings(args):
         algorithm.lmbda = 0.95
@@ -237,6 +245,7 @@ def evaluate(args: argparse.Namespace) -> None:
     task = experiment.task_name
     args.max_steps = int(experiment.task.config.get("max_steps", args.max_steps))
     continuous = experiment.continuous_actions
+    args.scenario = args.scenario or experiment.task.config.get("scenario")  # default: the one it trained on
     where = args.scenario or f"the {task} scenario"
     policy = held_out(task, trained_policy(experiment), args, continuous=continuous)
     print(f"{experiment.algorithm_name} ({args.evaluate}) on {args.holdout_worlds} held-out episodes of {where}"
@@ -275,19 +284,18 @@ def main() -> None:
     p.add_argument("--out", default="runs/benchmarl")
     p.add_argument("--evaluate", default=None, metavar="CHECKPOINT",
                    help="train nothing: play a run's checkpoint (summary.json's runs[i].checkpoint) on the held-out episodes")
-    p.add_argument("--scenario", default=None, help="with --evaluate: a scenario file to evaluate on instead of the task's own")
+    p.add_argument("--scenario", default=None,
+                   help="a scenario file in place of the task's own: to train and evaluate on, or with --evaluate to evaluate on")
     args = p.parse_args()
-    if args.scenario and not args.evaluate:
-        p.error("--scenario is for --evaluate (training takes the task's own scenario)")
     if args.tiny and not args.evaluate:
         args.worlds, args.max_steps, args.eval_episodes, args.holdout_worlds = 2, 20, 1, 4
+    if args.scenario and not os.path.isfile(args.scenario):
+        p.error(f"--scenario {args.scenario!r}: no such file")
     if args.holdout_worlds < 2:
         p.error(f"--holdout-worlds {args.holdout_worlds}: at least 2 (a standard error needs two)")
     if args.evaluate:
         if not os.path.isfile(args.evaluate):
             p.error(f"--evaluate {args.evaluate!r}: no such checkpoint file")
-        if args.scenario and not os.path.isfile(args.scenario):
-            p.error(f"--scenario {args.scenario!r}: no such file")
         torch.set_num_threads(args.threads)
         evaluate(args)
         return
@@ -295,6 +303,11 @@ def main() -> None:
         p.error(f"--algorithm {args.algorithm!r}: one of {sorted(ALGORITHMS)}")
     if args.task not in colcos.tasks():
         p.error(f"--task {args.task!r}: one of {sorted(colcos.tasks())}")
+    if args.scenario:
+        try:
+            VecEnv(args.task, num_envs=1, scenario=args.scenario)
+        except (colcos.ScenarioError, colcos.TaskError) as e:
+            p.error(f"--scenario {args.scenario!r}: {e}")
     try:
         args.set = [algorithm_setting(args.algorithm, kv) for kv in args.set]
     except ValueError as e:
@@ -313,13 +326,13 @@ def main() -> None:
     refs: dict[str, float] = {}
     name = reference_policy(args.task)
     if name is not None:
-        refs[name] = episode_return(args.task, lambda v: Baseline(v, name).act, args.max_steps, episodes, 12345)
-    refs["random"] = episode_return(args.task, lambda v: RandomPolicy(v, seed=1).act, args.max_steps, episodes, 12345)
+        refs[name] = episode_return(args.task, lambda v: Baseline(v, name).act, args.max_steps, episodes, 12345, args.scenario)
+    refs["random"] = episode_return(args.task, lambda v: RandomPolicy(v, seed=1).act, args.max_steps, episodes, 12345, args.scenario)
     held_refs: dict[str, dict[str, float]] = {}
     if name is not None:
         held_refs[name] = held_out(args.task, lambda v: Baseline(v, name).act, args)
     finals = [r["final_return"] for r in runs if r["final_return"] is not None]
-    summary = {"algorithm": args.algorithm, "task": args.task, "continuous": not args.discrete,
+    summary = {"algorithm": args.algorithm, "task": args.task, "scenario": args.scenario, "continuous": not args.discrete,
                "settings": "examples/ppo.py" if ppo_settings(args) else "BenchMARL defaults",
                "algorithm_settings": dict(args.set), "frames": args.frames, "runs": runs, "references": refs,
                "held_out": {"worlds": args.holdout_worlds, "seed": args.holdout_seed, "references": held_refs}}

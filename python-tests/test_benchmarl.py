@@ -16,6 +16,7 @@ benchmarl = pytest.importorskip("benchmarl")
 
 import colcos  # noqa: E402
 from colcos._core import TaskError  # noqa: E402
+from colcos.baselines import Baseline  # noqa: E402
 from colcos.benchmarl import ColcosTask, task  # noqa: E402
 
 EXAMPLE = pathlib.Path(__file__).resolve().parent.parent / "examples" / "benchmarl_run.py"
@@ -50,10 +51,14 @@ def test_specs_match_the_env(tmp_path):
 
 @pytest.mark.parametrize(
     "algorithm,extra",
-    [("mappo", []), ("ippo", []), ("masac", []), ("qmix", ["--discrete"])],
+    [("mappo", []), ("ippo", ["--scenario"]), ("masac", []), ("qmix", ["--discrete"])],
 )
 def test_one_tiny_iteration_of_each_algorithm(tmp_path, algorithm, extra):
     out = tmp_path / algorithm
+    # IPPO trains on a scenario file in place of the task's own: a smaller arena.
+    small = tmp_path / "small_arena.toml"
+    small.write_text(colcos.default_scenario("aggregation").replace("size = [1.439, 0.809]", "size = [0.72, 0.405]"))
+    extra = [a for e in extra for a in ((e, str(small)) if e == "--scenario" else (e,))]
     cmd = [sys.executable, str(EXAMPLE), "--algorithm", algorithm, "--task", "aggregation", "--tiny", "--out", str(out), *extra]
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-3000:]
@@ -78,13 +83,29 @@ def test_one_tiny_iteration_of_each_algorithm(tmp_path, algorithm, extra):
         assert again.returncode == 0, again.stderr[-3000:]
         assert f"held-out episodes of {scenario} (seed 777): {held['mean']:.1f} ± {held['se']:.1f}" in again.stdout, again.stdout
         assert "aggregation_follower:" in again.stdout
+    if algorithm == "ippo":
+        # The run trained and was scored on the file: its checkpoint remembers it, and its follower
+        # reference is the follower's return there, not on the task's own scenario.
+        assert summary["scenario"] == str(small)
+        again = subprocess.run([sys.executable, str(EXAMPLE), "--evaluate", summary["runs"][0]["checkpoint"], "--holdout-worlds", "4"],
+                               capture_output=True, text=True, timeout=600)  # fmt: skip
+        assert again.returncode == 0, again.stderr[-3000:]
+        assert f"held-out episodes of {small} (seed 777): {held['mean']:.1f} ± {held['se']:.1f}" in again.stdout, again.stdout
+        example = _example()
+        follower = summary["held_out"]["references"]["aggregation_follower"]["mean"]
+        on = [example.episode_returns("aggregation", lambda v: Baseline(v, "aggregation_follower").act, 20, 4, 777, scenario=s)
+              for s in (str(small), None)]  # fmt: skip
+        assert follower == round(float(on[0].mean()), 2) and abs(on[0].mean() - on[1].mean()) > 0.5, on
 
 
-def test_the_example_refuses_unknown_algorithms_and_tasks():
+def test_the_example_refuses_unknown_algorithms_tasks_and_bad_files(tmp_path):
     for args in (["--algorithm", "mapo"], ["--task", "nope"]):
         done = subprocess.run([sys.executable, str(EXAMPLE), *args, "--tiny"], capture_output=True, text=True, timeout=120)
         assert done.returncode == 2 and args[1] in done.stderr, done.stderr
-    for args, text in ((["--scenario", "x.toml"], "--scenario is for --evaluate"),
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[arena]\nwidth = "x"\n')
+    for args, text in ((["--scenario", "x.toml"], "--scenario 'x.toml': no such file"),
+                       (["--scenario", str(bad)], f"--scenario {str(bad)!r}: "),
                        (["--evaluate", "no/such.pt"], "--evaluate 'no/such.pt': no such checkpoint file")):  # fmt: skip
         done = subprocess.run([sys.executable, str(EXAMPLE), *args], capture_output=True, text=True, timeout=120)
         assert done.returncode == 2 and text in done.stderr, done.stderr
