@@ -121,7 +121,7 @@ def observation_policy(experiment: Experiment) -> Any:
     policy = experiment.policy
 
     def act(observations: np.ndarray) -> np.ndarray:
-        obs = torch.as_tensor(np.asarray(observations, dtype=np.float32), device=experiment.config.sampling_device)
+        obs = torch.as_tensor(np.array(observations, dtype=np.float32), device=experiment.config.sampling_device)
         group = TensorDict({"observation": obs}, batch_size=obs.shape[:2])
         with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
             out = policy(TensorDict({"robot": group}, batch_size=obs.shape[:1]))

@@ -13,6 +13,9 @@ Writes `OUT/table.md` and `OUT/result.json` (every episode's return).
 
     python examples/transfer.py --updates 2400 --twin-episodes 20 --out runs/transfer
 
+`--benchmarl NAME=CHECKPOINT` adds a BenchMARL policy (`examples/benchmarl_run.py --scenario OUT/identified.toml`
+trains one on a variant's scenario) to every column; `--variants` with no name leaves the PPO ones out.
+
 The fit comes from `colcos rig excite` on a twin with the truth and `colcos rig identify`
 (docs/transfer.md gives the commands; `examples/data/transfer/` holds the truth and the fit). Needs
 torch; matplotlib for `OUT/transfer.png`. The twin episodes run in real time (20 ms a step).
@@ -125,6 +128,32 @@ def policies(out: str, seeds: list[int], episode: int, history: int = 1, variant
     return table
 
 
+def benchmarl_policies(specs: list[tuple[str, str]], episode: int) -> dict:
+    """BenchMARL runs' checkpoints (`examples/benchmarl_run.py`, `NAME=CHECKPOINT`) as (simulator act
+    factory, twin act), each acting as BenchMARL evaluates it (its distribution's mode)."""
+    if not specs:
+        return {}
+    from benchmarl.experiment import Experiment
+
+    import benchmarl_run
+
+    n = VecEnv("aggregation", num_envs=1, max_cycles=episode).num_agents
+    table: dict = {}
+    for name, path in specs:
+        act = benchmarl_run.observation_policy(Experiment.reload_from_file(path))
+
+        def twin_act(a=act):
+            def run(obs: np.ndarray, ids: np.ndarray) -> np.ndarray:
+                full = np.zeros((1, n, obs.shape[1]), np.float32)  # the group's layout; absent agents read zeros
+                full[0, ids] = obs
+                return a(full)[0, ids]
+
+            return run
+
+        table[name] = (lambda _v, a=act: a, stacked(twin_act))
+    return table
+
+
 def boot(rng, stat, *xs: np.ndarray) -> tuple[float, float, float]:
     """`stat` of the arrays and its bootstrap 5-95 % interval (each array resampled on its own)."""
     draws = [stat(*(x[rng.integers(0, len(x), len(x))] for x in xs)) for _ in range(4000)]
@@ -149,6 +178,7 @@ def evaluate(paths: dict[str, str], args) -> dict:
     """Every policy's returns: simulator (nominal, truth) per world, twin per episode (interleaved),
     one twin pass per column of `twin_columns` over the same episodes."""
     table = policies(args.out, args.seeds, args.episode, args.history, tuple(args.variants))
+    table.update(benchmarl_policies(args.benchmarl, args.episode))
     res: dict = {k: {} for k in table}
     for k, (sim_act, _) in table.items():
         for col in ("nominal", "truth"):
@@ -200,6 +230,9 @@ def report(result: dict, args) -> str:
     if set(VARIANTS) <= set(args.variants) and "twin" in twins:
         pairs += [(f"identified-s{seed} − {other}-s{seed}", (f"identified-s{seed}", "twin"), (f"{other}-s{seed}", "twin"))
                   for seed in args.seeds for other in ("nominal", "generic")]
+    if "twin" in twins:
+        first, *others = [name for name, _ in args.benchmarl] or [""]
+        pairs += [(f"{k} − {first}", (k, "twin"), (first, "twin")) for k in others]
     if {"twin", "twin_compensated"} <= set(twins):
         pairs += [(f"{k}: compensated − not", (k, "twin_compensated"), (k, "twin")) for k in res if k != "standing still"]
     if pairs:
@@ -253,8 +286,11 @@ def main() -> None:
                    help="each policy's actor also sees which follower it drives (train_aggregation.py --agent-id)")
     p.add_argument("--history", type=int, default=1,
                    help="each policy's actor reads its last K observations (train_aggregation.py --history)")
-    p.add_argument("--variants", nargs="+", choices=VARIANTS, default=list(VARIANTS),
-                   help="the trained policies to train and evaluate (default: all three)")
+    p.add_argument("--variants", nargs="*", choices=VARIANTS, default=list(VARIANTS),
+                   help="the PPO policies to train and evaluate (default: all three; none: the --benchmarl ones only)")
+    p.add_argument("--benchmarl", action="append", default=[], metavar="NAME=CHECKPOINT",
+                   help="also evaluate a BenchMARL run's checkpoint (examples/benchmarl_run.py) under NAME (repeatable; "
+                        "the table compares each later one with the first on the twin)")
     p.add_argument("--compensate", action="store_true",
                    help="also evaluate every policy on the twin with the fit undone in the bridge ([rig] compensate)")
     p.add_argument("--compensated-only", action="store_true",
@@ -266,6 +302,18 @@ def main() -> None:
         p.error(f"--updates ({args.updates}) must be at least 1")
     if args.history < 1:
         p.error(f"--history ({args.history}) must be at least 1")
+    specs = [spec.partition("=") for spec in args.benchmarl]
+    for spec, (name, eq, path) in zip(args.benchmarl, specs):
+        if not eq or not name:
+            p.error(f"--benchmarl {spec!r}: expected NAME=CHECKPOINT")
+        if not os.path.isfile(path):
+            p.error(f"--benchmarl {spec!r}: no such checkpoint file {path!r}")
+    args.benchmarl = [(name, path) for name, _, path in specs]
+    names = [name for name, _ in args.benchmarl]
+    taken = {f"{v}-s{seed}" for v in args.variants for seed in args.seeds} | {"hand-written", "standing still"}
+    clash = sorted({n for n in names if names.count(n) > 1 or n in taken})
+    if clash:
+        p.error(f"--benchmarl: the name(s) {clash} are used twice or by another policy of the table")
     os.makedirs(args.out, exist_ok=True)
     paths = write_scenarios(args.out, args.fit, args.truth)
     train(paths, args)
@@ -278,7 +326,8 @@ def main() -> None:
     print(table)
     budget = f"{args.updates} updates{' (annealed)' if args.anneal else ''}" if args.updates else f"{args.minutes} min"
     stats = {k: v for k, v in result.items() if k.endswith("_stats")}
-    print(f"evaluation {time.time() - t0:.0f} s; training {budget} each; twin {stats}")
+    trained_here = f"; PPO training {budget} each" if args.variants else ""
+    print(f"evaluation {time.time() - t0:.0f} s{trained_here}; twin {stats}")
     with open(os.path.join(args.out, "table.md"), "w") as f:
         f.write(table + "\n")
     trained = {}

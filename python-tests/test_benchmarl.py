@@ -96,6 +96,16 @@ def test_one_tiny_iteration_of_each_algorithm(tmp_path, algorithm, extra):
         on = [example.episode_returns("aggregation", lambda v: Baseline(v, "aggregation_follower").act, 20, 4, 777, scenario=s)
               for s in (str(small), None)]  # fmt: skip
         assert follower == round(float(on[0].mean()), 2) and abs(on[0].mean() - on[1].mean()) > 0.5, on
+        # The transfer study takes the checkpoint as one more policy, on the simulator and the twin.
+        study = tmp_path / "transfer"
+        done = subprocess.run([sys.executable, str(EXAMPLE.parent / "transfer.py"), "--variants", "--benchmarl",
+                               f"ippo={summary['runs'][0]['checkpoint']}", "--episode", "20", "--eval-worlds", "2",
+                               "--twin-episodes", "1", "--out", str(study)], capture_output=True, text=True, timeout=600)  # fmt: skip
+        assert done.returncode == 0, done.stderr[-3000:]
+        returns = json.loads((study / "result.json").read_text())["returns"]
+        assert set(returns) == {"ippo", "hand-written", "standing still"}
+        assert [len(returns["ippo"][c]) for c in ("sim_nominal", "sim_truth", "twin")] == [2, 2, 1]
+        assert not list(study.glob("*-s0"))  # no PPO policy trained
 
 
 def test_the_example_refuses_unknown_algorithms_tasks_and_bad_files(tmp_path):

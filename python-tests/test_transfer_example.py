@@ -73,3 +73,13 @@ def test_the_compensated_twin_alone_is_one_column_without_pairs():
     # The twin keeps half the simulator's gain over standing still (100 of 200), the hand-written follower all.
     assert result["ratios"]["twin_compensated"]["nominal-s0"][0] == pytest.approx(0.5)
     assert result["ratios"]["twin_compensated"]["hand-written"][0] == pytest.approx(1.0)
+
+
+def test_bad_benchmarl_policies_are_refused_naming_them(tmp_path):
+    checkpoint = tmp_path / "run.pt"
+    checkpoint.write_bytes(b"")
+    for spec, text in ((str(checkpoint), "expected NAME=CHECKPOINT"), ("ippo=no/such.pt", "no such checkpoint file 'no/such.pt'"),
+                       ("hand-written=" + str(checkpoint), "['hand-written'] are used twice or by another policy")):  # fmt: skip
+        done = subprocess.run([sys.executable, str(REPO / "examples" / "transfer.py"), "--variants", "--benchmarl", spec,
+                               "--out", str(tmp_path / "out")], capture_output=True, text=True, timeout=120)  # fmt: skip
+        assert done.returncode == 2 and text in done.stderr, done.stderr
