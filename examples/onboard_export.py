@@ -64,6 +64,10 @@ def actor_from_state_dict(path: str):
     pairs = [
         (state[f"pi.{k}.weight"].numpy(), state[f"pi.{k}.bias"].numpy()) for k in keys
     ]
+    if pairs[-1][0].shape[0] != state["log_std"].shape[0]:
+        raise SystemExit(
+            f"{path}: a tanh actor (train_aggregation.py --tanh) is not exported: the C clips the mean"
+        )
     return pairs, state["obs_norm.mean"].numpy(), state["obs_norm.var"].numpy()
 
 

@@ -25,6 +25,8 @@ from torch import nn
 
 
 LOG_2PI = float(np.log(2 * np.pi))
+# softplus(0 + SOFTPLUS_BIAS) + 1e-4 = 1: a tanh actor's widths start at 1, as BenchMARL's.
+SOFTPLUS_BIAS = float(np.log(np.expm1(1.0 - 1e-4)))
 
 
 class RunningNorm(nn.Module):
@@ -62,13 +64,17 @@ class ActorCritic(nn.Module):
     sees which of the N agents it drives (a one-hot appended, `actor_input`): one network, but free to
     drive robots that differ (wheels, lags, sensor gains) each in its own way. `pi`, `obs_norm` and
     `log_std` are what a robot runs (`onboard_export.py` reads them by name; it takes only actors of
-    the 17 observation entries)."""
+    the 17 observation entries).
+
+    With `tanh`, the actor is BenchMARL's and IPPO's: `pi` also gives each action entry's width (a
+    biased softplus of its second half: 1 at an output of 0), and the action is the tanh of the
+    Gaussian sample (its mean's tanh when acting deterministically); `log_std` goes unused."""
 
     def __init__(self, obs_dim: int, critic_dim: int, act_dim: int = 2, hidden: int = 64, agents: int = 0,
-                 history: int = 1) -> None:  # fmt: skip
+                 history: int = 1, tanh: bool = False) -> None:  # fmt: skip
         super().__init__()
-        self.agents, self.history = agents, history
-        self.pi = mlp(obs_dim * history + agents, act_dim, hidden)
+        self.agents, self.history, self.tanh, self.act_dim = agents, history, tanh, act_dim
+        self.pi = mlp(obs_dim * history + agents, 2 * act_dim if tanh else act_dim, hidden)
         self.v = mlp(critic_dim, 1, hidden)
         self.log_std = nn.Parameter(torch.full((act_dim,), -0.5))
         self.obs_norm = RunningNorm(obs_dim * history + agents)
@@ -96,15 +102,31 @@ class ActorCritic(nn.Module):
         hot = np.broadcast_to(np.eye(self.agents, dtype=np.float32)[ids], (*obs.shape[:-1], self.agents))
         return np.concatenate([obs, hot], axis=-1)
 
-    def mean(self, obs: torch.Tensor) -> torch.Tensor:
-        """The Gaussian's mean for raw actor inputs (`actor_input`; normalised here)."""
+    def head(self, obs: torch.Tensor) -> torch.Tensor:
+        """What `pi` gives for raw actor inputs (`actor_input`; normalised here): the Gaussian's mean,
+        and with `tanh` its widths' pre-activations after it."""
         return self.pi(self.obs_norm(obs))
 
-    def log_prob(self, obs: torch.Tensor, act: torch.Tensor, mu: torch.Tensor | None = None) -> torch.Tensor:
-        """log pi(act | obs) summed over the action's entries: torch's `Normal(...).log_prob(act).sum(-1)`
-        in fewer tensor operations (the update's hot path on small batches); `mu`: `mean(obs)` if known."""
-        z = (act - (self.mean(obs) if mu is None else mu)) * torch.exp(-self.log_std)
-        return -0.5 * (z * z).sum(-1) - self.log_std.sum() - 0.5 * LOG_2PI * act.shape[-1]
+    def mean(self, obs: torch.Tensor) -> torch.Tensor:
+        """The Gaussian's mean for raw actor inputs (before the tanh, with `tanh`)."""
+        return self.head(obs)[..., : self.act_dim]
+
+    def log_stds(self, head: torch.Tensor) -> torch.Tensor:
+        """Each action entry's log width for a `head` output: `log_std`, or with `tanh` the biased
+        softplus of the head's second half (BenchMARL's `biased_softplus_1.0`, at least 1e-4)."""
+        if not self.tanh:
+            return self.log_std.expand(*head.shape[:-1], self.act_dim)
+        return torch.log(nn.functional.softplus(head[..., self.act_dim :] + SOFTPLUS_BIAS) + 1e-4)
+
+    def log_prob(self, obs: torch.Tensor, act: torch.Tensor, head: torch.Tensor | None = None) -> torch.Tensor:
+        """log pi(act | obs) of the Gaussian sample `act` (before the tanh, with `tanh`: the tanh's
+        Jacobian is the same for the old and the new policy, so it leaves PPO's ratio alone), summed
+        over the action's entries: torch's `Normal(...).log_prob(act).sum(-1)` in fewer tensor
+        operations (the update's hot path on small batches); `head`: `head(obs)` if known."""
+        head = self.head(obs) if head is None else head
+        log_std = self.log_stds(head)
+        z = (act - head[..., : self.act_dim]) * torch.exp(-log_std)
+        return -0.5 * (z * z).sum(-1) - log_std.sum(-1) - 0.5 * LOG_2PI * act.shape[-1]
 
     def value(self, critic_in: torch.Tensor) -> torch.Tensor:
         return self.v(self.critic_norm(critic_in)).squeeze(-1)
@@ -119,22 +141,25 @@ class ActorCritic(nn.Module):
 
     @torch.no_grad()
     def act(self, obs: np.ndarray, ids: np.ndarray | None = None) -> np.ndarray:
-        """Deterministic action (the mean, clipped to [-1, 1]) for observations of shape (..., obs_dim)
+        """Deterministic action (the mean, clipped to [-1, 1]; its tanh with `tanh`) for observations of shape (..., obs_dim)
         ((..., N, obs_dim) with `agents`, or `ids` given: see `actor_input`; with a `history`, stacked
         observations: see `policy`)."""
         x = self.actor_input(obs, ids)
         o = torch.from_numpy(np.array(x, dtype=np.float32).reshape(-1, x.shape[-1]))
-        a = self.pi(self.obs_norm(o)).clamp(-1, 1)
+        mu = self.mean(o)
+        a = torch.tanh(mu) if self.tanh else mu.clamp(-1, 1)
         return a.numpy().reshape(*x.shape[:-1], -1).astype(np.float32)
 
     @torch.no_grad()
     def sample(self, obs: np.ndarray, generator: torch.Generator, ids: np.ndarray | None = None) -> np.ndarray:
-        """Stochastic action, as in training: the mean plus Gaussian noise of sd `exp(log_std)` drawn
-        from `generator`, unclipped (the env's action map clips it)."""
+        """Stochastic action, as in training: the mean plus Gaussian noise of sd `exp(log_stds)` drawn
+        from `generator`, unclipped (the env's action map clips it); its tanh with `tanh`."""
         x = self.actor_input(obs, ids)
         o = torch.from_numpy(np.array(x, dtype=np.float32).reshape(-1, x.shape[-1]))
-        mu = self.pi(self.obs_norm(o))
-        a = mu + torch.exp(self.log_std) * torch.randn(mu.shape, generator=generator)
+        head = self.head(o)
+        mu = head[..., : self.act_dim]
+        a = mu + torch.exp(self.log_stds(head)) * torch.randn(mu.shape, generator=generator)
+        a = torch.tanh(a) if self.tanh else a
         return a.numpy().reshape(*x.shape[:-1], -1).astype(np.float32)
 
 
@@ -167,8 +192,9 @@ def load_model(path: str, obs_dim: int, history: int = 1) -> ActorCritic:
     actions, hidden units, agent ids) read from the saved tensors; in evaluation mode."""
     state = torch.load(path)
     hidden, inputs = state["pi.0.weight"].shape
-    model = ActorCritic(obs_dim, state["v.0.weight"].shape[1], act_dim=state["log_std"].shape[0], hidden=hidden,
-                        agents=inputs - obs_dim * history, history=history)
+    act_dim = state["log_std"].shape[0]
+    model = ActorCritic(obs_dim, state["v.0.weight"].shape[1], act_dim=act_dim, hidden=hidden,
+                        agents=inputs - obs_dim * history, history=history, tanh=state["pi.4.weight"].shape[0] == 2 * act_dim)
     model.load_state_dict(state)
     model.eval()
     return model
@@ -221,6 +247,7 @@ class Config:
     actor_warmup: int = 0  # the first N updates train only the critic (an actor that starts good, e.g. kickstarted, keeps still)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     own_critic: bool = False  # the critic sees only the agent's own observation (critic_input's `own`)
+    tanh: bool = False  # BenchMARL's actor: tanh of a Gaussian of learned, observation-dependent widths (ActorCritic's `tanh`)
     # Clip the actor's and the critic's gradients to `grad_norm` each, instead of one norm over both (where a
     # large critic error shrinks the actor's step with it).
     clip_apart: bool = False
@@ -267,14 +294,16 @@ class Trainer:
         self.e, self.n, self.d, self.b = e, n, d, e * n
         self.w = env.single_action_space.shape[0]
         self.c = critic_dim(env, cfg.team_critic, cfg.own_critic)
+        if cfg.tanh and (cfg.anchor or cfg.listen_bias or cfg.signal_bias or cfg.start_forward or cfg.start_lay):
+            raise ValueError("a tanh actor (Config.tanh) takes no anchor, listen_bias, signal_bias, start_forward or start_lay")
         self.model = ActorCritic(d, self.c, act_dim=self.w, hidden=cfg.hidden, agents=n if cfg.agent_id else 0,
-                                 history=cfg.history)
+                                 history=cfg.history, tanh=cfg.tanh)
         # The actor's input: the observations it remembers (and the agent's one-hot).
         self.d_in = d * cfg.history + self.model.agents
         self.memory = Memory(cfg.history)
         with torch.no_grad():
             self.model.pi[-1].bias[:2] = cfg.start_forward
-            self.model.pi[-1].bias[2:] = cfg.start_lay
+            self.model.pi[-1].bias[2 : self.w] = cfg.start_lay
         self.opt = torch.optim.Adam(self.model.parameters(), lr=cfg.lr, eps=1e-5)
         self.kl = 0.0  # the mean KL divergence of the last update's minibatch steps
         # Rewards are divided by a running std of the discounted return, so that the critic's targets
@@ -315,9 +344,12 @@ class Trainer:
             cri_buf[t] = critic_input(self.obs, self.state, self.cfg.team_critic, self.cfg.own_critic)
             with torch.no_grad():
                 noise = torch.randn(b, self.w)
-                act_buf[t] = model.pi(model.obs_norm(torch.from_numpy(obs_buf[t]))) + noise * model.log_std.exp()
-                logp_buf[t] = -0.5 * (noise * noise).sum(-1) - model.log_std.sum() - 0.5 * LOG_2PI * self.w
-            action = self.to_env(act_buf[t].numpy().reshape(e, n, self.w))
+                head = model.head(torch.from_numpy(obs_buf[t]))
+                log_std = model.log_stds(head)
+                act_buf[t] = head[:, : self.w] + noise * log_std.exp()
+                logp_buf[t] = -0.5 * (noise * noise).sum(-1) - log_std.sum(-1) - 0.5 * LOG_2PI * self.w
+            raw = act_buf[t].numpy().reshape(e, n, self.w)
+            action = self.to_env(np.tanh(raw) if cfg.tanh else raw)
             t1 = time.perf_counter()
             self.obs, rew, term, trunc, infos = self.env.step(action)
             self.seconds["env"] += time.perf_counter() - t1
@@ -378,13 +410,14 @@ class Trainer:
             perm = torch.randperm(m)
             for k in range(0, m, size):
                 idx = perm[k : k + size]
-                mu = model.mean(fo[idx])
-                log_ratio = model.log_prob(fo[idx], fa[idx], mu) - fl[idx]
+                head = model.head(fo[idx])
+                mu = head[:, : self.w]
+                log_ratio = model.log_prob(fo[idx], fa[idx], head) - fl[idx]
                 ratio = log_ratio.exp()
                 pg = -torch.min(ratio * fadv[idx], ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * fadv[idx]).mean()
                 vloss = 0.5 * (model.value(fc[idx]) - fret[idx]).pow(2).mean()
-                # The Gaussian's entropy is sum(log_std) + const: the same for every sample.
-                loss = pg + 0.5 * vloss - cfg.ent_coef * model.log_std.sum()
+                # The Gaussian's entropy is sum(log_std) + const (before a tanh).
+                loss = pg + 0.5 * vloss - cfg.ent_coef * model.log_stds(head).sum(-1).mean()
                 if cfg.anchor and self.anchor is not None:
                     with torch.no_grad():
                         frozen = self.anchor[0](self.anchor[1](fo[idx]))

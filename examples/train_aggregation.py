@@ -100,7 +100,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     """One training run: its evaluation curve (training seconds, updates, agent-steps, return)."""
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr, gamma=args.gamma,
-                     lam=args.lam, hidden=args.hidden, own_critic=args.own_critic, grad_norm=args.grad_norm,
+                     lam=args.lam, hidden=args.hidden, own_critic=args.own_critic, grad_norm=args.grad_norm, tanh=args.tanh,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
                      agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
                      target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup)
@@ -262,6 +262,8 @@ def main() -> None:
     p.add_argument("--team-critic", action="store_true", help="the critic also sees every follower's observation")
     p.add_argument("--grad-norm", type=float, default=ppo.Config.grad_norm, help="gradients are clipped to this norm")
     p.add_argument("--own-critic", action="store_true", help="the critic sees only the agent's own observation (as IPPO's)")
+    p.add_argument("--tanh", action="store_true",
+                   help="BenchMARL's actor: the tanh of a Gaussian whose widths the network gives per observation")
     p.add_argument("--agent-id", action="store_true",
                    help="the actor also sees which follower it drives (a one-hot): one policy, each robot its own way")
     p.add_argument("--history", type=int, default=1,
@@ -290,6 +292,8 @@ def main() -> None:
         p.error(f"--grad-norm ({args.grad_norm}) must be above 0")
     if args.hidden < 1:
         p.error(f"--hidden ({args.hidden}) must be at least 1")
+    if args.tanh and (args.kickstart or args.anchor):
+        p.error("--tanh: a tanh actor is not kickstarted (--kickstart, --anchor)")
     if args.own_critic and args.team_critic:
         p.error("--own-critic and --team-critic choose the critic's input: choose one")
     if args.holdout_worlds < 0 or args.holdout_worlds == 1:

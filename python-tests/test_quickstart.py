@@ -28,6 +28,43 @@ def test_log_prob_is_the_gaussian_log_density():
     assert torch.allclose(model.log_prob(obs, act), want, atol=1e-5)
 
 
+def test_a_tanh_actor_is_a_squashed_gaussian_of_learned_widths(tmp_path):
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    torch.manual_seed(4)
+    model = ppo.ActorCritic(17, 20, act_dim=2, tanh=True)
+    assert model.pi[-1].out_features == 4
+    obs = torch.randn(50, 17)
+    # Untrained: the widths are 1, as BenchMARL's biased softplus starts them.
+    assert torch.allclose(model.log_stds(model.head(obs)).exp(), torch.ones(50, 2), atol=1e-2)
+    with torch.no_grad():
+        model.pi[-1].weight.normal_()
+    head = model.head(obs)
+    sd = torch.nn.functional.softplus(head[:, 2:] + ppo.SOFTPLUS_BIAS) + 1e-4
+    act = torch.randn(50, 2) * 3
+    want = torch.distributions.Normal(head[:, :2], sd).log_prob(act).sum(-1)
+    assert torch.allclose(model.log_prob(obs, act), want, atol=1e-4)
+    # Acting: the mean's tanh; sampling: inside (-1, 1) and spread by the widths.
+    x = obs.numpy()
+    np.testing.assert_allclose(model.act(x), torch.tanh(head[:, :2]).detach().numpy(), atol=1e-6)
+    drawn = model.sample(x, torch.Generator().manual_seed(0))
+    assert np.all(np.abs(drawn) < 1) and not np.allclose(drawn, model.act(x))
+    # Trained a little and saved, it loads back as the same tanh actor.
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=20, num_threads=1)
+    trainer = ppo.Trainer(env, ppo.Config(horizon=8, epochs=1, minibatches=2, tanh=True, hidden=16), seed=0)
+    before = trainer.model.pi[-1].weight.detach().clone()
+    trainer.iterate()
+    assert not torch.equal(before, trainer.model.pi[-1].weight)
+    torch.save(trainer.model.state_dict(), tmp_path / "policy.pt")
+    loaded = ppo.load_model(str(tmp_path / "policy.pt"), 17)
+    assert loaded.tanh
+    np.testing.assert_array_equal(loaded.act(x), trainer.model.act(x))
+    with pytest.raises(ValueError, match="a tanh actor"):
+        ppo.Trainer(env, ppo.Config(tanh=True, anchor=0.1), seed=0)
+
+
 def test_trainer_counts_updates_and_samples():
     pytest.importorskip("torch")
     from colcos.vector import VecEnv
@@ -165,7 +202,8 @@ def test_quickstart_refuses_a_bad_param(tmp_path):
     assert res.returncode == 2 and "--gamma (0.0) must be in (0, 1]" in res.stderr
     for flags, text in ((["--lam", "1.5"], "--lam (1.5) must be in [0, 1]"), (["--hidden", "0"], "--hidden (0) must be at least 1"),
                         (["--grad-norm", "0"], "--grad-norm (0.0) must be above 0"),
-                        (["--own-critic", "--team-critic"], "--own-critic and --team-critic choose the critic's input")):  # fmt: skip
+                        (["--own-critic", "--team-critic"], "--own-critic and --team-critic choose the critic's input"),
+                        (["--tanh", "--kickstart", "100"], "--tanh: a tanh actor is not kickstarted")):  # fmt: skip
         res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), *flags, "--out", str(tmp_path)],
                              capture_output=True, text=True, timeout=120)  # fmt: skip
         assert res.returncode == 2 and text in res.stderr, flags
