@@ -142,9 +142,9 @@ def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> Experiment
     cfg.loggers = ["csv"]
     cfg.create_json = True  # marl-eval's JSON, which BenchMARL's plotting reads
     cfg.save_folder = str(out)
-    # The trained policy (and critic and optimiser) at the end, for `--evaluate`: no replay buffer.
+    # The trained policy (and critic and optimiser) at each evaluation and at the end, for `--evaluate`
+    # and for a run that diverges: the latest only, no replay buffer.
     cfg.checkpoint_at_end = True
-    cfg.checkpoint_interval = 0
     cfg.exclude_buffer_from_checkpoint = True
     cfg.keep_checkpoints_num = 1
     cfg.prefer_continuous_actions = not args.discrete
@@ -171,6 +171,7 @@ def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> Experiment
         cfg.off_policy_n_optimizer_steps = 2
         cfg.off_policy_train_batch_size = 32
         cfg.off_policy_init_random_frames = 0
+    cfg.checkpoint_interval = cfg.evaluation_interval
     return cfg
 
 
@@ -223,9 +224,24 @@ def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any
         seed=seed,
         config=experiment_config(args, out),
     )
-    experiment.run()
+    diverged = None
+    try:
+        experiment.run()
+    except colcos.ActionError as e:
+        if "NaN" not in str(e):
+            raise
+        # BenchMARL's PPO can diverge to NaN actions (facebookresearch/BenchMARL#144): the run is
+        # scored on its last checkpoint instead of losing it.
+        diverged = f"the policy's actions became NaN after {experiment.total_frames} frames"
     wall = time.time() - t0
-    held = held_out(args.task, trained_policy(experiment), args, continuous=not args.discrete)
+    checkpoints = sorted((pathlib.Path(experiment.folder_name) / "checkpoints").glob("*.pt"),
+                         key=lambda p: int(p.stem.rpartition("_")[2]))  # fmt: skip
+    scored = experiment
+    if diverged:
+        print(f"seed {seed}: {diverged}; scored on its last checkpoint"
+              f" ({checkpoints[-1].name if checkpoints else 'none: not scored'})", file=sys.stderr)  # fmt: skip
+        scored = Experiment.reload_from_file(str(checkpoints[-1])) if checkpoints else None
+    held = held_out(args.task, trained_policy(scored), args, continuous=not args.discrete) if scored else None
     files = sorted(pathlib.Path(experiment.folder_name).rglob("*.json"))
     final = None
     if files:
@@ -234,9 +250,9 @@ def run(args: argparse.Namespace, seed: int, out: pathlib.Path) -> dict[str, Any
         last = max((k for k in steps if k.startswith("step_")), key=lambda k: int(k.split("_")[1]))
         # "return": per evaluation episode, an agent's summed reward averaged over the agents.
         final = float(np.mean(steps[last]["return"]))
-    checkpoints = sorted((pathlib.Path(experiment.folder_name) / "checkpoints").glob("*.pt"))
     return {"seed": seed, "final_return": final, "held_out": held, "wall_s": wall, "frames": experiment.total_frames,
-            "folder": str(experiment.folder_name), "checkpoint": str(checkpoints[-1]) if checkpoints else None}  # fmt: skip
+            "folder": str(experiment.folder_name), "checkpoint": str(checkpoints[-1]) if checkpoints else None,
+            "diverged": diverged}  # fmt: skip
 
 
 def evaluate(args: argparse.Namespace) -> None:
@@ -340,8 +356,9 @@ def main() -> None:
     print(f"{args.algorithm} on {args.task} ({'discrete' if args.discrete else 'continuous'}), {args.frames} frames:")
     for r in runs:
         h = r["held_out"]
+        scored = f"{h['mean']:.1f} ± {h['se']:.1f}" if h else "not scored"
         print(f"  seed {r['seed']}: final evaluation return {r['final_return']}, {r['wall_s']:.0f} s;"
-              f" {args.holdout_worlds} held-out episodes {h['mean']:.1f} ± {h['se']:.1f}")  # fmt: skip
+              f" {args.holdout_worlds} held-out episodes {scored}" + (f" ({r['diverged']})" if r["diverged"] else ""))  # fmt: skip
     if finals:
         print(f"  median {np.median(finals):.1f}, spread {np.min(finals):.1f} .. {np.max(finals):.1f}")
     for k, v in refs.items():
