@@ -247,6 +247,11 @@ class Config:
     actor_warmup: int = 0  # the first N updates train only the critic (an actor that starts good, e.g. kickstarted, keeps still)
     team_critic: bool = False  # the critic sees every agent's observation (critic_input's `team`)
     own_critic: bool = False  # the critic sees only the agent's own observation (critic_input's `own`)
+    # IPPO's objective (BenchMARL's ClipPPOLoss: normalize_advantage=False, no reward scaling): with
+    # `raw_advantages` the advantages are not standardised over the batch, with `raw_rewards` the
+    # rewards are not divided by the running std of the discounted return.
+    raw_advantages: bool = False
+    raw_rewards: bool = False
     tanh: bool = False  # BenchMARL's actor: tanh of a Gaussian of learned, observation-dependent widths (ActorCritic's `tanh`)
     # Clip the actor's and the critic's gradients to `grad_norm` each, instead of one norm over both (where a
     # large critic error shrinks the actor's step with it).
@@ -383,7 +388,7 @@ class Trainer:
         cri = torch.from_numpy(cri_buf)
         with torch.no_grad():  # every value of the rollout in one batched forward pass
             values = model.value(cri.reshape((T + 1) * b, -1)).reshape(T + 1, b).numpy()
-        scale = float(torch.sqrt(self.ret_norm.var[0] + 1e-8))
+        scale = 1.0 if cfg.raw_rewards else float(torch.sqrt(self.ret_norm.var[0] + 1e-8))
         adv = np.zeros((T, b), np.float32)
         last = np.zeros(b, np.float32)
         for t in reversed(range(T)):
@@ -400,7 +405,8 @@ class Trainer:
         fret = torch.from_numpy(ret.reshape(-1))[keep]
         model.obs_norm.update(fo)
         model.critic_norm.update(fc)
-        fadv = (fadv - fadv.mean()) / (fadv.std() + 1e-8)
+        if not cfg.raw_advantages:
+            fadv = (fadv - fadv.mean()) / (fadv.std() + 1e-8)
         m = fo.shape[0]
         size = max(1, -(-m // cfg.minibatches))
         if cfg.anneal:
