@@ -388,7 +388,7 @@ class Trainer:
         cri = torch.from_numpy(cri_buf)
         with torch.no_grad():  # every value of the rollout in one batched forward pass
             values = model.value(cri.reshape((T + 1) * b, -1)).reshape(T + 1, b).numpy()
-        scale = 1.0 if cfg.raw_rewards else float(torch.sqrt(self.ret_norm.var[0] + 1e-8))
+        scale = self.reward_scale()
         adv = np.zeros((T, b), np.float32)
         last = np.zeros(b, np.float32)
         for t in reversed(range(T)):
@@ -405,8 +405,7 @@ class Trainer:
         fret = torch.from_numpy(ret.reshape(-1))[keep]
         model.obs_norm.update(fo)
         model.critic_norm.update(fc)
-        if not cfg.raw_advantages:
-            fadv = (fadv - fadv.mean()) / (fadv.std() + 1e-8)
+        fadv = self.policy_advantages(fadv)
         m = fo.shape[0]
         size = max(1, -(-m // cfg.minibatches))
         if cfg.anneal:
@@ -444,6 +443,16 @@ class Trainer:
                 if cfg.target_kl:
                     self._set_lr(adapt_lr(self.lr, kl, cfg.target_kl))
         self.kl = float(np.mean(kls))
+
+    def reward_scale(self) -> float:
+        """What the rewards are divided by before the advantages: the running sd of the discounted
+        return, or 1 with `raw_rewards`."""
+        return 1.0 if self.cfg.raw_rewards else float(torch.sqrt(self.ret_norm.var[0] + 1e-8))
+
+    def policy_advantages(self, adv: torch.Tensor) -> torch.Tensor:
+        """The advantages the policy loss weighs: standardised over the batch, or as they are with
+        `raw_advantages`."""
+        return adv if self.cfg.raw_advantages else (adv - adv.mean()) / (adv.std() + 1e-8)
 
     @property
     def lr(self) -> float:

@@ -65,6 +65,23 @@ def test_a_tanh_actor_is_a_squashed_gaussian_of_learned_widths(tmp_path):
         ppo.Trainer(env, ppo.Config(tanh=True, anchor=0.1), seed=0)
 
 
+def test_raw_rewards_and_advantages_are_left_as_they_are():
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=20, num_threads=1)
+    adv = torch.tensor([3.0, -1.0, 5.0, 0.5])
+    scaled = ppo.Trainer(env, ppo.Config(horizon=8, epochs=1, minibatches=1, hidden=16), seed=0)
+    raw = ppo.Trainer(env, ppo.Config(horizon=8, epochs=1, minibatches=1, hidden=16, raw_rewards=True, raw_advantages=True), seed=0)
+    for trainer in (scaled, raw):
+        trainer.iterate()
+    assert scaled.reward_scale() != pytest.approx(1.0, abs=1e-3) and raw.reward_scale() == 1.0
+    standard = scaled.policy_advantages(adv)
+    assert float(standard.mean()) == pytest.approx(0.0, abs=1e-6) and float(standard.std()) == pytest.approx(1.0, abs=1e-5)
+    assert torch.equal(raw.policy_advantages(adv), adv)
+
+
 def test_trainer_counts_updates_and_samples():
     pytest.importorskip("torch")
     from colcos.vector import VecEnv
