@@ -252,6 +252,9 @@ class Config:
     # rewards are not divided by the running std of the discounted return.
     raw_advantages: bool = False
     raw_rewards: bool = False
+    # Truncated episodes (the time limit) bootstrap from their final observation's value, as TorchRL's
+    # and SB3's PPO do; off, a truncation is treated as a termination (the value after it is 0).
+    bootstrap_truncated: bool = False
     tanh: bool = False  # BenchMARL's actor: tanh of a Gaussian of learned, observation-dependent widths (ActorCritic's `tanh`)
     # Clip the actor's and the critic's gradients to `grad_norm` each, instead of one norm over both (where a
     # large critic error shrinks the actor's step with it).
@@ -341,6 +344,7 @@ class Trainer:
         logp_buf = torch.zeros(T, b)
         rew_buf = np.zeros((T, b), np.float32)
         done_buf = np.zeros((T, b), np.float32)
+        term_buf = np.zeros((T, b), np.float32)
         valid_buf = np.zeros((T, b), bool)
         model = self.model
         for t in range(T):
@@ -369,7 +373,7 @@ class Trainer:
             valid_buf[t] = ~self.prev_done
             self.disc_ret = self.disc_ret * cfg.gamma * (~self.prev_done) + r
             self.ret_norm.update(torch.from_numpy(self.disc_ret[~self.prev_done].astype(np.float32))[:, None])
-            rew_buf[t], done_buf[t] = r, done
+            rew_buf[t], done_buf[t], term_buf[t] = r, done, term.reshape(b)
             self.ep_return += r
             if done.any():
                 self.finished.extend(self.ep_return[done].tolist())
@@ -378,12 +382,12 @@ class Trainer:
             self.agent_steps += b
         t0 = time.perf_counter()
         cri_buf[T] = critic_input(self.obs, self.state, self.cfg.team_critic, self.cfg.own_critic)
-        self._learn(obs_buf, cri_buf, act_buf, logp_buf, rew_buf, done_buf, valid_buf)
+        self._learn(obs_buf, cri_buf, act_buf, logp_buf, rew_buf, done_buf, term_buf, valid_buf)
         self.seconds["learn"] += time.perf_counter() - t0
         self.updates += 1
         return float(rew_buf[valid_buf].mean()) if valid_buf.any() else 0.0
 
-    def _learn(self, obs_buf, cri_buf, act_buf, logp_buf, rew_buf, done_buf, valid_buf) -> None:
+    def _learn(self, obs_buf, cri_buf, act_buf, logp_buf, rew_buf, done_buf, term_buf, valid_buf) -> None:
         cfg, model, T, b = self.cfg, self.model, self.cfg.horizon, self.b
         cri = torch.from_numpy(cri_buf)
         with torch.no_grad():  # every value of the rollout in one batched forward pass
@@ -393,7 +397,10 @@ class Trainer:
         last = np.zeros(b, np.float32)
         for t in reversed(range(T)):
             nonterminal = 1.0 - done_buf[t]
-            delta = rew_buf[t] / scale + cfg.gamma * values[t + 1] * nonterminal - values[t]
+            # An episode cut by its time limit goes on from its final observation (the one the done
+            # step returned, `values[t + 1]`); only a terminated one is worth nothing after it.
+            boot = 1.0 - term_buf[t] if cfg.bootstrap_truncated else nonterminal
+            delta = rew_buf[t] / scale + cfg.gamma * values[t + 1] * boot - values[t]
             last = delta + cfg.gamma * cfg.lam * nonterminal * last
             adv[t] = last
         ret = adv + values[:T]

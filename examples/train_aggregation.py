@@ -101,7 +101,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr, gamma=args.gamma,
                      lam=args.lam, hidden=args.hidden, own_critic=args.own_critic, grad_norm=args.grad_norm, tanh=args.tanh,
-                     raw_advantages=args.raw_advantages, raw_rewards=args.raw_rewards,
+                     raw_advantages=args.raw_advantages, raw_rewards=args.raw_rewards, bootstrap_truncated=args.bootstrap_truncated,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
                      agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
                      target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup)
@@ -267,6 +267,8 @@ def main() -> None:
                    help="advantages not standardised over each batch (as BenchMARL's PPO losses)")
     p.add_argument("--raw-rewards", action="store_true",
                    help="rewards not scaled by the running sd of the discounted return (as BenchMARL's)")
+    p.add_argument("--bootstrap-truncated", action="store_true",
+                   help="an episode cut by its time limit bootstraps from its final observation's value (not 0)")
     p.add_argument("--tanh", action="store_true",
                    help="BenchMARL's actor: the tanh of a Gaussian whose widths the network gives per observation")
     p.add_argument("--agent-id", action="store_true",
