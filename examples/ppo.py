@@ -392,17 +392,7 @@ class Trainer:
         cri = torch.from_numpy(cri_buf)
         with torch.no_grad():  # every value of the rollout in one batched forward pass
             values = model.value(cri.reshape((T + 1) * b, -1)).reshape(T + 1, b).numpy()
-        scale = self.reward_scale()
-        adv = np.zeros((T, b), np.float32)
-        last = np.zeros(b, np.float32)
-        for t in reversed(range(T)):
-            nonterminal = 1.0 - done_buf[t]
-            # An episode cut by its time limit goes on from its final observation (the one the done
-            # step returned, `values[t + 1]`); only a terminated one is worth nothing after it.
-            boot = 1.0 - term_buf[t] if cfg.bootstrap_truncated else nonterminal
-            delta = rew_buf[t] / scale + cfg.gamma * values[t + 1] * boot - values[t]
-            last = delta + cfg.gamma * cfg.lam * nonterminal * last
-            adv[t] = last
+        adv = gae(rew_buf / self.reward_scale(), values, done_buf, term_buf, cfg.gamma, cfg.lam, cfg.bootstrap_truncated)
         ret = adv + values[:T]
         keep = torch.from_numpy(valid_buf.reshape(-1))
         fo = torch.from_numpy(obs_buf.reshape(T * b, -1))[keep]
@@ -469,6 +459,23 @@ class Trainer:
     def _set_lr(self, lr: float) -> None:
         for group in self.opt.param_groups:
             group["lr"] = lr
+
+
+def gae(rew: np.ndarray, values: np.ndarray, done: np.ndarray, term: np.ndarray, gamma: float, lam: float,
+        bootstrap_truncated: bool = False) -> np.ndarray:  # fmt: skip
+    """Generalised advantage estimates (T, B) of a rollout: rewards, dones and terminations (T, B),
+    values (T + 1, B). After a done step the estimate starts again; an episode cut by its time limit
+    goes on from its final observation (the one the done step returned, `values[t + 1]`) with
+    `bootstrap_truncated`, else it is worth nothing after it, as after a termination."""
+    adv = np.zeros(rew.shape, np.float32)
+    last = np.zeros(rew.shape[1:], np.float32)
+    for t in reversed(range(rew.shape[0])):
+        nonterminal = 1.0 - done[t]
+        boot = 1.0 - term[t] if bootstrap_truncated else nonterminal
+        delta = rew[t] + gamma * values[t + 1] * boot - values[t]
+        last = delta + gamma * lam * nonterminal * last
+        adv[t] = last
+    return adv
 
 
 def adapt_lr(lr: float, kl: float, target: float, low: float = 1e-5, high: float = 1e-2) -> float:

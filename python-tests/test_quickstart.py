@@ -82,6 +82,24 @@ def test_raw_rewards_and_advantages_are_left_as_they_are():
     assert torch.equal(raw.policy_advantages(adv), adv)
 
 
+def test_a_truncated_episode_bootstraps_from_its_final_observation_only_when_asked():
+    pytest.importorskip("torch")
+    ppo = load_ppo()
+    g, lam = 0.9, 0.5
+    rew = np.array([[1.0], [1.0], [1.0]], np.float32)
+    values = np.array([[0.5], [0.5], [2.0], [0.5]], np.float32)  # values[2]: the final observation of step 1
+    done, term = np.array([[0.0], [1.0], [0.0]], np.float32), np.zeros((3, 1), np.float32)
+    after = 1.0 + g * 0.5 - 2.0  # step 2 (a reset step, masked in training) bootstraps from values[3]
+    for boot, cut in ((False, 1.0 - 0.5), (True, 1.0 + g * 2.0 - 0.5)):
+        adv = ppo.gae(rew, values, done, term, g, lam, bootstrap_truncated=boot)
+        # The episode ends at step 1: its estimate does not run on into step 2's.
+        np.testing.assert_allclose(adv[:, 0], [1.0 + g * 0.5 - 0.5 + g * lam * cut, cut, after], rtol=1e-6)
+    # A termination is worth nothing after it either way.
+    ended = ppo.gae(rew, values, done, done, g, lam, bootstrap_truncated=True)
+    np.testing.assert_allclose(ended, ppo.gae(rew, values, done, done, g, lam), rtol=1e-6)
+    assert ended[1, 0] == pytest.approx(0.5)
+
+
 def test_trainer_counts_updates_and_samples():
     pytest.importorskip("torch")
     from colcos.vector import VecEnv
