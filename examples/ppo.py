@@ -3,7 +3,8 @@
 All agents of all worlds share one policy; each (world, agent) pair is one sample stream. The actor sees
 only the agent's own observation (running z-score); the critic, used only in training, also sees the
 global state (`infos["state"]`) and a one-hot agent id (with `Config.own_critic`, the observation
-alone, as IPPO's). One `Trainer.iterate()` collects a rollout of
+alone, as IPPO's; with `Config.bootstrap_truncated`, an episode cut by its time limit bootstraps from
+its final observation's value instead of ending at 0). One `Trainer.iterate()` collects a rollout of
 `horizon` steps of every stream and runs `epochs` x `minibatches` clipped-PPO steps on it; a budget is
 a whole number of those updates, so a loaded machine changes the time a run takes, not its result.
 
