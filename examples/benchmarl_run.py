@@ -133,7 +133,7 @@ def observation_policy(experiment: Experiment) -> Any:
 def trained_policy(experiment: Experiment) -> Any:
     """The trained policy acting in a colcos `VecEnv`: `make(venv)()` gives the actions for `venv.obs`."""
     act = observation_policy(experiment)
-    return lambda venv: (lambda: act(np.array(venv.obs)))
+    return lambda venv: (lambda: act(venv.obs))  # `act` copies the observations once
 
 
 def experiment_config(args: argparse.Namespace, out: pathlib.Path) -> ExperimentConfig:

@@ -231,8 +231,8 @@ def report(result: dict, args) -> str:
         pairs += [(f"identified-s{seed} − {other}-s{seed}", (f"identified-s{seed}", "twin"), (f"{other}-s{seed}", "twin"))
                   for seed in args.seeds for other in ("nominal", "generic")]
     if "twin" in twins:
-        first, *others = [name for name, _ in args.benchmarl] or [""]
-        pairs += [(f"{k} − {first}", (k, "twin"), (first, "twin")) for k in others]
+        bench = [name for name, _ in args.benchmarl]
+        pairs += [(f"{k} − {bench[0]}", (k, "twin"), (bench[0], "twin")) for k in bench[1:]]
     if {"twin", "twin_compensated"} <= set(twins):
         pairs += [(f"{k}: compensated − not", (k, "twin_compensated"), (k, "twin")) for k in res if k != "standing still"]
     if pairs:
