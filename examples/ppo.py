@@ -253,6 +253,9 @@ class Config:
     # rewards are not divided by the running std of the discounted return.
     raw_advantages: bool = False
     raw_rewards: bool = False
+    # The actor's and the critic's inputs as the env gives them (BenchMARL's default): their running
+    # z-scores are never updated, so they stay the identity (within their clamp at +-10).
+    raw_observations: bool = False
     # Truncated episodes (the time limit) bootstrap from their final observation's value, as TorchRL's
     # and SB3's PPO do; off, a truncation is treated as a termination (the value after it is 0).
     bootstrap_truncated: bool = False
@@ -401,8 +404,9 @@ class Trainer:
         fa, fl = act_buf.reshape(T * b, -1)[keep], logp_buf.reshape(-1)[keep]
         fadv = torch.from_numpy(adv.reshape(-1))[keep]
         fret = torch.from_numpy(ret.reshape(-1))[keep]
-        model.obs_norm.update(fo)
-        model.critic_norm.update(fc)
+        if not cfg.raw_observations:
+            model.obs_norm.update(fo)
+            model.critic_norm.update(fc)
         fadv = self.policy_advantages(fadv)
         m = fo.shape[0]
         size = max(1, -(-m // cfg.minibatches))

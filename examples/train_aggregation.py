@@ -1,9 +1,11 @@
 """Quick start: PPO learns the follower of case II (aggregation) in two minutes on two cores.
 
 All followers of all worlds share one policy (`examples/ppo.py`); each (world, follower) pair is one
-sample stream. The actor sees only the follower's own 17 sensor values; the critic (used only in
-training) also sees the global state and which follower it is; the actor's and the critic's
-gradients are clipped each to its own norm (`ppo.Config.clip_apart`). The budget is a number of PPO updates,
+sample stream. The actor sees only the follower's own 17 sensor values, and so does the critic (used
+only in training; IPPO's, `--no-own-critic` adds the global state and which follower it is); an
+episode cut by its time limit is valued on from its final observation (`--no-bootstrap-truncated`:
+worth 0 after the cut); the actor's and the critic's gradients are clipped each to its own norm
+(`ppo.Config.clip_apart`). The budget is a number of PPO updates,
 so a loaded machine changes how long a run takes, not what it learns. Every `--eval-every` updates the
 deterministic policy is evaluated on the same 32 seeded episodes as the paper's hand-written follower
 (evaluation time is not counted as training time). With several `--seeds` it trains one policy per
@@ -101,7 +103,8 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
     env = VecEnv(num_envs=args.num_envs, seed=seed, max_cycles=args.episode, **env_kwargs)
     cfg = ppo.Config(horizon=args.horizon, epochs=args.epochs, minibatches=args.minibatches, lr=args.lr, gamma=args.gamma,
                      lam=args.lam, hidden=args.hidden, own_critic=args.own_critic, grad_norm=args.grad_norm, tanh=args.tanh,
-                     raw_advantages=args.raw_advantages, raw_rewards=args.raw_rewards, bootstrap_truncated=args.bootstrap_truncated,
+                     raw_advantages=args.raw_advantages, raw_rewards=args.raw_rewards, raw_observations=args.raw_observations,
+                     bootstrap_truncated=args.bootstrap_truncated,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
                      agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
                      target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup)
@@ -262,13 +265,18 @@ def main() -> None:
                    help="clip actor and critic gradients as one norm (by default each its own: ppo.Config.clip_apart)")
     p.add_argument("--team-critic", action="store_true", help="the critic also sees every follower's observation")
     p.add_argument("--grad-norm", type=float, default=ppo.Config.grad_norm, help="gradients are clipped to this norm")
-    p.add_argument("--own-critic", action="store_true", help="the critic sees only the agent's own observation (as IPPO's)")
+    p.add_argument("--own-critic", action=argparse.BooleanOptionalAction, default=None,
+                   help="the critic sees only the agent's own observation, as IPPO's (the default unless --team-critic); "
+                        "--no-own-critic: also the global state and which follower it is")
     p.add_argument("--raw-advantages", action="store_true",
                    help="advantages not standardised over each batch (as BenchMARL's PPO losses)")
     p.add_argument("--raw-rewards", action="store_true",
                    help="rewards not scaled by the running sd of the discounted return (as BenchMARL's)")
-    p.add_argument("--bootstrap-truncated", action="store_true",
-                   help="an episode cut by its time limit bootstraps from its final observation's value (not 0)")
+    p.add_argument("--raw-observations", action="store_true",
+                   help="observations not standardised (as BenchMARL's default): the running z-scores stay the identity")
+    p.add_argument("--bootstrap-truncated", action=argparse.BooleanOptionalAction, default=True,
+                   help="an episode cut by its time limit bootstraps from its final observation's value (the default; "
+                        "--no-bootstrap-truncated: it is worth 0 after the cut, as after a termination)")
     p.add_argument("--tanh", action="store_true",
                    help="BenchMARL's actor: the tanh of a Gaussian whose widths the network gives per observation")
     p.add_argument("--agent-id", action="store_true",
@@ -303,6 +311,8 @@ def main() -> None:
         p.error("--tanh: a tanh actor is not kickstarted (--kickstart, --anchor)")
     if args.own_critic and args.team_critic:
         p.error("--own-critic and --team-critic choose the critic's input: choose one")
+    if args.own_critic is None:
+        args.own_critic = not args.team_critic
     if args.holdout_worlds < 0 or args.holdout_worlds == 1:
         p.error(f"--holdout-worlds ({args.holdout_worlds}) must be 0 (none) or at least 2 (a standard error needs two)")
     if args.holdout_seed == args.eval_seed:
@@ -338,6 +348,8 @@ def main() -> None:
         "load_average_1min": round(os.getloadavg()[0], 1),
         "eval_worlds": args.eval_worlds, "eval_steps": args.episode, "eval_seed": args.eval_seed,
         "scenario": args.scenario,
+        "critic": "own" if args.own_critic else "team" if args.team_critic else "state",
+        "bootstrap_truncated": args.bootstrap_truncated,
         "task_params": {k: v for k, v in env_kwargs.items() if k not in ("task", "num_threads", "scenario")},
         "references": refs,
         "median_half": {"seconds": float(np.median([h[0] for h in half])), "return": float(np.median([h[1] for h in half]))},

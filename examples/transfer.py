@@ -94,7 +94,9 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     flags = ["--anneal"] if args.anneal and args.updates else []
     flags += ["--agent-id"] if args.agent_id else []
     flags += ["--history", str(args.history)]
-    flags += ["--clip-together"]  # the study in docs/transfer.md trained with one gradient norm
+    # The study in docs/transfer.md trained with one gradient norm and the quick start's earlier critic
+    # (global state and agent id) and time limits (worth 0 after the cut).
+    flags += ["--clip-together", "--no-own-critic", "--no-bootstrap-truncated"]
     flags += ["--holdout-worlds", "0"]  # this study evaluates every policy itself, on its own episodes
     for seed in args.seeds:
         for name in args.variants:

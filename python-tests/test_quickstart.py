@@ -82,6 +82,23 @@ def test_raw_rewards_and_advantages_are_left_as_they_are():
     assert torch.equal(raw.policy_advantages(adv), adv)
 
 
+def test_raw_observations_reach_the_networks_as_the_env_gives_them():
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    env = VecEnv(task="aggregation", num_envs=2, max_cycles=20, num_threads=1)
+    cfg = {"horizon": 8, "epochs": 1, "minibatches": 1, "hidden": 16, "own_critic": True}
+    scored = ppo.Trainer(env, ppo.Config(**cfg), seed=0)
+    raw = ppo.Trainer(env, ppo.Config(**cfg, raw_observations=True), seed=0)
+    for trainer in (scored, raw):
+        trainer.iterate()
+    assert float(scored.model.obs_norm.mean.abs().max()) > 1e-3
+    x = torch.from_numpy(np.asarray(env.obs, np.float32).reshape(-1, env.single_observation_space.shape[0]))
+    for norm in (raw.model.obs_norm, raw.model.critic_norm):
+        assert torch.equal(norm(x), x.clamp(-10, 10))
+
+
 def test_a_truncated_episode_bootstraps_from_its_final_observation_only_when_asked():
     pytest.importorskip("torch")
     ppo = load_ppo()
@@ -190,7 +207,7 @@ def test_start_forward_and_start_lay_set_the_untrained_means_of_their_outputs():
 
 
 def test_quickstart_runs_and_reports(tmp_path):
-    pytest.importorskip("torch")
+    torch = pytest.importorskip("torch")
     args = ["--updates", "4", "--eval-every", "2", "--seeds", "0", "1", "--num-envs", "2", "--horizon", "8",
             "--episode", "20", "--eval-worlds", "2", "--holdout-worlds", "6", "--threads", "1", "--out", str(tmp_path)]
     out = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), *args],
@@ -205,6 +222,9 @@ def test_quickstart_runs_and_reports(tmp_path):
         # The held-out episodes at half the budget and at the end, each with its standard error.
         assert [(h["updates"], h["se"] > 0) for h in run["holdout"].values()] == [(2, True), (4, True)]
     assert (tmp_path / "policy.pt").exists()
+    # By default the critic reads the agent's own 17 observation entries and time limits bootstrap.
+    assert (result["critic"], result["bootstrap_truncated"]) == ("own", True)
+    assert torch.load(tmp_path / "policy.pt")["v.0.weight"].shape[1] == 17
     assert set(result["references"]) == {"paper_follower", "random", "standing_still"}
     held = result["holdout"]
     assert (held["worlds"], held["seed"]) == (6, 777)
