@@ -94,7 +94,7 @@ def test_raw_observations_reach_the_networks_as_the_env_gives_them():
     for trainer in (scored, raw):
         trainer.iterate()
     assert float(scored.model.obs_norm.mean.abs().max()) > 1e-3
-    x = torch.from_numpy(np.asarray(env.obs, np.float32).reshape(-1, env.single_observation_space.shape[0]))
+    x = torch.from_numpy(np.array(env.obs, np.float32).reshape(-1, env.single_observation_space.shape[0]))
     for norm in (raw.model.obs_norm, raw.model.critic_norm):
         assert torch.equal(norm(x), x.clamp(-10, 10))
 
