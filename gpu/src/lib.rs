@@ -33,7 +33,7 @@ use std::sync::{Arc, Mutex};
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
     #[error(
-        "no GPU adapter found (wgpu found no Vulkan/Metal/DX12/GL device{0}); use --backend cpu, or install a driver (for a software one on Debian: apt-get install mesa-vulkan-drivers libvulkan1)"
+        "no GPU adapter found (wgpu found no Vulkan/Metal/DX12 device{0}); use --backend cpu, or install a driver (for a software one on Debian: apt-get install mesa-vulkan-drivers libvulkan1)"
     )]
     NoAdapter(String),
     #[error("only a software adapter is present ({0}); `auto` prefers the CPU backend over it")]
@@ -172,14 +172,36 @@ fn rank(info: &wgpu::AdapterInfo) -> u32 {
     t * 2 + u32::from(info.backend == wgpu::Backend::Gl)
 }
 
+/// Whether [`GpuContext::new`] may open this adapter. Not a GL one unless `WGPU_BACKEND` asks for GL:
+/// wgpu's GL backend puts every call of a device behind one context lock that panics after 6 s, and a
+/// thread waiting on a long dispatch holds it (seen with llvmpipe and parallel tests).
+fn usable(info: &wgpu::AdapterInfo) -> bool {
+    info.backend != wgpu::Backend::Gl
+        || wgpu::Backends::from_env().is_some_and(|b| b.contains(wgpu::Backends::GL))
+}
+
 impl GpuContext {
     /// Opens the best adapter the policy allows (see [`adapters`] for the order).
     pub fn new(policy: AdapterPolicy) -> Result<Arc<GpuContext>> {
         let inst = instance();
         let mut list = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()));
         list.sort_by_key(|a| rank(&a.get_info()));
-        let Some(adapter) = list.into_iter().next() else {
-            return Err(GpuError::NoAdapter(String::new()));
+        let skipped: Vec<String> = list
+            .iter()
+            .map(|a| a.get_info())
+            .filter(|i| !usable(i))
+            .map(|i| describe(&i))
+            .collect();
+        let Some(adapter) = list.into_iter().find(|a| usable(&a.get_info())) else {
+            let why = if skipped.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; skipped {} (wgpu's GL backend panics when threads share its device; WGPU_BACKEND=gl uses it anyway)",
+                    skipped.join(", ")
+                )
+            };
+            return Err(GpuError::NoAdapter(why));
         };
         let info = adapter.get_info();
         if policy == AdapterPolicy::HardwareOnly && is_software(&info) {
@@ -422,7 +444,7 @@ pub(crate) fn check_size(ctx: &GpuContext, what: &str, bytes: u64) -> Result<()>
 
 #[cfg(test)]
 mod tests {
-    use super::rank;
+    use super::{rank, usable};
     use wgpu::{AdapterInfo, Backend, DeviceType};
 
     fn adapter(name: &str, device_type: DeviceType, backend: Backend) -> AdapterInfo {
@@ -452,6 +474,15 @@ mod tests {
             adapter("NVIDIA H200", DeviceType::DiscreteGpu, Backend::Vulkan),
         ];
         list.sort_by_key(rank);
+        // GL only on request (WGPU_BACKEND), which the test environment does not set.
+        if std::env::var_os("WGPU_BACKEND").is_none() {
+            let opened: Vec<_> = list
+                .iter()
+                .filter(|a| usable(a))
+                .map(|a| a.backend)
+                .collect();
+            assert_eq!(opened, [Backend::Vulkan; 3]);
+        }
         let order: Vec<_> = list.iter().map(|a| (a.device_type, a.backend)).collect();
         assert_eq!(
             order,
