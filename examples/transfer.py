@@ -171,7 +171,10 @@ def ratio(tw: np.ndarray, sim: np.ndarray) -> float:
 
 def twin_columns(args) -> dict[str, str]:
     """The twin's columns and the host scenario of each: as the bridge assumes the nominal robots,
-    and (`--compensate`) with the fit undone in the bridge; `--compensated-only` runs the latter alone."""
+    and (`--compensate`) with the fit undone in the bridge; `--compensated-only` runs the latter alone;
+    none with `--twin-episodes 0` (the simulator's columns only)."""
+    if args.twin_episodes == 0:
+        return {}
     if args.compensated_only:
         return {"twin_compensated": "host_compensated"}
     return {"twin": "host", **({"twin_compensated": "host_compensated"} if args.compensate else {})}
@@ -185,7 +188,7 @@ def evaluate(paths: dict[str, str], args) -> dict:
     res: dict = {k: {} for k in table}
     for k, (sim_act, _) in table.items():
         for col in ("nominal", "truth"):
-            res[k][f"sim_{col}"] = sim_returns(sim_act, paths[col], args.eval_worlds, args.episode, 12345)
+            res[k][f"sim_{col}"] = sim_returns(sim_act, paths[col], args.eval_worlds, args.episode, args.eval_seed)
     out: dict = {"returns": res}
     t0 = time.time()
     for col, host in twin_columns(args).items():
@@ -281,8 +284,9 @@ def main() -> None:
     p.add_argument("--threads", type=int, default=None, help="env worker threads of each training run")
     p.add_argument("--episode", type=int, default=500, help="steps per episode (10 s)")
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
-    p.add_argument("--eval-worlds", type=int, default=32)
-    p.add_argument("--twin-episodes", type=int, default=8)
+    p.add_argument("--eval-worlds", type=int, default=32, help="simulator worlds (episodes) of each column")
+    p.add_argument("--eval-seed", type=int, default=12345, help="seed of the simulator's evaluation worlds")
+    p.add_argument("--twin-episodes", type=int, default=8, help="real-time twin episodes; 0: the simulator's columns only")
     p.add_argument("--fit", default=os.path.join(DATA, "fit.toml"))
     p.add_argument("--truth", default=os.path.join(DATA, "truth.toml"))
     p.add_argument("--agent-id", action="store_true",
@@ -306,6 +310,12 @@ def main() -> None:
     args = p.parse_args()
     if args.updates is not None and args.updates < 1:
         p.error(f"--updates ({args.updates}) must be at least 1")
+    if args.twin_episodes < 0:
+        p.error(f"--twin-episodes ({args.twin_episodes}) must be at least 0")
+    if args.twin_episodes == 0 and (args.compensate or args.compensated_only):
+        p.error("--compensate and --compensated-only need twin episodes (--twin-episodes 0 was given)")
+    if args.eval_worlds < 2:
+        p.error(f"--eval-worlds ({args.eval_worlds}) must be at least 2 (a column's sd needs two)")
     if args.history < 1:
         p.error(f"--history ({args.history}) must be at least 1")
     specs = [spec.partition("=") for spec in args.benchmarl]

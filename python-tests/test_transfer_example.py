@@ -67,6 +67,13 @@ def test_the_compensated_twin_alone_is_one_column_without_pairs():
     assert transfer.twin_columns(args) == {"twin_compensated": "host_compensated"}
     both = argparse.Namespace(**{**vars(args), "compensate": True, "compensated_only": False})
     assert transfer.twin_columns(both) == {"twin": "host", "twin_compensated": "host_compensated"}
+    sim_only = argparse.Namespace(**{**vars(args), "compensated_only": False, "twin_episodes": 0})
+    assert transfer.twin_columns(sim_only) == {}
+    sims = {k: {"sim_nominal": [v, v + 2.0], "sim_truth": [v, v]} for k, v in
+            (("nominal-s0", -100.0), ("hand-written", -150.0), ("standing still", -300.0))}
+    sim_table = transfer.report({"returns": sims}, sim_only)
+    assert sim_table.splitlines()[0] == "| policy | simulator, nominal (2 worlds) | simulator, truth (2 worlds) |"
+    assert "| nominal-s0 | -99.0 ± 1.4 | -100.0 ± 0.0 |" in sim_table and "twin" not in sim_table
     cols = lambda sim, twin: {"sim_nominal": [sim, sim + 2.0], "sim_truth": [sim, sim], "twin_compensated": [twin] * 3}
     result = {"returns": {"nominal-s0": cols(-100.0, -200.0), "hand-written": cols(-150.0, -150.0),
                           "standing still": cols(-300.0, -300.0)}}
@@ -86,3 +93,13 @@ def test_bad_benchmarl_policies_are_refused_naming_them(tmp_path):
         done = subprocess.run([sys.executable, str(REPO / "examples" / "transfer.py"), "--variants", "--benchmarl", spec,
                                "--out", str(tmp_path / "out")], capture_output=True, text=True, timeout=120)  # fmt: skip
         assert done.returncode == 2 and text in done.stderr, done.stderr
+
+
+def test_bad_evaluation_sizes_are_refused_naming_them(tmp_path):
+    for args, text in ((["--twin-episodes", "-1"], "--twin-episodes (-1) must be at least 0"),
+                       (["--twin-episodes", "0", "--compensate"], "need twin episodes"),
+                       (["--eval-worlds", "1"], "--eval-worlds (1) must be at least 2")):  # fmt: skip
+        done = subprocess.run([sys.executable, str(REPO / "examples" / "transfer.py"), *args, "--out", str(tmp_path)],
+                              capture_output=True, text=True, timeout=120)  # fmt: skip
+        assert done.returncode == 2 and text in done.stderr, done.stderr
+        assert not any(tmp_path.iterdir())  # refused before anything is written or trained
