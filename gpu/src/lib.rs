@@ -172,12 +172,12 @@ fn rank(info: &wgpu::AdapterInfo) -> u32 {
     t * 2 + u32::from(info.backend == wgpu::Backend::Gl)
 }
 
-/// Whether [`GpuContext::new`] may open this adapter. Not a GL one unless `WGPU_BACKEND` asks for GL:
-/// wgpu's GL backend puts every call of a device behind one context lock that panics after 6 s, and a
-/// thread waiting on a long dispatch holds it (seen with llvmpipe and parallel tests).
-fn usable(info: &wgpu::AdapterInfo) -> bool {
-    info.backend != wgpu::Backend::Gl
-        || wgpu::Backends::from_env().is_some_and(|b| b.contains(wgpu::Backends::GL))
+/// Whether [`GpuContext::new`] may open this adapter: not a GL one unless `gl_requested`
+/// (`WGPU_BACKEND` names GL). wgpu's GL backend puts every call of a device behind one context lock
+/// that panics after 6 s, and a thread waiting on a long dispatch holds it (seen with llvmpipe and
+/// parallel tests).
+fn usable(info: &wgpu::AdapterInfo, gl_requested: bool) -> bool {
+    info.backend != wgpu::Backend::Gl || gl_requested
 }
 
 impl GpuContext {
@@ -186,19 +186,17 @@ impl GpuContext {
         let inst = instance();
         let mut list = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()));
         list.sort_by_key(|a| rank(&a.get_info()));
-        let skipped: Vec<String> = list
-            .iter()
-            .map(|a| a.get_info())
-            .filter(|i| !usable(i))
-            .map(|i| describe(&i))
-            .collect();
-        let Some(adapter) = list.into_iter().find(|a| usable(&a.get_info())) else {
+        let gl = wgpu::Backends::from_env().is_some_and(|b| b.contains(wgpu::Backends::GL));
+        let (open, skipped): (Vec<_>, Vec<_>) =
+            list.into_iter().partition(|a| usable(&a.get_info(), gl));
+        let Some(adapter) = open.into_iter().next() else {
             let why = if skipped.is_empty() {
                 String::new()
             } else {
+                let names: Vec<_> = skipped.iter().map(|a| describe(&a.get_info())).collect();
                 format!(
                     "; skipped {} (wgpu's GL backend panics when threads share its device; WGPU_BACKEND=gl uses it anyway)",
-                    skipped.join(", ")
+                    names.join(", ")
                 )
             };
             return Err(GpuError::NoAdapter(why));
@@ -474,15 +472,14 @@ mod tests {
             adapter("NVIDIA H200", DeviceType::DiscreteGpu, Backend::Vulkan),
         ];
         list.sort_by_key(rank);
-        // GL only on request (WGPU_BACKEND), which the test environment does not set.
-        if std::env::var_os("WGPU_BACKEND").is_none() {
-            let opened: Vec<_> = list
-                .iter()
-                .filter(|a| usable(a))
+        let opened = |gl: bool| -> Vec<_> {
+            list.iter()
+                .filter(|a| usable(a, gl))
                 .map(|a| a.backend)
-                .collect();
-            assert_eq!(opened, [Backend::Vulkan; 3]);
-        }
+                .collect()
+        };
+        assert_eq!(opened(false), [Backend::Vulkan; 3], "GL only on request");
+        assert_eq!(opened(true).len(), list.len());
         let order: Vec<_> = list.iter().map(|a| (a.device_type, a.backend)).collect();
         assert_eq!(
             order,
