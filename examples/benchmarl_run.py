@@ -20,7 +20,7 @@ both. Without `--evaluate`, `--scenario FILE` trains and evaluates on that file 
 own scenario (the task's rewards and observations on other robots, fields or arenas).
 
 `--ppo-settings` trains the on-policy algorithms (`mappo`, `ippo`) with the settings of colcos's own
-PPO (`examples/ppo.py`) instead of BenchMARL's defaults: batches of `--horizon` 64 steps of every
+PPO's short recipe (`examples/train_aggregation.py --recipe short`) instead of BenchMARL's defaults: batches of `--horizon` 64 steps of every
 world, 4 passes of 4 minibatches over each, learning rate 1e-3, gamma 0.98, GAE lambda 0.95,
 gradients clipped at 0.5 (docs/training.md: on `aggregation` MAPPO learned no better with them).
 `--set KEY=VALUE` sets any field of the algorithm's BenchMARL config (`--set use_tanh_normal=false

@@ -227,9 +227,9 @@ def critic_dim(env: VecEnv, team: bool = False, own: bool = False) -> int:
 
 @dataclasses.dataclass
 class Config:
-    """PPO's settings; the defaults are the quick start's (see docs/python.md, "Training") but for
-    `own_critic` and `bootstrap_truncated`, which `train_aggregation.py` turns on (the other examples'
-    documented studies were measured with both off)."""
+    """PPO's settings; the defaults are `train_aggregation.py --recipe short`'s (see docs/python.md,
+    "Training") but for `own_critic` and `bootstrap_truncated`, which `train_aggregation.py` turns on
+    (the other examples' documented studies were measured with both off)."""
 
     horizon: int = 64  # steps of every stream per rollout
     epochs: int = 4

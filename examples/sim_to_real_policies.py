@@ -118,7 +118,7 @@ def main() -> None:
         out = os.path.join(args.out, name)
         if not os.path.exists(os.path.join(out, "policy.pt")):
             subprocess.run([sys.executable, os.path.join(here, "train_aggregation.py"), "--minutes", str(args.minutes),
-                            "--no-own-critic", "--no-bootstrap-truncated", "--episode", str(args.episode), "--scenario", scen, "--out", out], check=True)
+                            "--recipe", "short", "--no-own-critic", "--no-bootstrap-truncated", "--episode", str(args.episode), "--scenario", scen, "--out", out], check=True)
     v = VecEnv("aggregation", num_envs=1, max_cycles=args.episode)
     d = v.single_observation_space.shape[0]
     models = {name: load_model(os.path.join(args.out, name, "policy.pt"), d) for name in ("plain", "randomized")}

@@ -240,6 +240,35 @@ def test_quickstart_runs_and_reports(tmp_path):
     assert "perturbed by 0.001, 3 times: sd" in noise[1] and "4 held-out episodes" in noise[1]
 
 
+def load_quickstart():
+    """examples/train_aggregation.py as a module (it puts examples/ on sys.path for ppo and kickstart)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("train_aggregation", REPO / "examples" / "train_aggregation.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_recipe_fills_what_the_command_line_leaves_out():
+    pytest.importorskip("torch")
+    qs = load_quickstart()
+    ippo = qs.parse_args([])
+    assert (ippo.recipe, ippo.updates, ippo.horizon, ippo.epochs, ippo.minibatches) == ("ippo", 38, 500, 15, 40)
+    assert (ippo.gamma, ippo.lam, ippo.grad_norm, ippo.lr) == (0.99, 0.9, 5.0, 1e-3)
+    assert ippo.raw_advantages and ippo.raw_rewards and ippo.raw_observations
+    short = qs.parse_args(["--recipe", "short"])
+    assert (short.updates, short.eval_every, short.horizon, short.epochs, short.minibatches) == (720, 60, 64, 4, 4)
+    assert (short.gamma, short.lam, short.grad_norm) == (0.98, 0.95, 0.5)
+    assert not (short.raw_advantages or short.raw_rewards or short.raw_observations)
+    # A flag given wins over its recipe's value, the rest of the recipe stays.
+    mixed = qs.parse_args(["--recipe", "short", "--horizon", "100", "--raw-rewards"])
+    assert (mixed.horizon, mixed.epochs, mixed.raw_rewards, mixed.raw_advantages) == (100, 4, True, False)
+    mixed = qs.parse_args(["--no-raw-observations", "--updates", "3"])
+    assert (mixed.raw_observations, mixed.raw_rewards, mixed.updates, mixed.horizon) == (False, True, 3, 500)
+
+
 def test_quickstart_refuses_a_bad_param(tmp_path):
     pytest.importorskip("torch")
     res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), "--param", "progress_weight",
@@ -257,6 +286,9 @@ def test_quickstart_refuses_a_bad_param(tmp_path):
     assert res.returncode == 2 and "--gamma (0.0) must be in (0, 1]" in res.stderr
     for flags, text in ((["--lam", "1.5"], "--lam (1.5) must be in [0, 1]"), (["--hidden", "0"], "--hidden (0) must be at least 1"),
                         (["--grad-norm", "0"], "--grad-norm (0.0) must be above 0"),
+                        (["--epochs", "0"], "--epochs (0) must be at least 1"),
+                        (["--recipe", "long"], "argument --recipe: invalid choice: 'long'"),
+                        (["--param", "progress_weight=fast"], "--param 'progress_weight=fast': 'fast' is not a number"),
                         (["--own-critic", "--team-critic"], "--own-critic and --team-critic choose the critic's input"),
                         (["--tanh", "--kickstart", "100"], "--tanh: a tanh actor is not kickstarted")):  # fmt: skip
         res = subprocess.run([sys.executable, str(REPO / "examples" / "train_aggregation.py"), *flags, "--out", str(tmp_path)],

@@ -31,11 +31,12 @@ def test_tiny_transfer_study_with_agent_ids(tmp_path):
         assert trained["runs"][0]["updates"] == 1
         assert "--agent-id" in trained["command"]
         assert "--no-own-critic" in trained["command"]  # the documented tables' learner
+        assert "--recipe short" in trained["command"]
 
 
 def test_tiny_transfer_study_of_one_variant_on_a_compensated_twin_too(tmp_path):
     pytest.importorskip("torch")
-    args = ["--updates", "1", "--seeds", "0", "--variants", "nominal", "--compensate", "--learner", "default",
+    args = ["--updates", "1", "--seeds", "0", "--variants", "nominal", "--compensate", "--learner", "short",
             "--episode", "20", "--eval-worlds", "2", "--twin-episodes", "1", "--threads", "1", "--out", str(tmp_path)]
     out = subprocess.run([sys.executable, str(REPO / "examples" / "transfer.py"), *args],
                          capture_output=True, text=True, timeout=900, check=True).stdout
@@ -45,7 +46,8 @@ def test_tiny_transfer_study_of_one_variant_on_a_compensated_twin_too(tmp_path):
     assert set(result["returns"]) == {"nominal-s0", "hand-written", "standing still"}
     assert not (tmp_path / "generic-s0").exists()  # only the variant asked for is trained
     command = result["trained"]["nominal-s0"]["command"]
-    assert "--no-own-critic" not in command and "--clip-together" not in command  # the quick start's learner
+    assert "--no-own-critic" not in command and "--clip-together" not in command  # the short recipe as it is
+    assert "--recipe short" in command
     for policy, cols in result["returns"].items():
         assert len(cols["twin"]) == len(cols["twin_compensated"]) == 1, policy
     assert set(result["ratios"]) == {"twin", "twin_compensated"}
