@@ -279,7 +279,7 @@ def main() -> None:
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
     p.add_argument("--frames", type=int, default=None,
                    help="world steps of training (BenchMARL's frames; default 1,474,560 = 720 batches of 32 x 64 with the "
-                        "PPO settings, as the quick start's 720 updates, else 600,000)")
+                        "PPO settings, as the short recipe's 720 updates, else 600,000)")
     p.add_argument("--worlds", type=int, default=32, help="worlds stepped as one batch")
     p.add_argument("--max-steps", type=int, default=500, help="steps per episode")
     p.add_argument("--horizon", type=int, default=64, help="steps of every world per collected batch (PPO settings)")

@@ -247,7 +247,7 @@ def plot(runs: list[dict], refs: dict[str, float], held_refs: dict[str, dict], o
         ax.set_title("colcos aggregation: PPO quick start\n(lines: the 32 evaluation episodes; squares: held out, ± 2 se)", fontsize=9)
     else:
         ax.set_title("colcos aggregation: PPO quick start", fontsize=10)
-    ax.legend(fontsize=7, loc="lower center", ncol=2)
+    ax.legend(fontsize=7, loc="upper left", ncol=2)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "learning_curve.png"), dpi=120)
     plt.close(fig)
