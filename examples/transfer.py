@@ -94,8 +94,8 @@ def train(paths: dict[str, str], args: argparse.Namespace) -> None:
     flags = ["--anneal"] if args.anneal and args.updates else []
     flags += ["--agent-id"] if args.agent_id else []
     flags += ["--history", str(args.history)]
-    # Both learners are train_aggregation.py's 64-step recipe, whose budget `--updates` counts.
-    flags += ["--recipe", "short"]
+    # study and short are train_aggregation.py's 64-step recipe, ippo its default (whole episodes).
+    flags += ["--recipe", "ippo" if args.learner == "ippo" else "short"]
     if args.learner == "study":
         # docs/transfer.md's tables were measured with one gradient norm, the critic on state and
         # agent id, and time limits worth 0 after the cut: these flags keep them reproducible.
@@ -304,9 +304,10 @@ def main() -> None:
                    help="also evaluate every policy on the twin with the fit undone in the bridge ([rig] compensate)")
     p.add_argument("--compensated-only", action="store_true",
                    help="evaluate on the compensated twin only (the pass --compensate adds, without the other)")
-    p.add_argument("--learner", choices=("study", "short"), default="study",
+    p.add_argument("--learner", choices=("study", "short", "ippo"), default="study",
                    help="study: the PPO settings docs/transfer.md's tables were trained with; short: "
-                        "train_aggregation.py --recipe short as it is (IPPO's critic, the time-limit bootstrap)")
+                        "train_aggregation.py --recipe short as it is (IPPO's critic, the time-limit bootstrap); "
+                        "ippo: its default recipe (BenchMARL's IPPO schedule: --updates 38 is its budget)")
     p.add_argument("--train-only", action="store_true")
     p.add_argument("--out", default="runs/transfer")
     args = p.parse_args()

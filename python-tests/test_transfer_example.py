@@ -105,3 +105,14 @@ def test_bad_evaluation_sizes_are_refused_naming_them(tmp_path):
                               capture_output=True, text=True, timeout=120)  # fmt: skip
         assert done.returncode == 2 and text in done.stderr, done.stderr
         assert not any(tmp_path.iterdir())  # refused before anything is written or trained
+
+
+def test_the_ippo_learner_trains_with_the_quick_starts_default_recipe(tmp_path):
+    pytest.importorskip("torch")
+    args = ["--updates", "1", "--seeds", "0", "--variants", "nominal", "--learner", "ippo", "--episode", "20",
+            "--eval-worlds", "2", "--twin-episodes", "0", "--threads", "1", "--out", str(tmp_path)]
+    subprocess.run([sys.executable, str(REPO / "examples" / "transfer.py"), *args],
+                   capture_output=True, text=True, timeout=900, check=True)
+    trained = json.loads((tmp_path / "result.json").read_text())["trained"]["nominal-s0"]
+    assert "--recipe ippo" in trained["command"] and "--no-own-critic" not in trained["command"]
+    assert trained["recipe"] == "ippo" and trained["runs"][0]["updates"] == 1
