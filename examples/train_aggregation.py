@@ -1,4 +1,4 @@
-"""Quick start: PPO learns the follower of case II (aggregation) in about two minutes on two cores.
+"""Quick start: PPO learns the follower of case II (aggregation) in two to three minutes on two cores.
 
 All followers of all worlds share one policy (`examples/ppo.py`); each (world, follower) pair is one
 sample stream. The actor sees only the follower's own 17 sensor values, and so does the critic (used
@@ -48,10 +48,10 @@ import ppo
 from colcos.baselines import Baseline, RandomPolicy
 from colcos.vector import VecEnv
 
-# Each recipe's schedule, objective and budget (about 2 minutes of training on an idle 2-core x86
-# machine, docs/python.md); a flag given on the command line overrides its entry. `ippo` is
-# BenchMARL's IPPO (whole episodes, raw objective) with 15 passes a batch at 1e-3 where BenchMARL
-# makes 45 at 3e-4: the same learning in a third of the gradient steps (docs/ppo_studies.md).
+# Each recipe's schedule, objective and budget (ippo about 2.5 minutes of training on an idle 2-core
+# x86 machine, short about 2, docs/python.md); a flag given on the command line overrides its entry.
+# `ippo` is BenchMARL's IPPO (whole episodes, raw objective) with 15 passes a batch at 1e-3 where
+# BenchMARL makes 45 at 3e-4: as much learning in a third of the gradient steps (docs/ppo_studies.md).
 RECIPES: dict[str, dict] = {
     "ippo": {"updates": 38, "eval_every": 4, "horizon": 500, "epochs": 15, "minibatches": 40, "lr": 1e-3,
              "gamma": 0.99, "lam": 0.9, "grad_norm": 5.0,
@@ -258,7 +258,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--recipe", choices=sorted(RECIPES), default="ippo",
                    help="schedule, objective and budget (see above); flags given override its values")
-    p.add_argument("--updates", type=int, default=None, help="training budget in PPO updates (the recipe's: ~2 min on 2 idle cores)")
+    p.add_argument("--updates", type=int, default=None, help="training budget in PPO updates (ippo 38, short 720)")
     p.add_argument("--minutes", type=float, default=None, help="a wall-clock budget instead of --updates")
     p.add_argument("--seeds", type=int, nargs="+", default=None, help="train one policy per seed (default: --seed)")
     p.add_argument("--seed", type=int, default=0)
