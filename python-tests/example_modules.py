@@ -30,3 +30,12 @@ def load_task(name: str) -> types.ModuleType:
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def load_quickstart() -> types.ModuleType:
+    """examples/train_aggregation.py (it puts examples/ on sys.path for its ppo and kickstart)."""
+    spec = importlib.util.spec_from_file_location("train_aggregation", REPO / "examples" / "train_aggregation.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module

@@ -10,7 +10,7 @@ import sys
 
 import numpy as np
 import pytest
-from example_modules import load_ppo
+from example_modules import load_ppo, load_quickstart
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
@@ -238,17 +238,6 @@ def test_quickstart_runs_and_reports(tmp_path):
                            capture_output=True, text=True, timeout=600, check=True).stdout.splitlines()
     assert noise[0].startswith("paper's follower: 2 evaluation episodes") and len(noise) == 2
     assert "perturbed by 0.001, 3 times: sd" in noise[1] and "4 held-out episodes" in noise[1]
-
-
-def load_quickstart():
-    """examples/train_aggregation.py as a module (it puts examples/ on sys.path for ppo and kickstart)."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("train_aggregation", REPO / "examples" / "train_aggregation.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def test_a_recipe_fills_what_the_command_line_leaves_out():
