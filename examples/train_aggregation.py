@@ -122,7 +122,8 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
                      bootstrap_truncated=args.bootstrap_truncated,
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
                      agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
-                     target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup)
+                     target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup,
+                     learn_threads=args.learn_threads)
     trainer = ppo.Trainer(env, cfg, seed)
     train_seconds, cpu_start = 0.0, time.process_time()
     if args.kickstart:
@@ -303,6 +304,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                    help="the actor reads its last K observations (oldest first): a memory of its recent readings and commands")
     p.add_argument("--episode", type=int, default=500, help="steps per episode (10 s)")
     p.add_argument("--threads", type=int, default=None, help="env worker threads (default: one per core)")
+    p.add_argument("--learn-threads", type=int, default=os.cpu_count() or 1,
+                   help="torch threads for the policy update (default: one per core; the result is the same for any number)")
     p.add_argument("--eval-worlds", type=int, default=32)
     p.add_argument("--eval-seed", type=int, default=12345)
     p.add_argument("--holdout-worlds", type=int, default=1024,
@@ -329,6 +332,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         p.error(f"--lam ({args.lam}) must be in [0, 1]")
     if not args.grad_norm > 0.0:
         p.error(f"--grad-norm ({args.grad_norm}) must be above 0")
+    if args.learn_threads < 1:
+        p.error(f"--learn-threads ({args.learn_threads}) must be at least 1")
     if args.hidden < 1:
         p.error(f"--hidden ({args.hidden}) must be at least 1")
     if args.tanh and (args.kickstart or args.anchor):
