@@ -427,7 +427,7 @@ class Trainer:
             # One gather a pass, then contiguous slices: the same minibatches as indexing each one,
             # at a tenth of the gathers' cost (they were an eighth of a small minibatch's step).
             perm = torch.randperm(m)
-            po, pc, pa, pl, padv, pret = (x[perm] for x in (fo, fc, fa, fl, fadv, fret))
+            po, pc, pa, pl, padv, pret = (x.index_select(0, perm) for x in (fo, fc, fa, fl, fadv, fret))
             for k in range(0, m, size):
                 o, a, adv_k = po[k : k + size], pa[k : k + size], padv[k : k + size]
                 head = model.head(o)
