@@ -1,4 +1,4 @@
-"""Quick start: PPO learns the follower of case II (aggregation) in two to three minutes on two cores.
+"""Quick start: PPO learns the follower of case II (aggregation) in about a minute and a half on two cores.
 
 All followers of all worlds share one policy (`examples/ppo.py`); each (world, follower) pair is one
 sample stream. The actor sees only the follower's own 17 sensor values, and so does the critic (used
@@ -48,8 +48,8 @@ import ppo
 from colcos.baselines import Baseline, RandomPolicy
 from colcos.vector import VecEnv
 
-# Each recipe's schedule, objective and budget (ippo about 2.5 minutes of training on an idle 2-core
-# x86 machine, short about 2, docs/python.md); a flag given on the command line overrides its entry.
+# Each recipe's schedule, objective and budget (ippo about 1.5 minutes of training on an idle 2-core
+# x86 machine, short about 1.5, docs/python.md); a flag given on the command line overrides its entry.
 # `ippo` is BenchMARL's IPPO (whole episodes, raw objective) with 15 passes a batch at 1e-3 where
 # BenchMARL makes 45 at 3e-4: as much learning in a third of the gradient steps (docs/ppo_studies.md).
 RECIPES: dict[str, dict] = {
@@ -359,7 +359,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 def main() -> None:
     args = parse_args()
-    # The policy's tensors are small: one torch thread is fastest (two fight the env's workers).
+    # The rollout's tensors are small: one torch thread is fastest there (two fight the env's workers);
+    # the update's minibatches take --learn-threads (ppo.Config.learn_threads).
     torch.set_num_threads(1)
     os.makedirs(args.out, exist_ok=True)
     env_kwargs: dict = {"task": "aggregation", "num_threads": args.threads}

@@ -133,6 +133,24 @@ def test_trainer_counts_updates_and_samples():
     assert any(not np.array_equal(a.numpy(), p.detach().numpy()) for a, p in zip(before, trainer.model.pi.parameters()))
 
 
+def test_the_update_learns_the_same_on_any_number_of_threads():
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    learned = []
+    for threads in (1, 2):
+        env = VecEnv(task="aggregation", num_envs=16, max_cycles=50, num_threads=1)
+        # Minibatches of 1,200 rows: big enough that torch splits its matrix products and tanh over threads.
+        cfg = ppo.Config(horizon=50, epochs=2, minibatches=2, own_critic=True, learn_threads=threads)
+        trainer = ppo.Trainer(env, cfg, seed=3)
+        torch.set_num_threads(1)
+        trainer.iterate()
+        assert torch.get_num_threads() == 1, "the rollout's thread count is restored after the update"
+        learned.append(torch.cat([p.detach().flatten() for p in trainer.model.parameters()]))
+    assert torch.equal(learned[0], learned[1])
+
+
 def test_the_team_critic_sees_every_agents_observation():
     pytest.importorskip("torch")
     ppo = load_ppo()
