@@ -138,7 +138,7 @@ def test_the_update_learns_the_same_on_any_number_of_threads():
     from colcos.vector import VecEnv
 
     ppo = load_ppo()
-    learned = []
+    learned, before = [], torch.get_num_threads()
     for threads in (1, 2):
         env = VecEnv(task="aggregation", num_envs=16, max_cycles=50, num_threads=1)
         # Minibatches of 1,200 rows: big enough that torch splits its matrix products and tanh over threads.
@@ -148,6 +148,7 @@ def test_the_update_learns_the_same_on_any_number_of_threads():
         trainer.iterate()
         assert torch.get_num_threads() == 1, "the rollout's thread count is restored after the update"
         learned.append(torch.cat([p.detach().flatten() for p in trainer.model.parameters()]))
+    torch.set_num_threads(before)
     assert torch.equal(learned[0], learned[1])
 
 
