@@ -9,7 +9,7 @@ its final observation's value instead of ending at 0). One `Trainer.iterate()` c
 a whole number of those updates, so a loaded machine changes the time a run takes, not its result.
 
 Used by `train_aggregation.py` (the quick start), `stigmergy.py` and, through the former, `transfer.py`
-and `onboard_export.py`. Needs torch.
+and `onboard_export.py`; the network itself is in `ppo_model.py`. Needs torch.
 """
 
 from __future__ import annotations
@@ -24,181 +24,8 @@ import torch
 from colcos.vector import VecEnv
 from torch import nn
 
-
-LOG_2PI = float(np.log(2 * np.pi))
-# softplus(0 + SOFTPLUS_BIAS) + 1e-4 = 1: a tanh actor's widths start at 1, as BenchMARL's.
-SOFTPLUS_BIAS = float(np.log(np.expm1(1.0 - 1e-4)))
-
-
-class RunningNorm(nn.Module):
-    """Running mean / variance of the inputs (Chan et al. parallel update), applied as a z-score."""
-
-    def __init__(self, dim: int) -> None:
-        super().__init__()
-        self.register_buffer("mean", torch.zeros(dim))
-        self.register_buffer("var", torch.ones(dim))
-        self.register_buffer("count", torch.tensor(1e-4))
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        return ((x - self.mean) / torch.sqrt(self.var + 1e-8)).clamp(-10, 10)
-
-    @torch.no_grad()
-    def update(self, x: torch.Tensor) -> None:
-        if x.shape[0] == 0:
-            return
-        m, v, n = x.mean(0), x.var(0, unbiased=False), x.shape[0]
-        delta, tot = m - self.mean, self.count + n
-        self.mean += delta * n / tot
-        self.var = (self.var * self.count + v * n + delta**2 * self.count * n / tot) / tot
-        self.count = tot
-
-
-def mlp(i: int, o: int, hidden: int) -> nn.Sequential:
-    return nn.Sequential(nn.Linear(i, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh(), nn.Linear(hidden, o))
-
-
-class ActorCritic(nn.Module):
-    """Gaussian actor on the agent's own observation; critic on observation + global state + agent id.
-
-    With `history` = k > 1 the actor reads the agent's last k observations, oldest first (a `Memory`
-    stacks them: `policy()` gives an acting function that keeps one). With `agents` = N > 0 it also
-    sees which of the N agents it drives (a one-hot appended, `actor_input`): one network, but free to
-    drive robots that differ (wheels, lags, sensor gains) each in its own way. `pi`, `obs_norm` and
-    `log_std` are what a robot runs (`onboard_export.py` reads them by name; it takes only actors of
-    the 17 observation entries).
-
-    With `tanh`, the actor is BenchMARL's and IPPO's: `pi` also gives each action entry's width (a
-    biased softplus of its second half: 1 at an output of 0), and the action is the tanh of the
-    Gaussian sample (its mean's tanh when acting deterministically); `log_std` goes unused."""
-
-    def __init__(self, obs_dim: int, critic_dim: int, act_dim: int = 2, hidden: int = 64, agents: int = 0,
-                 history: int = 1, tanh: bool = False) -> None:  # fmt: skip
-        super().__init__()
-        self.agents, self.history, self.tanh, self.act_dim = agents, history, tanh, act_dim
-        self.pi = mlp(obs_dim * history + agents, 2 * act_dim if tanh else act_dim, hidden)
-        self.v = mlp(critic_dim, 1, hidden)
-        self.log_std = nn.Parameter(torch.full((act_dim,), -0.5))
-        self.obs_norm = RunningNorm(obs_dim * history + agents)
-        self.critic_norm = RunningNorm(critic_dim)
-        with torch.no_grad():  # small initial actions: the policy starts near "stand still", not saturated
-            self.pi[-1].weight.mul_(0.01)
-            self.pi[-1].bias.zero_()
-
-    def actor_input(self, obs: np.ndarray, ids: np.ndarray | None = None) -> np.ndarray:
-        """What the actor reads for observations `obs` (..., N, obs_dim): the observations, and with
-        `agents` the one-hot of each row's agent appended. Rows along axis -2 are agents 0..N-1 unless
-        `ids` (their agent indices, shape (N,)) says otherwise (a PettingZoo dict of the live agents)."""
-        obs = np.asarray(obs, dtype=np.float32)
-        if not self.agents:
-            return obs
-        if ids is None:
-            if obs.ndim < 2 or obs.shape[-2] != self.agents:
-                raise ValueError(f"an actor of {self.agents} agents needs observations (..., {self.agents}, obs) "
-                                 f"or the agents' ids, got shape {obs.shape}")
-            ids = np.arange(self.agents)
-        ids = np.asarray(ids)
-        if ids.shape != obs.shape[-2:-1] or ids.min(initial=0) < 0 or ids.max(initial=0) >= self.agents:
-            raise ValueError(f"agent ids {ids.tolist()} for observations of shape {obs.shape}: one id in "
-                             f"0..{self.agents - 1} per row")
-        hot = np.broadcast_to(np.eye(self.agents, dtype=np.float32)[ids], (*obs.shape[:-1], self.agents))
-        return np.concatenate([obs, hot], axis=-1)
-
-    def head(self, obs: torch.Tensor) -> torch.Tensor:
-        """What `pi` gives for raw actor inputs (`actor_input`; normalised here): the Gaussian's mean,
-        and with `tanh` its widths' pre-activations after it."""
-        return self.pi(self.obs_norm(obs))
-
-    def mean(self, obs: torch.Tensor) -> torch.Tensor:
-        """The Gaussian's mean for raw actor inputs (before the tanh, with `tanh`)."""
-        return self.head(obs)[..., : self.act_dim]
-
-    def log_stds(self, head: torch.Tensor) -> torch.Tensor:
-        """Each action entry's log width for a `head` output: `log_std`, or with `tanh` the biased
-        softplus of the head's second half (BenchMARL's `biased_softplus_1.0`, at least 1e-4)."""
-        if not self.tanh:
-            return self.log_std.expand(*head.shape[:-1], self.act_dim)
-        return torch.log(nn.functional.softplus(head[..., self.act_dim :] + SOFTPLUS_BIAS) + 1e-4)
-
-    def log_prob(self, obs: torch.Tensor, act: torch.Tensor, head: torch.Tensor | None = None) -> torch.Tensor:
-        """log pi(act | obs) of the Gaussian sample `act` (before the tanh, with `tanh`: the tanh's
-        Jacobian is the same for the old and the new policy, so it leaves PPO's ratio alone), summed
-        over the action's entries: torch's `Normal(...).log_prob(act).sum(-1)` in fewer tensor
-        operations (the update's hot path on small batches); `head`: `head(obs)` if known."""
-        head = self.head(obs) if head is None else head
-        log_std = self.log_stds(head)
-        z = (act - head[..., : self.act_dim]) * torch.exp(-log_std)
-        return -0.5 * (z * z).sum(-1) - log_std.sum(-1) - 0.5 * LOG_2PI * act.shape[-1]
-
-    def value(self, critic_in: torch.Tensor) -> torch.Tensor:
-        return self.v(self.critic_norm(critic_in)).squeeze(-1)
-
-    def policy(self) -> Callable[..., np.ndarray]:
-        """`act` for a stream of observations (one episode, or one per world of a batch): with a
-        `history`, each call's observations join the last ones in a fresh `Memory`."""
-        if self.history == 1:
-            return self.act
-        memory = Memory(self.history)
-        return lambda obs, ids=None: self.act(memory.push(obs), ids)
-
-    @torch.no_grad()
-    def act(self, obs: np.ndarray, ids: np.ndarray | None = None) -> np.ndarray:
-        """Deterministic action (the mean, clipped to [-1, 1]; its tanh with `tanh`) for observations of shape (..., obs_dim)
-        ((..., N, obs_dim) with `agents`, or `ids` given: see `actor_input`; with a `history`, stacked
-        observations: see `policy`)."""
-        x = self.actor_input(obs, ids)
-        o = torch.from_numpy(np.array(x, dtype=np.float32).reshape(-1, x.shape[-1]))
-        mu = self.mean(o)
-        a = torch.tanh(mu) if self.tanh else mu.clamp(-1, 1)
-        return a.numpy().reshape(*x.shape[:-1], -1).astype(np.float32)
-
-    @torch.no_grad()
-    def sample(self, obs: np.ndarray, generator: torch.Generator, ids: np.ndarray | None = None) -> np.ndarray:
-        """Stochastic action, as in training: the mean plus Gaussian noise of sd `exp(log_stds)` drawn
-        from `generator`, unclipped (the env's action map clips it); its tanh with `tanh`."""
-        x = self.actor_input(obs, ids)
-        o = torch.from_numpy(np.array(x, dtype=np.float32).reshape(-1, x.shape[-1]))
-        head = self.head(o)
-        mu = head[..., : self.act_dim]
-        a = mu + torch.exp(self.log_stds(head)) * torch.randn(mu.shape, generator=generator)
-        a = torch.tanh(a) if self.tanh else a
-        return a.numpy().reshape(*x.shape[:-1], -1).astype(np.float32)
-
-
-class Memory:
-    """The last `history` observations of every row, oldest first, flattened: what an actor with a
-    history reads. A row's first observation (or one marked `fresh`: the first of a new episode)
-    fills its whole history."""
-
-    def __init__(self, history: int) -> None:
-        self.history = history
-        self.stack: np.ndarray | None = None
-
-    def push(self, obs: np.ndarray, fresh: np.ndarray | None = None) -> np.ndarray:
-        """Adds `obs` (..., obs_dim); returns (..., history * obs_dim). `fresh`: a mask over the rows
-        (obs.shape[:-1]) that start again."""
-        obs = np.asarray(obs, dtype=np.float32)
-        if self.history == 1:
-            return obs
-        if self.stack is None or self.stack.shape[:-2] != obs.shape[:-1]:
-            self.stack = np.repeat(obs[..., None, :], self.history, axis=-2)
-        else:
-            self.stack = np.concatenate([self.stack[..., 1:, :], obs[..., None, :]], axis=-2)
-            if fresh is not None and fresh.any():
-                self.stack[fresh] = obs[fresh][..., None, :]
-        return self.stack.reshape(*obs.shape[:-1], -1)
-
-
-def load_model(path: str, obs_dim: int, history: int = 1) -> ActorCritic:
-    """A saved `ActorCritic` (its `state_dict`) of actors with `history`; its sizes (critic input,
-    actions, hidden units, agent ids) read from the saved tensors; in evaluation mode."""
-    state = torch.load(path)
-    hidden, inputs = state["pi.0.weight"].shape
-    act_dim = state["log_std"].shape[0]
-    model = ActorCritic(obs_dim, state["v.0.weight"].shape[1], act_dim=act_dim, hidden=hidden,
-                        agents=inputs - obs_dim * history, history=history, tanh=state["pi.4.weight"].shape[0] == 2 * act_dim)
-    model.load_state_dict(state)
-    model.eval()
-    return model
+# The policy lives in ppo_model.py; its names stay importable from here.
+from ppo_model import LOG_2PI, SOFTPLUS_BIAS, ActorCritic, Memory, RunningNorm, load_model, mlp  # noqa: F401
 
 
 def critic_input(obs: np.ndarray, state: np.ndarray, team: bool = False, own: bool = False) -> np.ndarray:
@@ -281,6 +108,7 @@ class Config:
     # torch threads for the update (the rollout keeps the caller's): its minibatches of ~1,000 rows
     # are big enough to share (1.4x faster on two cores), and the result is the same for any number.
     learn_threads: int = 1
+    compile: bool = False
 
 
 def clip_gradients(model: ActorCritic, apart: bool, norm: float = 0.5) -> None:
@@ -322,6 +150,8 @@ class Trainer:
             self.model.pi[-1].bias[:2] = cfg.start_forward
             self.model.pi[-1].bias[2 : self.w] = cfg.start_lay
         self.opt = torch.optim.Adam(self.model.parameters(), lr=cfg.lr, eps=1e-5)
+        # torch.compile'd (Config.compile): forward and backward fused into generated kernels.
+        self.loss = torch.compile(self._minibatch_loss, dynamic=False) if cfg.compile else self._minibatch_loss
         self.kl = 0.0  # the mean KL divergence of the last update's minibatch steps
         # Rewards are divided by a running std of the discounted return, so that the critic's targets
         # stay O(1) whatever the reward's scale.
@@ -429,25 +259,9 @@ class Trainer:
             perm = torch.randperm(m)
             po, pc, pa, pl, padv, pret = (x.index_select(0, perm) for x in (fo, fc, fa, fl, fadv, fret))
             for k in range(0, m, size):
-                o, a, adv_k = po[k : k + size], pa[k : k + size], padv[k : k + size]
-                head = model.head(o)
-                mu = head[:, : self.w]
-                log_ratio = model.log_prob(o, a, head) - pl[k : k + size]
-                ratio = log_ratio.exp()
-                pg = -torch.min(ratio * adv_k, ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * adv_k).mean()
-                vloss = 0.5 * (model.value(pc[k : k + size]) - pret[k : k + size]).pow(2).mean()
-                # The Gaussian's entropy is sum(log_std) + const (before a tanh).
-                loss = pg + 0.5 * vloss - cfg.ent_coef * model.log_stds(head).sum(-1).mean()
-                if cfg.anchor and self.anchor is not None:
-                    with torch.no_grad():
-                        frozen = self.anchor[0](self.anchor[1](o))
-                    loss = loss + cfg.anchor * (mu - frozen).pow(2).sum(-1).mean()
-                if cfg.listen_bias:
-                    loss = loss - cfg.listen_bias * listening(model, o, mu, cfg.message_inputs)
-                if cfg.signal_bias:
-                    loss = loss - cfg.signal_bias * signalling(model, mu, cfg.message_output, cfg.message_threshold)
-                if self.updates < cfg.actor_warmup:
-                    loss = 0.5 * vloss
+                warm = self.updates < cfg.actor_warmup
+                loss, ratio, log_ratio = self.loss(po[k : k + size], pa[k : k + size], pl[k : k + size],
+                                                   padv[k : k + size], pc[k : k + size], pret[k : k + size], warm)
                 self.opt.zero_grad()
                 loss.backward()
                 clip_gradients(model, cfg.clip_apart, cfg.grad_norm)
@@ -458,6 +272,31 @@ class Trainer:
                 if cfg.target_kl:
                     self._set_lr(adapt_lr(self.lr, kl, cfg.target_kl))
         self.kl = float(np.mean(kls))
+
+    def _minibatch_loss(self, o: torch.Tensor, a: torch.Tensor, old_logp: torch.Tensor, adv: torch.Tensor,
+                        cri: torch.Tensor, ret: torch.Tensor, warm: bool) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """PPO's loss on one minibatch, with its probability ratio and log ratio (for the KL estimate);
+        `warm`: the critic's loss alone (`Config.actor_warmup`)."""
+        cfg, model = self.cfg, self.model
+        head = model.head(o)
+        mu = head[:, : self.w]
+        log_ratio = model.log_prob(o, a, head) - old_logp
+        ratio = log_ratio.exp()
+        pg = -torch.min(ratio * adv, ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * adv).mean()
+        vloss = 0.5 * (model.value(cri) - ret).pow(2).mean()
+        # The Gaussian's entropy is sum(log_std) + const (before a tanh).
+        loss = pg + 0.5 * vloss - cfg.ent_coef * model.log_stds(head).sum(-1).mean()
+        if cfg.anchor and self.anchor is not None:
+            with torch.no_grad():
+                frozen = self.anchor[0](self.anchor[1](o))
+            loss = loss + cfg.anchor * (mu - frozen).pow(2).sum(-1).mean()
+        if cfg.listen_bias:
+            loss = loss - cfg.listen_bias * listening(model, o, mu, cfg.message_inputs)
+        if cfg.signal_bias:
+            loss = loss - cfg.signal_bias * signalling(model, mu, cfg.message_output, cfg.message_threshold)
+        if warm:
+            loss = 0.5 * vloss
+        return loss, ratio, log_ratio
 
     def reward_scale(self) -> float:
         """What the rewards are divided by before the advantages: the running sd of the discounted

@@ -123,7 +123,7 @@ def train(seed: int, env_kwargs: dict, args: argparse.Namespace, out: str) -> di
                      anneal=args.updates if args.anneal and not args.minutes else 0, team_critic=args.team_critic,
                      agent_id=args.agent_id, history=args.history, clip_apart=not args.clip_together,
                      target_kl=args.target_kl, anchor=args.anchor, actor_warmup=args.actor_warmup,
-                     learn_threads=args.learn_threads)
+                     learn_threads=args.learn_threads, compile=args.compile)
     trainer = ppo.Trainer(env, cfg, seed)
     train_seconds, cpu_start = 0.0, time.process_time()
     if args.kickstart:
@@ -306,6 +306,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--threads", type=int, default=None, help="env worker threads (default: one per core)")
     p.add_argument("--learn-threads", type=int, default=os.cpu_count() or 1,
                    help="torch threads for the policy update (default: one per core; the result is the same for any number)")
+    p.add_argument("--compile", action="store_true",
+                   help="the update's loss through torch.compile (faster; not the same bits as without it)")
     p.add_argument("--eval-worlds", type=int, default=32)
     p.add_argument("--eval-seed", type=int, default=12345)
     p.add_argument("--holdout-worlds", type=int, default=1024,

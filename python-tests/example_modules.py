@@ -11,7 +11,11 @@ REPO = pathlib.Path(__file__).resolve().parents[1]
 
 
 def load_ppo() -> types.ModuleType:
-    """examples/ppo.py: the PPO trainer and its ActorCritic, the network the robots run."""
+    """examples/ppo.py: the PPO trainer and its ActorCritic, the network the robots run (importing its
+    ppo_model as the scripts do)."""
+    folder = REPO / "examples"
+    if str(folder) not in sys.path:
+        sys.path.insert(0, str(folder))
     spec = importlib.util.spec_from_file_location("ppo", REPO / "examples" / "ppo.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

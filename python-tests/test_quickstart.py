@@ -152,6 +152,26 @@ def test_the_update_learns_the_same_on_any_number_of_threads():
     assert torch.equal(learned[0], learned[1])
 
 
+def test_the_compiled_update_learns_what_the_eager_one_does():
+    torch = pytest.importorskip("torch")
+    from colcos.vector import VecEnv
+
+    ppo = load_ppo()
+    learned, before = [], torch.get_num_threads()
+    for compiled in (False, True):
+        env = VecEnv(task="aggregation", num_envs=4, max_cycles=50, num_threads=1)
+        cfg = ppo.Config(horizon=50, epochs=2, minibatches=3, own_critic=True, compile=compiled)
+        trainer = ppo.Trainer(env, cfg, seed=5)
+        start = torch.cat([p.detach().flatten() for p in trainer.model.parameters()])
+        trainer.iterate()
+        learned.append(torch.cat([p.detach().flatten() for p in trainer.model.parameters()]) - start)
+    torch.set_num_threads(before)
+    # The same steps to within the rounding of fused kernels: far closer than any step is long.
+    step = learned[0].abs().max()
+    assert step > 1e-4
+    assert (learned[1] - learned[0]).abs().max() < 1e-3 * step
+
+
 def test_the_team_critic_sees_every_agents_observation():
     pytest.importorskip("torch")
     ppo = load_ppo()
