@@ -3,9 +3,14 @@
 from __future__ import annotations
 
 import functools
+import os
 import types
 
 import pytest
+
+# examples/ppo.py's setting, before any test runs a matrix product: its update is the same on any
+# number of threads (test_quickstart.py).
+os.environ.setdefault("MKL_CBWR", "AUTO,STRICT")
 
 import colcos
 
