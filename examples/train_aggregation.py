@@ -307,7 +307,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--learn-threads", type=int, default=os.cpu_count() or 1,
                    help="torch threads for the policy update (default: one per core; the result is the same for any number)")
     p.add_argument("--compile", action="store_true",
-                   help="the update's loss through torch.compile (faster; not the same bits as without it)")
+                   help="the update's loss through torch.compile and Adam fused (faster; not the same bits as without it)")
     p.add_argument("--eval-worlds", type=int, default=32)
     p.add_argument("--eval-seed", type=int, default=12345)
     p.add_argument("--holdout-worlds", type=int, default=1024,

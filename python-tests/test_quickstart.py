@@ -157,7 +157,7 @@ def test_the_compiled_update_learns_what_the_eager_one_does():
     from colcos.vector import VecEnv
 
     ppo = load_ppo()
-    learned, before = [], torch.get_num_threads()
+    learned = []
     for compiled in (False, True):
         env = VecEnv(task="aggregation", num_envs=4, max_cycles=50, num_threads=1)
         cfg = ppo.Config(horizon=50, epochs=2, minibatches=3, own_critic=True, compile=compiled)
@@ -165,7 +165,6 @@ def test_the_compiled_update_learns_what_the_eager_one_does():
         start = torch.cat([p.detach().flatten() for p in trainer.model.parameters()])
         trainer.iterate()
         learned.append(torch.cat([p.detach().flatten() for p in trainer.model.parameters()]) - start)
-    torch.set_num_threads(before)
     # The same steps to within the rounding of fused kernels: far closer than any step is long.
     step = learned[0].abs().max()
     assert step > 1e-4
