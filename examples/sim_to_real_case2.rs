@@ -9,7 +9,7 @@
 //! the figure `s_t.png`; `-- --plot OUT_DIR` draws the figure again from `s_t.csv`.
 use colcos::bridge::calibrate::RigCalibration;
 use colcos::bridge::protocol::swarmcon::HeaderForm;
-use colcos::bridge::rig::{LiveOptions, LiveSession};
+use colcos::bridge::rig::{LiveOptions, LiveSession, RigEnds};
 use colcos::bridge::twin::{TrackerServer, Twin, UdpChannel};
 use colcos::bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos::experiment::case2::SCENARIO_TOML;
@@ -119,8 +119,12 @@ fn on_twin(label: &str, host: &Scenario, twin: &Scenario) -> Curve {
     let source = open_pose_source(&tracker_url, &SourceOptions::new(cal.frame_transform(host)))
         .expect("pose source");
     let link = open_robot_link(&robots_url).expect("robot link");
-    let mut session =
-        LiveSession::new(host, source, link, None, LiveOptions::default()).expect("session");
+    let ends = RigEnds {
+        source,
+        link,
+        frames: None,
+    };
+    let mut session = LiveSession::new(host, ends, LiveOptions::default()).expect("session");
     let probe = World::new(host).expect("world");
     let (leader, followers) = roles(&probe);
     let n = probe.robot_count();

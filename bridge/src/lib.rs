@@ -30,7 +30,7 @@ pub mod transport;
 pub mod twin;
 
 pub use calibrate::RigCalibration;
-pub use rig::{LiveOptions, LiveReport, LiveSession};
+pub use rig::{LiveOptions, LiveReport, LiveSession, RigEnds};
 pub use transport::{
     LinkError, PoseSource, RobotLink, SourceError, SourceOptions, open_pose_source, open_robot_link,
 };

@@ -191,14 +191,13 @@ fn check(truth: &Truth, seed: u64) {
              {got_offset:.1} +- {offset_sd:.1} (truth {offset}); {} of {} readings, rms {:.1} counts",
             sensor.used, sensor.readings, sensor.rms
         );
-        assert!(
-            (got_gain - gain).abs() / gain < 0.1,
-            "robot {i} sensor gain {got_gain} vs {gain}"
-        );
+        assert_fraction(&format!("robot {i} sensor gain"), got_gain, *gain, 0.1);
         // The offset's scale is the dark counts' (30) and the screen's black: within 100 counts.
-        assert!(
-            (got_offset - offset).abs() < 100.0,
-            "robot {i} sensor offset {got_offset} vs {offset}"
+        assert_near(
+            &format!("robot {i} sensor offset"),
+            got_offset,
+            *offset,
+            100.0,
         );
         let fit = fit_robot(i, &series[i].commands, &series[i].poses, &opts);
         let (scale, scale_sd) = fit.wheel_scale.clone().unwrap();
@@ -217,56 +216,56 @@ fn check(truth: &Truth, seed: u64) {
             "{p} {h}"
         );
         for w in 0..2 {
-            assert!(
-                (scale[w] - s[w]).abs() / s[w] < 0.05,
-                "robot {i} wheel {w}: {scale:?} vs {s:?}"
-            );
+            assert_fraction(&format!("robot {i} wheel {w}"), scale[w], s[w], 0.05);
         }
-        assert!(
-            (got_lag - lag).abs() / lag < 0.2,
-            "robot {i} lag {got_lag} vs {lag}"
-        );
-        assert!(
-            (got_lat - lat).abs() < 0.005,
-            "robot {i} latency {got_lat} vs {lat}"
-        );
+        assert_fraction(&format!("robot {i} lag"), got_lag, *lag, 0.2);
+        assert_near(&format!("robot {i} latency"), got_lat, *lat, 0.005);
     }
 }
 
-#[test]
-fn identifies_the_first_truth() {
-    check(
-        &[
+/// Asserts that `got` is within `tol` of the `truth` of `what`.
+fn assert_near(what: &str, got: f64, truth: f64, tol: f64) {
+    assert!((got - truth).abs() < tol, "{what} {got} vs {truth}");
+}
+
+/// Asserts that `got` is within the fraction `tol` of the `truth` of `what`.
+fn assert_fraction(what: &str, got: f64, truth: f64, tol: f64) {
+    assert!((got - truth).abs() / truth < tol, "{what} {got} vs {truth}");
+}
+
+/// Three truths, each with the seed of its excitation and tracker noise.
+const TRUTHS: [(Truth, u64); 3] = [
+    (
+        [
             ([1.0, 0.9], 0.05, 0.04, (0.8, 120.0)),
             ([0.85, 1.0], 0.08, 0.0, (1.0, 0.0)),
             ([1.1, 1.05], 0.03, 0.1, (1.25, -300.0)),
         ],
         1,
-    );
-}
-
-#[test]
-fn identifies_the_second_truth() {
-    check(
-        &[
+    ),
+    (
+        [
             ([0.95, 0.95], 0.12, 0.02, (1.1, 50.0)),
             ([1.0, 0.8], 0.04, 0.06, (0.7, 400.0)),
             ([0.9, 1.1], 0.06, 0.08, (0.95, -100.0)),
         ],
         2,
-    );
-}
-
-#[test]
-fn identifies_the_third_truth() {
-    check(
-        &[
+    ),
+    (
+        [
             ([1.2, 1.0], 0.1, 0.12, (1.4, 0.0)),
             ([0.7, 0.75], 0.02, 0.04, (0.6, 200.0)),
             ([1.0, 1.0], 0.05, 0.0, (0.9, 30.0)),
         ],
         3,
-    );
+    ),
+];
+
+#[test]
+fn identifies_every_truth() {
+    for (truth, seed) in &TRUTHS {
+        check(truth, *seed);
+    }
 }
 
 #[test]

@@ -45,15 +45,16 @@ fn run_rig(
     let faults = twin.twin.tracker().faults();
     let robot_faults = twin.twin.robots().faults.clone();
     let mut twin = twin.spawn(seconds + 1.0);
-    let source = twin.pose_source(&sc);
-    let link = twin.robot_link();
-    let frames = twin.frames.take();
+    let ends = rig::RigEnds {
+        source: twin.pose_source(&sc),
+        link: twin.robot_link(),
+        frames: twin.frames.take(),
+    };
     let dir = tempfile::tempdir().unwrap();
     let log_path = dir.path().join("rig.mcap");
     let live_opts = LiveOptions {
         duration: Some(seconds),
-        stream_width: 480,
-        stream_hz: 25.0,
+        stream: rig::FrameRate::new(480, 25.0),
         log: Some(log_path.clone()),
         trajectory: Some(dir.path().join("trajectory.csv")),
         gif: Some(dir.path().join("run.gif")),
@@ -63,7 +64,7 @@ fn run_rig(
     let bridge = {
         let sc = sc.clone();
         let stop = stop.clone();
-        std::thread::spawn(move || rig::run(&sc, source, link, frames, live_opts, stop).unwrap())
+        std::thread::spawn(move || rig::run(&sc, ends, live_opts, stop).unwrap())
     };
     during(&faults, &robot_faults);
     let report = bridge.join().unwrap();

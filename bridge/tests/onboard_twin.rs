@@ -48,19 +48,16 @@ fn run(
     let log = dir.path().join("rig.mcap");
     let opts = LiveOptions {
         duration: Some(seconds),
-        stream_width: 480,
+        stream: rig::FrameRate::every_tick(480),
         log: Some(log.clone()),
         ..LiveOptions::default()
     };
-    let report = rig::run(
-        host,
-        twin.pose_source(host),
-        twin.robot_link(),
-        twin.frames.take(),
-        opts,
-        Arc::new(AtomicBool::new(false)),
-    )
-    .unwrap();
+    let ends = rig::RigEnds {
+        source: twin.pose_source(host),
+        link: twin.robot_link(),
+        frames: twin.frames.take(),
+    };
+    let report = rig::run(host, ends, opts, Arc::new(AtomicBool::new(false))).unwrap();
     let twin = twin.join();
     (twin, report, read_log(&std::fs::read(&log).unwrap()))
 }

@@ -3,7 +3,7 @@
 //! compensated with its identified values. Driven straight ahead by the bridge, the compensated robot
 //! drives as the nominal robot beside them does (straight, as far), the other curves and falls
 //! short; on the dark screen the compensated robot's own counts read as the nominal robot's.
-use colcos_bridge::rig::{LiveOptions, LiveSession};
+use colcos_bridge::rig::{LiveOptions, LiveSession, RigEnds};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::SensorSource;
@@ -38,12 +38,16 @@ fn a_compensated_robot_drives_and_reads_as_the_nominal_one() {
     let twin = LoopbackTwin::udp(&twin_sc, false);
     let start: Vec<Pose> = twin.twin.arena().world().poses().to_vec();
     let twin = twin.spawn(seconds + 1.5);
-    let (source, link) = (twin.pose_source(&host), twin.robot_link());
+    let ends = RigEnds {
+        source: twin.pose_source(&host),
+        link: twin.robot_link(),
+        frames: None,
+    };
     let live_opts = LiveOptions {
         duration: Some(seconds),
         ..LiveOptions::default()
     };
-    let mut session = LiveSession::new(&host, source, link, None, live_opts).unwrap();
+    let mut session = LiveSession::new(&host, ends, live_opts).unwrap();
     let forward = vec![Some(WheelCommand::new(0.04, 0.04)); 3];
     // Each robot's mean count over the ticks after its first answers, all on the black screen (the
     // sensors' noise is about 10 counts a reading).

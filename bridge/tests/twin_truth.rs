@@ -9,7 +9,7 @@
 //! which smears the motors' response.
 use colcos_bridge::identify::{Excitation, FitOptions, identify};
 use colcos_bridge::protocol::swarmcon::{FrameTransform, HeaderForm};
-use colcos_bridge::rig::{LiveOptions, LiveSession};
+use colcos_bridge::rig::{LiveOptions, LiveSession, RigEnds};
 use colcos_bridge::twin::{TrackerServer, Twin, UdpChannel};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::behaviour::WheelCommand;
@@ -93,14 +93,18 @@ fn the_twin_drives_its_hidden_truth_and_identification_finds_it() {
 
     let opts = SourceOptions::new(FrameTransform::new(host.arena_size().y as f64));
     let source = open_pose_source(&format!("swarmcon://{tracker_addr}"), &opts).unwrap();
-    let link = open_robot_link(&url).unwrap();
+    let ends = RigEnds {
+        source,
+        link: open_robot_link(&url).unwrap(),
+        frames: None,
+    };
     let log = dir.path().join("rig.mcap");
     let live_opts = LiveOptions {
         duration: Some(seconds),
         log: Some(log.clone()),
         ..LiveOptions::default()
     };
-    let mut session = LiveSession::new(&host, source, link, None, live_opts).unwrap();
+    let mut session = LiveSession::new(&host, ends, live_opts).unwrap();
     let excitation = Excitation::new(host.spec.seed, 0.14);
     let mut overrides = vec![None::<WheelCommand>; 3];
     while !session.is_over() {

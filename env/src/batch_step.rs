@@ -7,7 +7,7 @@
 use crate::error::Result;
 use crate::outputs::OutSlices;
 use crate::world_slot::WorldSlot;
-use crate::world_step::{Begun, Ctx, begin_world, conclude_world, finish_world};
+use crate::world_step::{Begun, Ctx, WorldMut, begin_world, conclude_world, finish_world};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::{MAX_HOSTED_ARENAS, PhysicsBackend, RapierHost};
 use colcos_sim::scenario::Scenario;
@@ -115,8 +115,8 @@ fn step_chunk(
         let w = first + i;
         let lay = &rates[w * per_world..(w + 1) * per_world];
         let mut out = buffers.world(i);
-        let in_host = host.as_deref_mut().map(|h| (h, i));
-        match begin_world(ctx, w, slot, (cmds, lay), &mut out, in_host) {
+        let world = WorldMut::in_chunk(w, i, slot, &mut out, host.as_deref_mut());
+        match begin_world(ctx, world, (cmds, lay)) {
             Ok(b) => begun[i] = b,
             Err(err) if result.is_ok() => result = Err(err),
             Err(_) => {}
@@ -129,8 +129,8 @@ fn step_chunk(
     // the order changes nothing else; 7-10 % more steps a second at 1,024 worlds).
     for (i, slot) in slots.iter_mut().enumerate().rev() {
         let mut out = buffers.world(i);
-        let in_host = host.as_deref_mut().map(|h| (h, i));
-        let finished = finish_world(ctx, first + i, slot, &mut out, begun[i], in_host);
+        let world = WorldMut::in_chunk(first + i, i, slot, &mut out, host.as_deref_mut());
+        let finished = finish_world(ctx, world, begun[i]);
         if result.is_ok() {
             result = finished;
         }
@@ -158,8 +158,8 @@ pub(crate) fn conclude_batch(
                     continue;
                 }
                 let mut out = buffers.world(i);
-                let in_host = host.as_deref_mut().map(|h| (h, i));
-                let concluded = conclude_world(ctx, k * c + i, slot, &mut out, in_host);
+                let world = WorldMut::in_chunk(k * c + i, i, slot, &mut out, host.as_deref_mut());
+                let concluded = conclude_world(ctx, world);
                 if result.is_ok() {
                     result = concluded;
                 }

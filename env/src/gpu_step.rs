@@ -8,7 +8,9 @@ use crate::error::Result;
 use crate::gpu_stage::GpuStage;
 use crate::outputs::OutSlices;
 use crate::world_slot::WorldSlot;
-use crate::world_step::{Begun, Ctx, Evaluation, begin_world, conclude_world, finish_motion};
+use crate::world_step::{
+    Begun, Ctx, Evaluation, WorldMut, begin_world, conclude_world, finish_motion,
+};
 use colcos_sim::behaviour::WheelCommand;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -43,8 +45,8 @@ pub(crate) fn step_batch_gpu(
                     let cmds = &commands[i * n..(i + 1) * n];
                     let lay = &rates[w * per_world..(w + 1) * per_world];
                     let mut out = buffers.world(i);
-                    let in_host = host.as_deref_mut().map(|h| (h, i));
-                    begun[i] = match begin_world(ctx, w, slot, (cmds, lay), &mut out, in_host) {
+                    let world = WorldMut::in_chunk(w, i, slot, &mut out, host.as_deref_mut());
+                    begun[i] = match begin_world(ctx, world, (cmds, lay)) {
                         Ok(b) => b,
                         Err(err) => {
                             if result.is_ok() {
@@ -86,8 +88,8 @@ pub(crate) fn step_batch_gpu(
                 let w = k * c + i;
                 slot.world.sense_from_sums(stage.sums_of(w));
                 let mut out = buffers.world(i);
-                let in_host = host.as_deref_mut().map(|h| (h, i));
-                let done = conclude_world(ctx, w, slot, &mut out, in_host);
+                let world = WorldMut::in_chunk(w, i, slot, &mut out, host.as_deref_mut());
+                let done = conclude_world(ctx, world);
                 if result.is_ok() {
                     result = done;
                 }

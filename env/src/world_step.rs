@@ -44,6 +44,29 @@ pub(crate) enum Evaluation<'a> {
     },
 }
 
+/// World `w` as a step reaches it: its slot, its output slices and, for a world in a rapier host,
+/// the host and the world's slot in it.
+pub(crate) struct WorldMut<'a, 'o> {
+    pub(crate) w: usize,
+    pub(crate) slot: &'a mut WorldSlot,
+    pub(crate) out: &'a mut OutSlices<'o>,
+    pub(crate) host: Option<(&'a mut RapierHost, usize)>,
+}
+
+impl<'a, 'o> WorldMut<'a, 'o> {
+    /// World `w`, the `i`-th of its chunk, whose rapier steps are in the chunk's `host` if it has one.
+    pub(crate) fn in_chunk(
+        w: usize,
+        i: usize,
+        slot: &'a mut WorldSlot,
+        out: &'a mut OutSlices<'o>,
+        host: Option<&'a mut RapierHost>,
+    ) -> Self {
+        let host = host.map(|h| (h, i));
+        WorldMut { w, slot, out, host }
+    }
+}
+
 /// How far [`begin_world`] took a world's step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Begun {
@@ -55,7 +78,7 @@ pub(crate) enum Begun {
     InHost,
 }
 
-/// One whole step of a world that steps alone.
+/// One whole step of world `w`, which steps alone.
 pub(crate) fn step_world(
     ctx: &Ctx,
     w: usize,
@@ -63,22 +86,19 @@ pub(crate) fn step_world(
     actions: AgentActions,
     out: &mut OutSlices,
 ) -> Result<()> {
-    let begun = begin_world(ctx, w, slot, actions, out, None)?;
-    finish_world(ctx, w, slot, out, begun, None)
+    let begun = begin_world(ctx, WorldMut::in_chunk(w, 0, slot, out, None), actions)?;
+    finish_world(ctx, WorldMut::in_chunk(w, 0, slot, out, None), begun)
 }
 
 /// The first half of a world's step: autoreset, scripted robots, shield, and the motion, which
-/// for a world in a rapier host (`host`: the host and the world's slot in it) waits for the
-/// host's step.
+/// for a world in a rapier host waits for the host's step.
 pub(crate) fn begin_world(
     ctx: &Ctx,
-    w: usize,
-    slot: &mut WorldSlot,
+    world: WorldMut,
     (cmds, rates): AgentActions,
-    out: &mut OutSlices,
-    host: Option<(&mut RapierHost, usize)>,
 ) -> Result<Begun> {
     let agents = ctx.task.agents();
+    let (slot, out) = (&mut *world.slot, &mut *world.out);
     out.final_mask[0] = false;
     out.shield.fill(0);
     if slot.episode.done {
@@ -86,7 +106,7 @@ pub(crate) fn begin_world(
         out.rewards.fill(0.0);
         out.terminated.fill(false);
         out.truncated.fill(false);
-        next_episode(ctx, w, slot, out, host)?;
+        next_episode(ctx, world)?;
         return Ok(Begun::Reset);
     }
     let poses = slot.world.poses();
@@ -115,7 +135,7 @@ pub(crate) fn begin_world(
                 .set_deposit_actions(i, lay.map(|&f| if term { 0.0 } else { f }));
         }
     }
-    Ok(match host {
+    Ok(match world.host {
         Some((host, _)) => {
             slot.world.begin_step_in(&slot.overrides, host);
             Begun::InHost
@@ -128,18 +148,12 @@ pub(crate) fn begin_world(
 }
 
 /// The second half of a world's step, after its host's step: rewards, ends of episodes, outputs.
-pub(crate) fn finish_world(
-    ctx: &Ctx,
-    w: usize,
-    slot: &mut WorldSlot,
-    out: &mut OutSlices,
-    begun: Begun,
-    mut host: Option<(&mut RapierHost, usize)>,
-) -> Result<()> {
-    if !finish_motion(slot, begun, host.as_mut().map(|(h, _)| &mut **h)) {
+pub(crate) fn finish_world(ctx: &Ctx, mut world: WorldMut, begun: Begun) -> Result<()> {
+    let host = world.host.as_mut().map(|(h, _)| &mut **h);
+    if !finish_motion(world.slot, begun, host) {
         return Ok(());
     }
-    conclude_world(ctx, w, slot, out, host)
+    conclude_world(ctx, world)
 }
 
 /// A world's motion finished after its host's step (nothing to do for a world that stepped alone);
@@ -160,13 +174,8 @@ pub(crate) fn finish_motion(
 /// The end of a world's step once it has moved and sensed: rewards, ends of episodes, outputs, and a
 /// same-step autoreset; or, where the evaluation is deferred (a task written in Python), nothing
 /// until it is given.
-pub(crate) fn conclude_world(
-    ctx: &Ctx,
-    w: usize,
-    slot: &mut WorldSlot,
-    out: &mut OutSlices,
-    host: Option<(&mut RapierHost, usize)>,
-) -> Result<()> {
+pub(crate) fn conclude_world(ctx: &Ctx, world: WorldMut) -> Result<()> {
+    let (w, slot, out) = (world.w, &mut *world.slot, &mut *world.out);
     slot.awaiting = matches!(ctx.evaluation, Evaluation::Deferred);
     if slot.awaiting {
         return Ok(());
@@ -200,19 +209,14 @@ pub(crate) fn conclude_world(
     if done && ctx.mode == AutoresetMode::SameStep {
         out.final_obs.copy_from_slice(out.obs);
         out.final_mask[0] = true;
-        next_episode(ctx, w, slot, out, host)?;
+        next_episode(ctx, world)?;
     }
     Ok(())
 }
 
-/// Replaces world `w` by its next episode (in its rapier host's slot, if any) and writes its outputs.
-fn next_episode(
-    ctx: &Ctx,
-    w: usize,
-    slot: &mut WorldSlot,
-    out: &mut OutSlices,
-    host: Option<(&mut RapierHost, usize)>,
-) -> Result<()> {
+/// Replaces the world by its next episode (in its rapier host's slot, if any) and writes its outputs.
+fn next_episode(ctx: &Ctx, world: WorldMut) -> Result<()> {
+    let WorldMut { w, slot, out, host } = world;
     *slot = WorldSlot::build(
         ctx.scenario,
         ctx.task,

@@ -5,7 +5,7 @@ use crate::{GoTo, PlantError, PlantKind, PlantOptions};
 use colcos_bridge::calibrate::RigCalibration;
 use colcos_bridge::protocol::colias::LegacyDrive;
 use colcos_bridge::rig::HostWorld;
-use colcos_bridge::rig::{LiveOptions, LiveSession, LoopCore, replay};
+use colcos_bridge::rig::{FrameRate, LiveOptions, LiveSession, LoopCore, RigEnds, replay};
 use colcos_bridge::transport::FrameServer;
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_env::task::registry;
@@ -22,8 +22,7 @@ use std::time::Instant;
 
 /// The frames the host streams to a twin started here whose robots read their own sensors: wide
 /// enough for a sensor's footprint to cover a few pixels, at twice the default telemetry rate.
-const TWIN_FRAME_WIDTH: u32 = 480;
-const TWIN_FRAME_HZ: f64 = 10.0;
+const TWIN_FRAMES: FrameRate = FrameRate::new(480, 10.0);
 
 /// What the last reset's go-to did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -209,11 +208,15 @@ impl LiveEnv {
         let link = open_robot_link(&robots)?;
         let live = LiveOptions {
             log: plant.log.clone(),
-            stream_width: TWIN_FRAME_WIDTH,
-            stream_hz: TWIN_FRAME_HZ,
+            stream: TWIN_FRAMES,
             ..LiveOptions::default()
         };
-        let session = LiveSession::new(scenario, source, link, frames, live)?;
+        let ends = RigEnds {
+            source,
+            link,
+            frames,
+        };
+        let session = LiveSession::new(scenario, ends, live)?;
         Ok(Driver::Live {
             session: Box::new(session),
             tracker,

@@ -6,7 +6,7 @@
 use crate::PlantError;
 use crate::driver::TwinThread;
 use colcos_bridge::calibrate::RigCalibration;
-use colcos_bridge::rig::{LiveOptions, LiveSession};
+use colcos_bridge::rig::{LiveOptions, LiveSession, RigEnds};
 use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
@@ -48,18 +48,46 @@ impl Default for PreflightLimits {
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct PreflightReport {
     pub episodes: usize,
-    pub ticks: u64,
-    pub robot_ticks: u64,
-    pub walled: u64,
-    pub capped: u64,
-    pub boundary: u64,
-    pub collisions: u64,
-    pub overruns: u64,
+    #[serde(flatten)]
+    pub counts: PreflightCounts,
     pub stops: Vec<String>,
     /// The farthest any body reached past the edge, if one did.
     pub worst_boundary: Option<PastEdge>,
     /// Each limit broken, with its value.
     pub broken: Vec<String>,
+}
+
+/// The ticks of every episode, and those of them that count against the limits.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct PreflightCounts {
+    pub ticks: u64,
+    pub robot_ticks: u64,
+    /// Robot-ticks the shield turned from a virtual wall, and those it capped.
+    pub walled: u64,
+    pub capped: u64,
+    /// Ticks with a body past the edge, with robots overlapping, and overrun.
+    pub boundary: u64,
+    pub collisions: u64,
+    pub overruns: u64,
+}
+
+impl PreflightCounts {
+    /// Each limit's name, the value it is checked on (a fraction of the ticks or robot-ticks, or a
+    /// count) and the limit.
+    fn against(&self, limits: &PreflightLimits) -> [(&'static str, f64, f64); 5] {
+        let frac = |n: u64, d: u64| n as f64 / d.max(1) as f64;
+        [
+            ("walled", frac(self.walled, self.robot_ticks), limits.walled),
+            ("capped", frac(self.capped, self.robot_ticks), limits.capped),
+            ("boundary", self.boundary as f64, limits.boundary as f64),
+            (
+                "collisions",
+                frac(self.collisions, self.ticks),
+                limits.collisions,
+            ),
+            ("overruns", frac(self.overruns, self.ticks), limits.overruns),
+        ]
+    }
 }
 
 /// Where a body reached farthest past the arena's edge.
@@ -95,8 +123,12 @@ pub fn check(
             &twin.tracker_url,
             &SourceOptions::new(calibration.frame_transform(&sc)),
         )?;
-        let link = open_robot_link(&twin.robots_url)?;
-        let mut session = LiveSession::new(&sc, source, link, None, LiveOptions::default())?;
+        let ends = RigEnds {
+            source,
+            link: open_robot_link(&twin.robots_url)?,
+            frames: None,
+        };
+        let mut session = LiveSession::new(&sc, ends, LiveOptions::default())?;
         let start = Instant::now();
         let mut tick = 0u64;
         while start.elapsed().as_secs_f64() < seconds {
@@ -109,11 +141,11 @@ pub fn check(
                 .filter(|(_, (t, _))| t.seen)
                 .map(|(i, (_, p))| (i, p.pos))
                 .collect();
-            r.ticks += 1;
-            r.robot_ticks += seen.len() as u64;
+            r.counts.ticks += 1;
+            r.counts.robot_ticks += seen.len() as u64;
             for i in core.interventions() {
-                r.walled += i.walled as u64;
-                r.capped += i.capped as u64;
+                r.counts.walled += i.walled as u64;
+                r.counts.capped += i.capped as u64;
             }
             // How far the body reaches past the nearest edge (negative: inside).
             let past = |p: glam::Vec2| radius - p.min(arena - p).min_element();
@@ -130,32 +162,24 @@ pub fn check(
                     });
                 }
             }
-            r.boundary += beyond as u64;
+            r.counts.boundary += beyond as u64;
             let touching = seen.iter().enumerate().any(|(i, (_, a))| {
                 seen[..i]
                     .iter()
                     .any(|(_, b)| a.distance(*b) < 2.0 * radius - 0.005)
             });
-            r.collisions += touching as u64;
+            r.counts.collisions += touching as u64;
             session.wait_next();
             tick += 1;
         }
         let report = session.report();
-        r.overruns += report.overruns;
+        r.counts.overruns += report.overruns;
         r.stops.extend(report.stops);
         r.episodes += 1;
         drop(session);
         drop(twin);
     }
-    let frac = |n: u64, d: u64| n as f64 / d.max(1) as f64;
-    let checks = [
-        ("walled", frac(r.walled, r.robot_ticks), limits.walled),
-        ("capped", frac(r.capped, r.robot_ticks), limits.capped),
-        ("boundary", r.boundary as f64, limits.boundary as f64),
-        ("collisions", frac(r.collisions, r.ticks), limits.collisions),
-        ("overruns", frac(r.overruns, r.ticks), limits.overruns),
-    ];
-    for (name, value, limit) in checks {
+    for (name, value, limit) in r.counts.against(limits) {
         if value > limit {
             let mut text = format!("{name} = {value:.4} over the limit {limit}");
             if let ("boundary", Some(w)) = (name, r.worst_boundary) {

@@ -10,7 +10,10 @@ fn the_shield_holds_robots_on_board_at_the_virtual_wall() {
     let sc = onboard(&onboard_policy(), 1.3);
     let limits = colcos_plant::preflight::PreflightLimits::default();
     let r = colcos_plant::preflight::check(&sc, 1, 3.0, &limits).unwrap();
-    assert_eq!(r.boundary, 0, "{r:?}");
-    assert!(r.walled as f64 > 0.3 * r.robot_ticks as f64, "{r:?}");
+    assert_eq!(r.counts.boundary, 0, "{r:?}");
+    assert!(
+        r.counts.walled as f64 > 0.3 * r.counts.robot_ticks as f64,
+        "{r:?}"
+    );
     assert!(r.broken.iter().any(|b| b.starts_with("walled")), "{r:?}");
 }

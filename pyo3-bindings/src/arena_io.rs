@@ -5,7 +5,7 @@ use crate::args;
 use crate::errors::Kind;
 use colcos_env::{Actions, BufferPtrs, EnvSpec, Space};
 use colcos_sim::robot::Pose;
-use numpy::ndarray::{ArrayView, IxDyn};
+use numpy::ndarray::{ArrayView, IntoDimension, IxDyn};
 use numpy::{
     Element, PyArray, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods,
 };
@@ -224,11 +224,19 @@ pub(crate) fn render_width(width: Option<&Bound<'_, PyAny>>, max: u64) -> PyResu
     })
 }
 
+/// `values` (in C order) as a numpy array of shape `shape`, whose product must be their count.
+pub(crate) fn shaped<'py, T: Element, D: IntoDimension>(
+    py: Python<'py>,
+    values: Vec<T>,
+    shape: D,
+) -> PyResult<Bound<'py, PyAny>> {
+    Ok(PyArray1::from_vec(py, values).reshape(shape)?.into_any())
+}
+
 /// An RGB image as a uint8 array `(H, W, 3)`.
 pub(crate) fn image<'py>(py: Python<'py>, img: image::RgbImage) -> PyResult<Bound<'py, PyAny>> {
     let (w, h) = (img.width() as usize, img.height() as usize);
-    let flat = PyArray1::from_vec(py, img.into_raw());
-    Ok(flat.reshape([h, w, 3])?.into_any())
+    shaped(py, img.into_raw(), [h, w, 3])
 }
 
 /// Poses as a float32 array `(R, 3)`: x m, y m, heading rad.
@@ -236,7 +244,5 @@ pub(crate) fn pose_rows<'py>(py: Python<'py>, poses: Vec<Pose>) -> PyResult<Boun
     let flat: Vec<f32> = (poses.iter())
         .flat_map(|p| [p.pos.x, p.pos.y, p.heading])
         .collect();
-    Ok(PyArray1::from_vec(py, flat)
-        .reshape([poses.len(), 3])?
-        .into_any())
+    shaped(py, flat, [poses.len(), 3])
 }

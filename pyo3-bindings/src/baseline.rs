@@ -1,13 +1,13 @@
 //! `colcos._core.Baseline`: the paper's hand-written behaviours as policies over a `VecEnv` or a
 //! `Plant` (a twin, the rig). Locks are taken with the GIL released, the env's before the policy's
 //! (one order, no deadlock).
+use crate::arena_io::shaped;
 use crate::args::{self, guard};
 use crate::errors::{Kind, to_py};
 use crate::plant::PyPlant;
 use crate::vec_env::PyVecEnv;
 use colcos_env::EnvError;
 use colcos_env::baseline::{Arenas, BaselinePolicy};
-use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use std::sync::Mutex;
 
@@ -78,7 +78,7 @@ impl PyBaseline {
                 }
                 policy.act(a, out).map(|()| out.clone())
             })?;
-            Ok(PyArray1::from_vec(py, out).reshape(self.shape)?.into_any())
+            shaped(py, out, self.shape)
         })
     }
 }

@@ -1,9 +1,10 @@
 //! Sweeps from Python (`colcos.sweep`): a checked plan, the local runner, the runs of a list of ids
 //! (what a Ray task calls) and the resumable results table the rows go into. The GIL is released while
 //! runs execute.
+use crate::arena_io::shaped;
 use crate::errors::Kind;
 use colcos_sweep::{Plan, ResultsTable, SweepError, SweepOptions, Trace};
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::PyArray1;
 use pyo3::exceptions::{PyOSError, PyRuntimeError};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
@@ -199,14 +200,8 @@ impl Sweep {
                 let (steps, n) = (t.times.len(), t.roles.len());
                 let d = pyo3::types::PyDict::new(py);
                 d.set_item("times", PyArray1::from_vec(py, t.times))?;
-                d.set_item(
-                    "positions",
-                    PyArray1::from_vec(py, t.positions).reshape([steps, n, 2])?,
-                )?;
-                d.set_item(
-                    "headings",
-                    PyArray1::from_vec(py, t.headings).reshape([steps, n])?,
-                )?;
+                d.set_item("positions", shaped(py, t.positions, [steps, n, 2])?)?;
+                d.set_item("headings", shaped(py, t.headings, [steps, n])?)?;
                 d.set_item("roles", t.roles)?;
                 Ok((id, cells, d))
             })

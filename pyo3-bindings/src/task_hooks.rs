@@ -2,11 +2,11 @@
 //! worlds move; then the hooks' rewards and terminations end it), the state of every world as numpy
 //! arrays, and the fields sampled at any points, each once per batched step over all worlds.
 //! Functions of the module rather than methods: the env's own class stays about stepping.
-use crate::arena_io::{self, flat};
+use crate::arena_io::{self, flat, shaped};
 use crate::args::guard;
 use crate::errors::{Kind, to_py};
 use crate::plant::{PyPlant, plant_err};
-use crate::task_view::{Counters, View};
+use crate::task_view::{Counters, Dims, View};
 use crate::vec_env::PyVecEnv;
 use colcos_env::VecEnv;
 use colcos_env::encoding::OBS_DIM;
@@ -15,7 +15,7 @@ use colcos_sim::field::Pheromone;
 use colcos_sim::robot::Pose;
 use colcos_sim::scenario::Scenario;
 use colcos_sim::world::ArenaView;
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -84,31 +84,24 @@ fn task_view<'py>(py: Python<'py>, env: &Bound<'py, PyAny>) -> PyResult<Bound<'p
             Core::Plant(p) => py.detach(|| plant_view(&p.lock())),
         };
         let d = PyDict::new(py);
-        let (e, r, n) = (v.e, v.r, v.n);
-        d.set_item("poses", PyArray1::from_vec(py, v.poses).reshape([e, r, 3])?)?;
-        d.set_item(
-            "tracked",
-            PyArray1::from_vec(py, v.tracked).reshape([e, r, 3])?,
-        )?;
-        d.set_item("seen", PyArray1::from_vec(py, v.seen).reshape([e, r])?)?;
-        d.set_item(
-            "wheels",
-            PyArray1::from_vec(py, v.wheels).reshape([e, r, 2])?,
-        )?;
-        d.set_item(
-            "commands",
-            PyArray1::from_vec(py, v.commands).reshape([e, r, 2])?,
-        )?;
-        let deposits = PyArray1::from_vec(py, v.deposits).reshape([e, n, v.d])?;
-        d.set_item("deposit_actions", deposits)?;
-        d.set_item(
-            "obs",
-            PyArray1::from_vec(py, v.obs).reshape([e, n, OBS_DIM])?,
-        )?;
-        d.set_item("steps", PyArray1::from_vec(py, v.steps))?;
-        d.set_item("stepped", PyArray1::from_vec(py, v.stepped))?;
-        d.set_item("episode", PyArray1::from_vec(py, v.episode))?;
-        d.set_item("time", PyArray1::from_vec(py, v.time))?;
+        let Dims { e, r, n, d: per } = v.dims;
+        let rows = v.robots;
+        d.set_item("poses", shaped(py, rows.poses, [e, r, 3])?)?;
+        d.set_item("tracked", shaped(py, rows.tracked, [e, r, 3])?)?;
+        d.set_item("seen", shaped(py, rows.seen, [e, r])?)?;
+        d.set_item("wheels", shaped(py, rows.wheels, [e, r, 2])?)?;
+        d.set_item("commands", shaped(py, rows.commands, [e, r, 2])?)?;
+        d.set_item("deposit_actions", shaped(py, v.deposits, [e, n, per])?)?;
+        d.set_item("obs", shaped(py, v.obs, [e, n, OBS_DIM])?)?;
+        let worlds = &v.worlds;
+        let steps = worlds.iter().map(|c| c.steps as i64);
+        d.set_item("steps", PyArray1::from_iter(py, steps))?;
+        let stepped = worlds.iter().map(|c| c.stepped);
+        d.set_item("stepped", PyArray1::from_iter(py, stepped))?;
+        let episode = worlds.iter().map(|c| c.episode as i64);
+        d.set_item("episode", PyArray1::from_iter(py, episode))?;
+        let time = worlds.iter().map(|c| c.time);
+        d.set_item("time", PyArray1::from_iter(py, time))?;
         Ok(d)
     })
 }
@@ -118,7 +111,12 @@ fn batch_view(env: &VecEnv) -> View {
     let agents = &s.agent_robots;
     let max_speed = env.scenario().spec.robot.max_wheel_speed;
     let d = env.action_decoder().deposits();
-    let mut v = View::new(s.num_envs, s.num_robots, s.num_agents, d);
+    let mut v = View::new(Dims {
+        e: s.num_envs,
+        r: s.num_robots,
+        n: s.num_agents,
+        d,
+    });
     for w in 0..s.num_envs {
         let Some(world) = env.world(w) else {
             continue;
@@ -140,7 +138,12 @@ fn plant_view(env: &LiveEnv) -> View {
     let s = env.spec();
     let host = env.host();
     let d = env.action_decoder().deposits();
-    let mut v = View::new(1, s.num_robots, s.num_agents, d);
+    let mut v = View::new(Dims {
+        e: 1,
+        r: s.num_robots,
+        n: s.num_agents,
+        d,
+    });
     let stepped = env.is_awaiting();
     let c = Counters {
         steps: env.episode_steps() + stepped as u64,
@@ -262,7 +265,7 @@ fn sample_fields<'py>(
             Core::Plant(pl) => py.detach(|| sample(&[pl.lock().host().pheromones()])),
         };
         let (out, e, p, f) = sampled.map_err(|m: String| Kind::Action.err(m))?;
-        Ok(PyArray1::from_vec(py, out).reshape([e, p, f])?.into_any())
+        shaped(py, out, [e, p, f])
     })
 }
 
@@ -314,12 +317,8 @@ fn sample_gradients<'py>(
         };
         let (values, grads, e, p, f) = sampled.map_err(|m: String| Kind::Action.err(m))?;
         Ok((
-            PyArray1::from_vec(py, values)
-                .reshape([e, p, f])?
-                .into_any(),
-            PyArray1::from_vec(py, grads)
-                .reshape([e, p, f, 2])?
-                .into_any(),
+            shaped(py, values, [e, p, f])?,
+            shaped(py, grads, [e, p, f, 2])?,
         ))
     })
 }
@@ -390,7 +389,7 @@ fn unit_vectors<'py>(
             out.extend([v.x, v.y]);
         }
         shape.push(2);
-        Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
+        shaped(py, out, shape)
     })
 }
 

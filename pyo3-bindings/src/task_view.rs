@@ -5,23 +5,34 @@ use colcos_env::world_output::write_obs;
 use colcos_sim::tracker::TrackedPose;
 use colcos_sim::world::ArenaView;
 
-/// One step's state of `e` worlds of `r` robots, `n` agents with `d` deposit actions each.
+/// One step's state of every world, each array flat in world order.
 pub(crate) struct View {
+    pub dims: Dims,
+    pub robots: RobotRows,
+    /// Each agent's deposit actions `[E, N, D]` and observations `[E, N, OBS_DIM]`.
+    pub deposits: Vec<f32>,
+    pub obs: Vec<f32>,
+    /// Each world's episode counters `[E]`.
+    pub worlds: Vec<Counters>,
+}
+
+/// The sizes of a [`View`]: `e` worlds of `r` robots, `n` agents with `d` deposit actions each.
+#[derive(Clone, Copy)]
+pub(crate) struct Dims {
     pub e: usize,
     pub r: usize,
     pub n: usize,
     pub d: usize,
+}
+
+/// Each robot's state `[E, R, ...]`: its true and tracked poses (x, y, heading), whether the tracker
+/// saw it, its wheel speeds and its last commands (left, right).
+pub(crate) struct RobotRows {
     pub poses: Vec<f32>,
     pub tracked: Vec<f32>,
     pub seen: Vec<bool>,
     pub wheels: Vec<f32>,
     pub commands: Vec<f32>,
-    pub deposits: Vec<f32>,
-    pub obs: Vec<f32>,
-    pub steps: Vec<i64>,
-    pub stepped: Vec<bool>,
-    pub episode: Vec<i64>,
-    pub time: Vec<f32>,
 }
 
 /// One world's episode counters for [`View::push`].
@@ -35,23 +46,20 @@ pub(crate) struct Counters {
 }
 
 impl View {
-    pub fn new(e: usize, r: usize, n: usize, d: usize) -> View {
+    pub fn new(dims: Dims) -> View {
+        let Dims { e, r, n, d } = dims;
         View {
-            e,
-            r,
-            n,
-            d,
-            poses: Vec::with_capacity(e * r * 3),
-            tracked: Vec::with_capacity(e * r * 3),
-            seen: Vec::with_capacity(e * r),
-            wheels: Vec::with_capacity(e * r * 2),
-            commands: Vec::with_capacity(e * r * 2),
+            dims,
+            robots: RobotRows {
+                poses: Vec::with_capacity(e * r * 3),
+                tracked: Vec::with_capacity(e * r * 3),
+                seen: Vec::with_capacity(e * r),
+                wheels: Vec::with_capacity(e * r * 2),
+                commands: Vec::with_capacity(e * r * 2),
+            },
             deposits: Vec::with_capacity(e * n * d),
             obs: Vec::with_capacity(e * n * OBS_DIM),
-            steps: Vec::with_capacity(e),
-            stepped: Vec::with_capacity(e),
-            episode: Vec::with_capacity(e),
-            time: Vec::with_capacity(e),
+            worlds: Vec::with_capacity(e),
         }
     }
 
@@ -70,24 +78,23 @@ impl View {
         let start = self.obs.len();
         self.obs.resize(start + agents.len() * OBS_DIM, 0.0);
         write_obs(arena, agents, max_speed, &mut self.obs[start..]);
+        let rows = &mut self.robots;
         for p in arena.poses() {
-            self.poses.extend([p.pos.x, p.pos.y, p.heading]);
+            rows.poses.extend([p.pos.x, p.pos.y, p.heading]);
         }
         for t in tracked {
-            (self.tracked).extend([t.pose.pos.x, t.pose.pos.y, t.pose.heading]);
-            self.seen.push(t.seen);
+            rows.tracked
+                .extend([t.pose.pos.x, t.pose.pos.y, t.pose.heading]);
+            rows.seen.push(t.seen);
         }
         for slot in arena.robots() {
-            self.wheels.extend([slot.drive.left, slot.drive.right]);
-            self.commands
+            rows.wheels.extend([slot.drive.left, slot.drive.right]);
+            rows.commands
                 .extend([slot.command.left, slot.command.right]);
         }
         for &i in agents {
             self.deposits.extend_from_slice(deposits(i));
         }
-        self.steps.push(c.steps as i64);
-        self.stepped.push(c.stepped);
-        self.episode.push(c.episode as i64);
-        self.time.push(c.time);
+        self.worlds.push(c);
     }
 }

@@ -111,18 +111,27 @@ pub fn pixels_at<const N: usize>(
     screen: &ScreenSpec,
     points: &[Vec2; N],
 ) -> [[u8; 3]; N] {
-    pixels_at_frozen(pheromones, &FrozenSources::new(pheromones), screen, points)
+    let frozen = FrozenSources::new(pheromones);
+    let fields = ScreenFields {
+        pheromones,
+        frozen: &frozen,
+        screen,
+    };
+    pixels_at_frozen(&fields, points)
 }
 
-/// [`pixels_at`] with the Gaussian sources already frozen at the fields' time (`frozen` must come from
-/// these `pheromones` as they are now).
-pub fn pixels_at_frozen<const N: usize>(
-    pheromones: &[Pheromone],
-    frozen: &FrozenSources,
-    screen: &ScreenSpec,
-    points: &[Vec2; N],
-) -> [[u8; 3]; N] {
-    let levels = levels_at(pheromones, frozen, screen, points, N);
+/// What eq. (1) sums on a panel at one time: the pheromones, with their Gaussian sources already
+/// frozen at the fields' time (`frozen` must come from these `pheromones` as they are now).
+#[derive(Clone, Copy)]
+pub struct ScreenFields<'a> {
+    pub pheromones: &'a [Pheromone],
+    pub frozen: &'a FrozenSources,
+    pub screen: &'a ScreenSpec,
+}
+
+/// [`pixels_at`] with the Gaussian sources already frozen.
+pub fn pixels_at_frozen<const N: usize>(fields: &ScreenFields, points: &[Vec2; N]) -> [[u8; 3]; N] {
+    let levels = levels_at(fields, points, N);
     let mut out = [[0u8; 3]; N];
     for (k, o) in out.iter_mut().enumerate() {
         *o = [levels[0][k] as u8, levels[1][k] as u8, levels[2][k] as u8];
@@ -137,18 +146,16 @@ pub fn pixels_at_frozen<const N: usize>(
 /// on the same grid; the arithmetic runs over arrays of points (structure of arrays) so that it
 /// vectorises.
 pub fn levels_at<const N: usize>(
-    pheromones: &[Pheromone],
-    frozen: &FrozenSources,
-    screen: &ScreenSpec,
+    fields: &ScreenFields,
     points: &[Vec2; N],
     group: usize,
 ) -> [[u32; N]; 3] {
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2.
-        return unsafe { levels_at_avx2(pheromones, frozen, screen, points, group) };
+        return unsafe { levels_at_avx2(fields, points, group) };
     }
-    levels_at_portable(pheromones, frozen, screen, points, group)
+    levels_at_portable(fields, points, group)
 }
 
 /// [`levels_at`] compiled for AVX2: the same operations in wider registers (twice the f64 lanes of
@@ -157,24 +164,25 @@ pub fn levels_at<const N: usize>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn levels_at_avx2<const N: usize>(
-    pheromones: &[Pheromone],
-    frozen: &FrozenSources,
-    screen: &ScreenSpec,
+    fields: &ScreenFields,
     points: &[Vec2; N],
     group: usize,
 ) -> [[u32; N]; 3] {
-    levels_at_portable(pheromones, frozen, screen, points, group)
+    levels_at_portable(fields, points, group)
 }
 
 /// [`levels_at`] for any x86-64 (or other) processor.
 #[inline(always)]
 pub fn levels_at_portable<const N: usize>(
-    pheromones: &[Pheromone],
-    frozen: &FrozenSources,
-    screen: &ScreenSpec,
+    fields: &ScreenFields,
     points: &[Vec2; N],
     group: usize,
 ) -> [[u32; N]; 3] {
+    let ScreenFields {
+        pheromones,
+        frozen,
+        screen,
+    } = *fields;
     let group = group.clamp(1, N.max(1));
     let pixel = screen.pixel_size();
     let [nx, ny] = screen.resolution;

@@ -137,11 +137,18 @@ fn image_map_reads_png_top_row_at_height() {
     ));
 }
 
-fn grid_pheromone(colour: [f32; 3], spec: GridSpec) -> Pheromone {
+/// A grid pheromone `p` of `colour` on `spec`, its values set by `fill`.
+fn grid_pheromone(
+    colour: [f32; 3],
+    spec: GridSpec,
+    fill: impl FnOnce(&mut GridField),
+) -> Pheromone {
+    let mut g = GridField::new(spec, GridParams::default());
+    fill(&mut g);
     Pheromone {
         name: "p".into(),
         colour,
-        model: FieldModel::Grid(GridField::new(spec, GridParams::default())),
+        model: FieldModel::Grid(g),
     }
 }
 
@@ -152,14 +159,10 @@ fn pixel_at_rounds_and_clips() {
         ny: 4,
         cell: 0.25,
     };
-    let mut a = grid_pheromone([100.0, 0.0, -50.0], spec);
-    let mut b = grid_pheromone([0.0, 1.0, 0.0], spec);
-    if let FieldModel::Grid(g) = &mut a.model {
-        g.values_mut().fill(1.004); // r 100.4 -> 100; b negative -> 0
-    }
-    if let FieldModel::Grid(g) = &mut b.model {
-        g.values_mut().fill(254.5); // g rounds half away from zero -> 255
-    }
+    // r 100.4 -> 100; b negative -> 0
+    let a = grid_pheromone([100.0, 0.0, -50.0], spec, |g| g.values_mut().fill(1.004));
+    // g rounds half away from zero -> 255
+    let b = grid_pheromone([0.0, 1.0, 0.0], spec, |g| g.values_mut().fill(254.5));
     let screen = ScreenSpec {
         resolution: [8, 8],
         size: [1.0, 1.0],
@@ -168,10 +171,7 @@ fn pixel_at_rounds_and_clips() {
         pixel_at(&[a, b], &screen, Vec2::new(0.3, 0.6)),
         [100, 255, 0]
     );
-    let mut c = grid_pheromone([3.0, 2.6, 0.0], spec);
-    if let FieldModel::Grid(g) = &mut c.model {
-        g.values_mut().fill(1000.0);
-    }
+    let c = grid_pheromone([3.0, 2.6, 0.0], spec, |g| g.values_mut().fill(1000.0));
     assert_eq!(pixel_at(&[c], &screen, Vec2::new(0.3, 0.6)), [255, 255, 0]);
     // Pixel centres.
     assert_eq!(screen.pixel_size(), Vec2::splat(0.125));
@@ -192,10 +192,9 @@ fn render_puts_high_y_at_the_top() {
         ny: 81,
         cell: 0.01,
     };
-    let mut p = grid_pheromone([0.0, 0.0, 255.0], spec);
-    if let FieldModel::Grid(g) = &mut p.model {
-        g.deposit_point(&Kernel::Disc { radius: 0.05 }, Vec2::new(0.3, 0.7), 1.0);
-    }
+    let p = grid_pheromone([0.0, 0.0, 255.0], spec, |g| {
+        g.deposit_point(&Kernel::Disc { radius: 0.05 }, Vec2::new(0.3, 0.7), 1.0)
+    });
     let gauss = Pheromone {
         name: "g".into(),
         colour: [255.0 * 0.01 * std::f32::consts::TAU, 0.0, 0.0],
@@ -226,7 +225,7 @@ fn render_puts_high_y_at_the_top() {
     assert_eq!(img.get_pixel(120, 5).0[0], 0);
     // Same values as pixel_at at the panel's own resolution.
     let full = render(
-        std::slice::from_ref(&grid_pheromone([1.0; 3], spec)),
+        std::slice::from_ref(&grid_pheromone([1.0; 3], spec, |_| {})),
         &screen,
         1440,
         810,
@@ -243,12 +242,11 @@ fn render_matches_pixel_at() {
         ny: 30,
         cell: 0.02,
     };
-    let mut p = grid_pheromone([40.0, 10.0, 0.0], spec);
-    if let FieldModel::Grid(g) = &mut p.model {
+    let p = grid_pheromone([40.0, 10.0, 0.0], spec, |g| {
         for (k, v) in g.values_mut().iter_mut().enumerate() {
             *v = (k % 13) as f32 * 0.37;
         }
-    }
+    });
     let screen = ScreenSpec {
         resolution: [160, 90],
         size: [1.0, 0.6],
@@ -372,11 +370,9 @@ proptest::proptest! {
         let mut ps: Vec<Pheromone> = [[255.0, 0.0, 0.0], [0.0, 255.0, 40.0], [10.0, 0.0, 255.0]]
             .into_iter()
             .map(|colour| {
-                let mut p = grid_pheromone(colour, spec);
-                if let FieldModel::Grid(g) = &mut p.model {
-                    g.values_mut().iter_mut().for_each(|v| *v = rng.random_range(0.0..1.2));
-                }
-                p
+                grid_pheromone(colour, spec, |g| {
+                    g.values_mut().iter_mut().for_each(|v| *v = rng.random_range(0.0..1.2))
+                })
             })
             .collect();
         ps.insert(1, Pheromone {
@@ -405,8 +401,9 @@ proptest::proptest! {
             points[k % 9] + 0.015 * Vec2::from_angle((k / 9) as f32 * std::f32::consts::FRAC_PI_2)
         });
         let frozen = colcos_sim::field::FrozenSources::new(&ps);
-        let fast = colcos_sim::screen::levels_at(&ps, &frozen, &screen, &robot, 9);
-        let portable = colcos_sim::screen::levels_at_portable(&ps, &frozen, &screen, &robot, 9);
+        let fields = colcos_sim::screen::ScreenFields { pheromones: &ps, frozen: &frozen, screen: &screen };
+        let fast = colcos_sim::screen::levels_at(&fields, &robot, 9);
+        let portable = colcos_sim::screen::levels_at_portable(&fields, &robot, 9);
         proptest::prop_assert_eq!(fast, portable);
         for (k, p) in robot.iter().enumerate() {
             let want = reference_pixel(&ps, &screen, *p).map(u32::from);

@@ -4,30 +4,23 @@
 //! `[randomize]` drawing around each robot's own values.
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::robot::Actuation;
-use colcos_sim::scenario::Scenario;
+use colcos_sim::scenario::{RobotGroupSpec, Scenario, ScenarioBuilder};
 use colcos_sim::world::World;
 
-/// One robot at the centre of a 1.2 m arena, heading +x, with `extra` appended (e.g. `[individual]`).
+/// One robot at the centre of a 1.2 m arena, heading +x (and a second near a corner), without sensor
+/// noise or tracker latency: the scenario file with `extra` appended (e.g. `[individual]`).
 fn scenario(extra: &str) -> Scenario {
-    let text = format!(
-        r#"
-duration = 20.0
-[screen]
-resolution = [240, 240]
-size = [1.2, 1.2]
-[sensor]
-noise = 0.0
-[tracker]
-latency = 0.0
-[[robots]]
-count = 2
-behaviour = "wander"
-placement = "explicit"
-poses = [[0.6, 0.6, 0.0], [0.1, 0.1, 90.0]]
-{extra}
-"#
-    );
-    Scenario::from_toml_str(&text, ".").unwrap()
+    let base = ScenarioBuilder::new()
+        .duration(20.0)
+        .screen([240, 240], [1.2, 1.2])
+        .with(|s| {
+            s.sensor.noise = 0.0;
+            s.tracker.latency = 0.0;
+        })
+        .robots(RobotGroupSpec::new(2, "wander").at_poses(vec![[0.6, 0.6, 0.0], [0.1, 0.1, 90.0]]))
+        .build()
+        .unwrap();
+    Scenario::from_toml_str(&format!("{}\n{extra}\n", base.to_toml()), ".").unwrap()
 }
 
 fn left_speeds(world: &mut World, cmd: WheelCommand, steps: usize) -> Vec<f32> {

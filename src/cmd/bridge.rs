@@ -3,9 +3,9 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use colcos_bridge::calibrate::RigCalibration;
-use colcos_bridge::rig::{self, LiveOptions};
+use colcos_bridge::rig::{self, FrameRate, LiveOptions, RigEnds};
 use colcos_bridge::transport::FrameServer;
-use colcos_bridge::{PoseSource, RobotLink, SourceOptions, open_pose_source, open_robot_link};
+use colcos_bridge::{SourceOptions, open_pose_source, open_robot_link};
 use colcos_sim::scenario::Scenario;
 use std::fmt::Write as _;
 use std::net::SocketAddr;
@@ -56,14 +56,6 @@ pub struct BridgeArgs {
     pub quiet: bool,
 }
 
-/// The ends of the rig a live run talks through.
-pub(crate) struct RigEnds {
-    pub source: Box<dyn PoseSource>,
-    pub link: Box<dyn RobotLink>,
-    /// The server the displayed frames go out on, when asked for.
-    pub frames: Option<FrameServer>,
-}
-
 /// Makes `out` (where a live run writes), then opens the pose source `tracker` names (mapped into
 /// the arena by the scenario's rig calibration), the robots' link `robots` and, given an address,
 /// the frame server. Errors name the flag.
@@ -111,18 +103,22 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
     let display = display_on(&sc, args.display, args.windowed, args.display_width)?;
     let live_opts = LiveOptions {
         display,
-        display_width: args.display_width,
-        display_hz: if args.display_rate.is_finite() {
-            args.display_rate
-        } else {
-            10.0
+        display_frames: FrameRate {
+            width: args.display_width,
+            hz: if args.display_rate.is_finite() {
+                args.display_rate
+            } else {
+                10.0
+            },
         },
         duration: args.duration,
-        stream_width: args.frame_width.clamp(16, 7680),
-        stream_hz: if args.frame_rate.is_finite() {
-            args.frame_rate.clamp(1.0, 50.0)
-        } else {
-            25.0
+        stream: FrameRate {
+            width: args.frame_width.clamp(16, 7680),
+            hz: if args.frame_rate.is_finite() {
+                args.frame_rate.clamp(1.0, 50.0)
+            } else {
+                25.0
+            },
         },
         log: Some(log.clone()),
         trajectory: Some(args.out.join("trajectory.csv")),
@@ -131,7 +127,7 @@ pub fn bridge(args: BridgeArgs, text: &mut String) -> Result<()> {
         ..LiveOptions::default()
     };
     let stop = super::stop_on_signal()?;
-    let report = rig::run(&sc, ends.source, ends.link, ends.frames, live_opts, stop)?;
+    let report = rig::run(&sc, ends, live_opts, stop)?;
     let summary = args.out.join("summary.json");
     std::fs::write(&summary, serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("writing {}", summary.display()))?;

@@ -7,7 +7,7 @@ use super::bridge::{display_on, open_rig};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use colcos_bridge::identify::{self, Excitation, FitOptions, Param};
-use colcos_bridge::rig::{LiveOptions, LiveSession};
+use colcos_bridge::rig::{FrameRate, LiveOptions, LiveSession};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::scenario::Scenario;
 use std::fmt::Write as _;
@@ -98,15 +98,13 @@ pub fn excite(args: ExciteArgs, text: &mut String) -> Result<()> {
         duration: Some(args.seconds),
         log: Some(log.clone()),
         display,
-        display_width: 960,
-        display_hz: 10.0,
-        stream_width: 960,
-        stream_hz: 25.0,
+        display_frames: FrameRate::new(960, 10.0),
+        stream: FrameRate::new(960, 25.0),
         ..LiveOptions::default()
     };
     let excitation = Excitation::new(sc.spec.seed, max_speed as f32);
     let n = sc.robot_count();
-    let mut session = LiveSession::new(&sc, ends.source, ends.link, ends.frames, live_opts)?;
+    let mut session = LiveSession::new(&sc, ends, live_opts)?;
     let mut overrides: Vec<Option<WheelCommand>> = vec![None; n];
     while !session.is_over() {
         let t = session.elapsed();

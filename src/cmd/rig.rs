@@ -87,19 +87,20 @@ pub fn run(command: RigCommand, text: &mut String) -> Result<()> {
         overruns: args.max_overruns,
     };
     let r = preflight::check(&sc, args.episodes as usize, args.seconds, &limits)?;
+    let c = &r.counts;
     writeln!(
         text,
         "pre-flight of {} on the twin: {} episodes, {} ticks; walled {}, capped {} of {} robot-ticks; \
          {} ticks past the edge, {} with robots overlapping, {} overruns; safety stops: {}",
         args.scenario.display(),
         r.episodes,
-        r.ticks,
-        r.walled,
-        r.capped,
-        r.robot_ticks,
-        r.boundary,
-        r.collisions,
-        r.overruns,
+        c.ticks,
+        c.walled,
+        c.capped,
+        c.robot_ticks,
+        c.boundary,
+        c.collisions,
+        c.overruns,
         if r.stops.is_empty() {
             "none".to_string()
         } else {

@@ -60,15 +60,8 @@ pub struct LoopCore {
     firmware: Firmware,
     legacy: LegacyDrive,
     keepalive: f64,
-    telemetry_every: f64,
-    answer_timeout: f64,
     last_sent: Vec<(WheelCommand, f64)>,
-    next_telemetry: f64,
-    telemetry_robot: usize,
-    answered: Vec<Option<f64>>,
-    /// When each robot was first asked for data: one that never answers is silent too.
-    first_asked: Vec<Option<f64>>,
-    silent: Vec<bool>,
+    poll: TelemetryPoll,
     counters: CoreCounters,
     // The last tick's outputs, reused.
     fresh: Vec<usize>,
@@ -84,6 +77,74 @@ pub struct LoopCore {
     /// The robots run a policy of their own (`[rig] onboard`): the host sends only its parameters,
     /// starts and stops.
     onboard: Option<OnboardSupervisor>,
+}
+
+/// The data requests, one robot at a time in turn, and who answers them.
+struct TelemetryPoll {
+    every: f64,
+    next: f64,
+    robot: usize,
+    /// A robot that has not answered for this long (since its last answer, or since it was first
+    /// asked), s, is silent.
+    answer_timeout: f64,
+    answered: Vec<Option<f64>>,
+    /// When each robot was first asked for data: one that never answers is silent too.
+    first_asked: Vec<Option<f64>>,
+    silent: Vec<bool>,
+}
+
+impl TelemetryPoll {
+    /// Requests to `n` robots, `hz` a second to each (0: none).
+    fn new(hz: f32, n: usize) -> TelemetryPoll {
+        let every = if hz > 0.0 && n > 0 {
+            1.0 / (hz as f64 * n as f64)
+        } else {
+            f64::INFINITY
+        };
+        TelemetryPoll {
+            every,
+            next: 0.0,
+            robot: 0,
+            // Each robot is asked every `n / hz` s; five missed answers (at least a second) mean it
+            // is gone.
+            answer_timeout: (5.0 * every * n as f64).max(1.0),
+            answered: vec![None; n],
+            first_asked: vec![None; n],
+            silent: vec![false; n],
+        }
+    }
+
+    /// Robot `i` answered at `t`.
+    fn answer(&mut self, i: usize, t: f64) {
+        self.answered[i] = Some(t);
+        self.silent[i] = false;
+    }
+
+    /// Whether robot `i` falls silent at `t` (once, until it answers again): the seconds since its
+    /// last answer or first request, and whether it ever answered.
+    fn falls_silent(&mut self, i: usize, t: f64) -> Option<(f64, bool)> {
+        let since = self.answered[i].or(self.first_asked[i]);
+        if let Some(at) = since
+            && !self.silent[i]
+            && t - at > self.answer_timeout
+        {
+            self.silent[i] = true;
+            return Some((t - at, self.answered[i].is_some()));
+        }
+        None
+    }
+
+    /// The robot of `n` to ask for data at `t`, if a request is due.
+    fn due(&mut self, t: f64, n: usize) -> Option<usize> {
+        if t < self.next || n == 0 {
+            return None;
+        }
+        let k = self.robot % n;
+        self.first_asked[k].get_or_insert(t);
+        self.robot += 1;
+        self.next = t + self.every;
+        Some(k)
+    }
 }
 
 impl LoopCore {
@@ -105,11 +166,6 @@ impl LoopCore {
         let radio = rig.radio_addresses(n)?;
         let onboard = crate::onboard::OnboardManifest::of_scenario(scenario)?
             .map(|m| OnboardSupervisor::new(&m, scenario, calibration.colour.as_ref(), &radio));
-        let telemetry_every = if rig.telemetry_hz > 0.0 && n > 0 {
-            1.0 / (rig.telemetry_hz as f64 * n as f64)
-        } else {
-            f64::INFINITY
-        };
         Ok(LoopCore {
             shield: Shield::new(
                 rig.shield,
@@ -121,16 +177,8 @@ impl LoopCore {
             firmware: rig.firmware,
             legacy,
             keepalive: 1.0 / rig.keepalive_hz.max(1.0) as f64,
-            telemetry_every,
-            // Each robot is asked every `n / telemetry_hz` s; five missed answers (at least a
-            // second) mean it is gone.
-            answer_timeout: (5.0 * telemetry_every * n as f64).max(1.0),
             last_sent: vec![(WheelCommand::STOP, f64::NEG_INFINITY); n],
-            next_telemetry: 0.0,
-            telemetry_robot: 0,
-            answered: vec![None; n],
-            first_asked: vec![None; n],
-            silent: vec![false; n],
+            poll: TelemetryPoll::new(rig.telemetry_hz, n),
             counters: CoreCounters::default(),
             fresh: Vec::with_capacity(n),
             packets: Vec::with_capacity(n + 1),
@@ -175,7 +223,7 @@ impl LoopCore {
     }
     /// Robots that have stopped answering data requests.
     pub fn silent(&self) -> &[bool] {
-        &self.silent
+        &self.poll.silent
     }
     /// The frames the last tick sent, in order.
     pub fn packets(&self) -> &[CommandPacket] {
@@ -213,8 +261,7 @@ impl LoopCore {
         for tm in input.telemetry {
             self.counters.telemetry_received += 1;
             if let Some(i) = self.radio.iter().position(|&r| r == tm.id) {
-                self.answered[i] = Some(t);
-                self.silent[i] = false;
+                self.poll.answer(i, t);
                 let bumpers =
                     std::array::from_fn(|k| bumper_reading(tm.tcrt_on[k], tm.tcrt_off[k]));
                 let counts = self.calibration.robot_counts(
@@ -229,28 +276,17 @@ impl LoopCore {
                 }
             }
         }
-        // A robot that has not answered for `answer_timeout` (since its last answer, or since it was
-        // first asked): its radio is gone, so it can no longer be stopped from here (its firmware's
-        // timeout must); said once, and its readings are no longer trusted.
+        // A silent robot: its radio is gone, so it can no longer be stopped from here (its
+        // firmware's timeout must); said once, and its readings are no longer trusted.
         for i in 0..self.radio.len() {
-            let since = self.answered[i].or(self.first_asked[i]);
-            if let Some(at) = since
-                && !self.silent[i]
-                && t - at > self.answer_timeout
-            {
-                self.silent[i] = true;
+            if let Some((quiet, ever_answered)) = self.poll.falls_silent(i, t) {
                 self.counters.silent_robots.push(self.radio[i]);
-                let detail = if self.answered[i].is_some() {
-                    format!(
-                        "radio {} has not answered for {:.2} s",
-                        self.radio[i],
-                        t - at
-                    )
+                let detail = if ever_answered {
+                    format!("radio {} has not answered for {quiet:.2} s", self.radio[i])
                 } else {
                     format!(
-                        "radio {} has never answered ({:.2} s since asked)",
-                        self.radio[i],
-                        t - at
+                        "radio {} has never answered ({quiet:.2} s since asked)",
+                        self.radio[i]
                     )
                 };
                 self.events.push(
@@ -275,7 +311,7 @@ impl LoopCore {
                 self.counters.shield.add(intervention);
                 let hold = stopped
                     || !self.host.tracked()[i].seen
-                    || self.silent[i]
+                    || self.poll.silent[i]
                     || intervention.walled;
                 let drives = onboard.frames(
                     i,
@@ -295,7 +331,7 @@ impl LoopCore {
             }
             // A held robot is sent a stop, which the shield has nothing to change: counting its
             // turned command would charge the behaviour for a robot that did not drive.
-            let held = stopped || !self.host.tracked()[i].seen || self.silent[i];
+            let held = stopped || !self.host.tracked()[i].seen || self.poll.silent[i];
             let (cmd, intervention) = if held {
                 (WheelCommand::STOP, Intervention::default())
             } else {
@@ -318,17 +354,12 @@ impl LoopCore {
             }
         }
         self.host.drive(&self.sent, step as f32);
-        if t >= self.next_telemetry && !self.radio.is_empty() {
-            let k = self.telemetry_robot % self.radio.len();
-            self.first_asked[k].get_or_insert(t);
-            let robot = self.radio[k];
+        if let Some(k) = self.poll.due(t, self.radio.len()) {
             self.packets.push(CommandPacket::new(
-                robot,
+                self.radio[k],
                 stamp,
                 HostCommand::RequestTelemetry(1),
             ));
-            self.telemetry_robot += 1;
-            self.next_telemetry = t + self.telemetry_every;
         }
         self.counters.commands_sent += self.packets.len() as u64;
     }

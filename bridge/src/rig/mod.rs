@@ -21,7 +21,7 @@ mod watchdog;
 
 pub use core::{CoreCounters, LoopCore, PoseIn, TickInput};
 pub use host::HostWorld;
-pub use options::{FrameSink, LiveOptions, LiveReport};
+pub use options::{FrameRate, FrameSink, LiveOptions, LiveReport};
 pub use session::LiveSession;
 
 use crate::transport::{FrameServer, PoseSource, RobotLink};
@@ -30,18 +30,24 @@ use colcos_sim::scenario::Scenario;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// The ends of the rig a live run talks through.
+pub struct RigEnds {
+    pub source: Box<dyn PoseSource>,
+    pub link: Box<dyn RobotLink>,
+    /// The server the displayed frames go out on, when asked for.
+    pub frames: Option<FrameServer>,
+}
+
 /// Runs the live loop on `scenario`'s robots, their behaviours deciding, until `stop` is set or the
 /// duration is over; every robot is stopped when it returns (or unwinds).
 pub fn run(
     scenario: &Scenario,
-    source: Box<dyn PoseSource>,
-    link: Box<dyn RobotLink>,
-    frames: Option<FrameServer>,
+    ends: RigEnds,
     opts: LiveOptions,
     stop: Arc<AtomicBool>,
 ) -> Result<LiveReport> {
     let status = opts.status;
-    let mut session = LiveSession::new(scenario, source, link, frames, opts)?;
+    let mut session = LiveSession::new(scenario, ends, opts)?;
     while !stop.load(Ordering::Relaxed) && !session.is_over() {
         session.tick(&[])?;
         session.wait_next();

@@ -9,22 +9,45 @@ pub trait FrameSink: Send {
     fn show(&mut self, frame: &image::RgbImage) -> bool;
 }
 
+/// Frames drawn from the screen: `width` px wide (the height from the panel's aspect), `hz` a second.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameRate {
+    pub width: u32,
+    pub hz: f64,
+}
+
+impl FrameRate {
+    pub const fn new(width: u32, hz: f64) -> FrameRate {
+        FrameRate { width, hz }
+    }
+
+    /// Frames `width` px wide, one a tick.
+    pub const fn every_tick(width: u32) -> FrameRate {
+        FrameRate { width, hz: 0.0 }
+    }
+
+    /// The size of a frame `width` px wide of a panel of `size` (m).
+    pub(crate) fn size(width: u32, size: [f32; 2]) -> (u32, u32) {
+        (
+            width,
+            ((width as f32) * size[1] / size[0]).round().max(1.0) as u32,
+        )
+    }
+}
+
 /// What a live run does besides driving the robots.
 #[derive(Default)]
 pub struct LiveOptions {
-    /// The LCD's window, shown `display_width` px wide at `display_hz` (the window scales it to the
-    /// panel). The CPU draws a 4K frame of three grid pheromones in ~3 ms; Gaussian fields cost an
-    /// `exp` per source and pixel, so the default is a smaller frame.
+    /// The LCD's window, shown at `display_frames` (the window scales it to the panel; 16 to 7680
+    /// px, 1 to 50 a second). The CPU draws a 4K frame of three grid pheromones in ~3 ms; Gaussian
+    /// fields cost an `exp` per source and pixel, so the default is a smaller frame.
     pub display: Option<std::sync::Mutex<Box<dyn FrameSink>>>,
-    pub display_width: u32,
-    pub display_hz: f64,
+    pub display_frames: FrameRate,
     /// Stop after this many seconds (None: until stopped).
     pub duration: Option<f64>,
-    /// Width of the frames sent to the frame stream (height from the panel's aspect); 0: none.
-    pub stream_width: u32,
-    /// Frames sent to the frame stream per second (at most one a tick; 0: every tick). Rendering
-    /// costs the loop: a 960-pixel frame of two Gaussian fields takes ~10 ms on one core.
-    pub stream_hz: f64,
+    /// The frames sent to the frame stream: width 0, none; at most one a tick, `hz` 0, every tick.
+    /// Rendering costs the loop: a 960-pixel frame of two Gaussian fields takes ~10 ms on one core.
+    pub stream: FrameRate,
     /// Where the rig log (MCAP) goes; None: no log.
     pub log: Option<PathBuf>,
     /// Where the trajectory CSV goes (the simulator's columns, the tracked poses as used); None: none.

@@ -1,16 +1,17 @@
 //! The live loop's edges: poses from the tracker, telemetry from the link, the clock, the watchdog,
 //! the screen's sinks, the logs, and the frames out; [`LoopCore`] in the middle. [`super::run`] ticks
 //! it at the screen's rate; the Python plants tick it from a policy's `step`.
+use super::RigEnds;
 use super::core::{LoopCore, PoseIn, TickInput};
 use super::gif_thread::GifThread;
-use super::options::{LiveOptions, LiveReport};
+use super::options::{FrameRate, LiveOptions, LiveReport};
 use super::recorder::{Recorder, Topic, fnv1a};
 use super::stopper::{SharedLog, StopOnDrop, Stopper, record};
 use super::watchdog::{self, Heartbeats, SafetyLimits, StopReason};
 use crate::protocol::colias::Telemetry;
 use crate::transport::FrameServer;
 use crate::transport::{ClockOffset, epoch_s};
-use crate::transport::{ConnectionState, PoseSource, RobotLink};
+use crate::transport::{ConnectionState, PoseSource};
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::error::{Result, SimError};
 use colcos_sim::output::{TickRows, TrajectoryLog};
@@ -64,13 +65,12 @@ pub struct LiveSession {
 
 impl LiveSession {
     /// A loop over `scenario`'s robots, its watchdog running from now.
-    pub fn new(
-        scenario: &Scenario,
-        source: Box<dyn PoseSource>,
-        link: Box<dyn RobotLink>,
-        frames: Option<FrameServer>,
-        opts: LiveOptions,
-    ) -> Result<LiveSession> {
+    pub fn new(scenario: &Scenario, ends: RigEnds, opts: LiveOptions) -> Result<LiveSession> {
+        let RigEnds {
+            source,
+            link,
+            frames,
+        } = ends;
         let core = LoopCore::new(scenario, opts.legacy)?;
         let rig = &scenario.spec.rig;
         let n = core.robot_count();
@@ -127,11 +127,7 @@ impl LiveSession {
             })
         };
         let dt = scenario.spec.dt as f64;
-        let stream_size = {
-            let s = scenario.spec.screen.size;
-            let w = opts.stream_width;
-            (w, ((w as f32) * s[1] / s[0]).round().max(1.0) as u32)
-        };
+        let stream_size = FrameRate::size(opts.stream.width, scenario.spec.screen.size);
         Ok(LiveSession {
             groups: core.host().groups(),
             core,
@@ -409,8 +405,8 @@ impl LiveSession {
             && t >= self.next_frame
             && server.subscribers() > 0
         {
-            self.next_frame = t + if self.opts.stream_hz > 0.0 {
-                1.0 / self.opts.stream_hz
+            self.next_frame = t + if self.opts.stream.hz > 0.0 {
+                1.0 / self.opts.stream.hz
             } else {
                 0.0
             };
@@ -428,12 +424,10 @@ impl LiveSession {
             && !self.display_gone
             && t >= self.next_display
         {
-            self.next_display = t + 1.0 / self.opts.display_hz.clamp(1.0, 50.0);
-            let (s, w) = (
-                self.scenario.spec.screen.size,
-                self.opts.display_width.clamp(16, 7680),
-            );
-            let h = ((w as f32) * s[1] / s[0]).round().max(1.0) as u32;
+            let frames = self.opts.display_frames;
+            self.next_display = t + 1.0 / frames.hz.clamp(1.0, 50.0);
+            let (w, h) =
+                FrameRate::size(frames.width.clamp(16, 7680), self.scenario.spec.screen.size);
             let img = kept(&mut self.display_img, w, h);
             host.render_into(img);
             if let Ok(mut d) = display.lock()

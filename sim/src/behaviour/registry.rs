@@ -9,9 +9,23 @@ use crate::robot::ColiasParams;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-/// Builds a behaviour from its `params` table (`key` names it in errors) for a robot with `robot`'s
-/// body (a behaviour that turns at a set yaw rate needs its wheel base).
-type Builder = fn(&toml::Table, &str, &ColiasParams) -> Result<Box<dyn Behaviour>>;
+/// Builds a behaviour from what a group asks for.
+type Builder = fn(&Request) -> Result<Box<dyn Behaviour>>;
+
+/// What a behaviour is built from: the group's `params` table, its key (`robots[2]`, for errors) and
+/// the robot's body (a behaviour that turns at a set yaw rate needs its wheel base).
+struct Request<'a> {
+    params: &'a toml::Table,
+    key: &'a str,
+    robot: &'a ColiasParams,
+}
+
+impl Request<'_> {
+    /// The `params` table as `T` ([`parse_params`]).
+    fn parse<T: DeserializeOwned>(&self) -> Result<T> {
+        parse_params(self.params, self.key)
+    }
+}
 
 /// A registered behaviour.
 struct Entry {
@@ -108,7 +122,7 @@ pub fn build_with(
     robot: &ColiasParams,
 ) -> Result<Box<dyn Behaviour>> {
     match REGISTRY.iter().find(|e| e.name == name) {
-        Some(entry) => (entry.build)(params, key, robot),
+        Some(entry) => (entry.build)(&Request { params, key, robot }),
         None => {
             let known: Vec<_> = REGISTRY.iter().map(|e| e.name).collect();
             Err(SimError::invalid(
@@ -185,20 +199,21 @@ fn speed_checked(key: &str, speed: f32) -> Result<f32> {
     }
 }
 
-fn build_wander(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box<dyn Behaviour>> {
-    let p: WanderParams = parse_params(params, key)?;
-    Ok(Box::new(Wander::new(speed_checked(key, p.speed)?)))
+fn build_wander(r: &Request) -> Result<Box<dyn Behaviour>> {
+    let p: WanderParams = r.parse()?;
+    Ok(Box::new(Wander::new(speed_checked(r.key, p.speed)?)))
 }
 
-fn build_avoid(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box<dyn Behaviour>> {
-    let p: WanderParams = parse_params(params, key)?;
+fn build_avoid(r: &Request) -> Result<Box<dyn Behaviour>> {
+    let p: WanderParams = r.parse()?;
     Ok(Box::new(Avoid::new(Wander::new(speed_checked(
-        key, p.speed,
+        r.key, p.speed,
     )?))))
 }
 
-fn build_follow(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box<dyn Behaviour>> {
-    let p: FollowParams = parse_params(params, key)?;
+fn build_follow(r: &Request) -> Result<Box<dyn Behaviour>> {
+    let key = r.key;
+    let p: FollowParams = r.parse()?;
     let channel = p.channel.index();
     let speed = speed_checked(key, p.speed)?;
     if !p.sensitivity.is_finite() {
@@ -223,34 +238,22 @@ fn build_follow(params: &toml::Table, key: &str, _: &ColiasParams) -> Result<Box
     ))))
 }
 
-fn build_forage(
-    params: &toml::Table,
-    key: &str,
-    robot: &ColiasParams,
-) -> Result<Box<dyn Behaviour>> {
-    let p: ForagingParams = parse_params(params, key)?;
-    p.validate(key)?;
+fn build_forage(r: &Request) -> Result<Box<dyn Behaviour>> {
+    let p: ForagingParams = r.parse()?;
+    p.validate(r.key)?;
     let mut forage = super::paper::Foraging::new(p);
-    forage.wheel_base = robot.wheel_base;
+    forage.wheel_base = r.robot.wheel_base;
     Ok(Box::new(forage))
 }
 
-fn build_aggregation_leader(
-    params: &toml::Table,
-    key: &str,
-    _: &ColiasParams,
-) -> Result<Box<dyn Behaviour>> {
-    let p: LeaderParams = parse_params(params, key)?;
-    Ok(Box::new(super::paper::Leader::new(p.validate(key)?)))
+fn build_aggregation_leader(r: &Request) -> Result<Box<dyn Behaviour>> {
+    let p: LeaderParams = r.parse()?;
+    Ok(Box::new(super::paper::Leader::new(p.validate(r.key)?)))
 }
 
-fn build_aggregation_follower(
-    params: &toml::Table,
-    key: &str,
-    _: &ColiasParams,
-) -> Result<Box<dyn Behaviour>> {
-    let p: FollowerParams = parse_params(params, key)?;
-    Ok(Box::new(super::paper::Follower::new(p.validate(key)?)))
+fn build_aggregation_follower(r: &Request) -> Result<Box<dyn Behaviour>> {
+    let p: FollowerParams = r.parse()?;
+    Ok(Box::new(super::paper::Follower::new(p.validate(r.key)?)))
 }
 
 #[cfg(test)]

@@ -302,7 +302,12 @@ mod tests {
             };
             let sensors = crate::sensors::sensor_positions(&pose, 0.015);
             let points: [Vec2; SAMPLES] = std::array::from_fn(|j| sensors[j / 9] + offsets[j % 9]);
-            let want = super::super::levels_at(&ph, &frozen, &screen, &points, SAMPLES);
+            let fields = super::super::ScreenFields {
+                pheromones: &ph,
+                frozen: &frozen,
+                screen: &screen,
+            };
+            let want = super::super::levels_at(&fields, &points, SAMPLES);
             let samples = FootprintSamples {
                 xs: std::array::from_fn(|j| points[if j < SAMPLES { j } else { 0 }].x),
                 ys: std::array::from_fn(|j| points[if j < SAMPLES { j } else { 0 }].y),

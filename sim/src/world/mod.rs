@@ -37,7 +37,7 @@ pub mod stages {
     pub use super::robots::{
         decide, decide_and_drive, drive, finish_physics_in, physics, physics_in,
     };
-    pub use super::sensing::{index, sense, sense_from_sums};
+    pub use super::sensing::{index, sense};
     pub use super::tracking::track;
 }
 

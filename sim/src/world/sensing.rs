@@ -118,8 +118,8 @@ impl Sensing {
         self.sensor_points[i]
     }
     /// Where robot `i`'s colour sensors sample the screen, from each sensor's centre (the same for
-    /// its four: [`ColourSensor::sample_points`] adds a centre to them): what [`sense_from_sums`]
-    /// wants the level sums over.
+    /// its four: [`ColourSensor::sample_points`] adds a centre to them): what
+    /// [`super::World::sense_from_sums`] wants the level sums over.
     pub fn footprint_offsets(&self, i: usize) -> [Vec2; crate::sensors::RING_POINTS + 1] {
         let sampler = self
             .robot_sensors
@@ -187,38 +187,43 @@ pub fn sense(
     slots: &mut [RobotSlot],
     time: f32,
 ) {
-    sense_with(sensing, fields, screen, poses, slots, time, None);
+    let sets = SenseSets {
+        fields,
+        screen,
+        poses,
+        slots,
+        time,
+    };
+    sense_with(sensing, sets, None);
 }
 
-/// Stage `sense` with the colour sensors' footprint level sums given (four per robot, in robot then
-/// sensor order, over [`Sensing::footprint_offsets`] from [`Sensing::sensor_centres`]), e.g. from a
-/// GPU that holds the grid pheromones: the same observations and random draws as [`sense`] on a screen with those sums.
+/// The data sets stage [`sense`] reads and writes besides the sensing state, at `time`.
+pub(super) struct SenseSets<'a> {
+    pub(super) fields: &'a mut FieldSet,
+    pub(super) screen: &'a ScreenSpec,
+    pub(super) poses: &'a [Pose],
+    pub(super) slots: &'a mut [RobotSlot],
+    pub(super) time: f32,
+}
+
+/// Stage [`sense`], with the colour sensors' footprint level sums computed here (`None`) or `given`
+/// (four per robot, in robot then sensor order, over [`Sensing::footprint_offsets`] from
+/// [`Sensing::sensor_centres`]), e.g. from a GPU that holds the grid pheromones: the same
+/// observations and random draws as on a screen with those sums.
 ///
 /// # Panics
-/// If `sums` does not hold four entries per robot.
-pub fn sense_from_sums(
-    sensing: &mut Sensing,
-    fields: &mut FieldSet,
-    screen: &ScreenSpec,
-    poses: &[Pose],
-    slots: &mut [RobotSlot],
-    time: f32,
-    sums: &[[u32; 3]],
-) {
-    assert_eq!(sums.len(), 4 * slots.len(), "four footprint sums per robot");
-    sense_with(sensing, fields, screen, poses, slots, time, Some(sums));
-}
-
-/// [`sense`], with the footprint sums computed here (`None`) or given.
-fn sense_with(
-    sensing: &mut Sensing,
-    fields: &mut FieldSet,
-    screen: &ScreenSpec,
-    poses: &[Pose],
-    slots: &mut [RobotSlot],
-    time: f32,
-    given: Option<&[[u32; 3]]>,
-) {
+/// If `given` does not hold four entries per robot.
+pub(super) fn sense_with(sensing: &mut Sensing, sets: SenseSets, given: Option<&[[u32; 3]]>) {
+    let SenseSets {
+        fields,
+        screen,
+        poses,
+        slots,
+        time,
+    } = sets;
+    if let Some(sums) = given {
+        assert_eq!(sums.len(), 4 * slots.len(), "four footprint sums per robot");
+    }
     fields.freeze();
     let (sensor_points, forwards) = (&sensing.sensor_points, &sensing.forwards);
     let (pheromones, frozen) = (fields.pheromones(), fields.frozen());

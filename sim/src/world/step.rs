@@ -1,8 +1,8 @@
 //! One step of a world, composed from the stages: decide -> drive -> physics -> track -> inject ->
 //! sense, with the field step beside the robots' motion.
 use super::stages::{
-    decide_and_drive, drive, finish_physics_in, index, inject, physics, physics_in, sense,
-    step_fields, track,
+    decide_and_drive, drive, finish_physics_in, index, inject, physics, physics_in, step_fields,
+    track,
 };
 use super::{PARALLEL_ROBOTS, World};
 use crate::behaviour::WheelCommand;
@@ -154,13 +154,13 @@ impl World {
 
     /// Stage `sense`, from the footprint level sums `sums` when given.
     fn sense_with(&mut self, sums: Option<&[[u32; 3]]>) {
-        let (sensing, fields, screen) = (&mut self.sensing, &mut self.fields, &self.screen);
-        let (poses, slots) = (self.robots.physics.poses(), &mut self.robots.slots);
-        match sums {
-            Some(sums) => super::stages::sense_from_sums(
-                sensing, fields, screen, poses, slots, self.time, sums,
-            ),
-            None => sense(sensing, fields, screen, poses, slots, self.time),
-        }
+        let sets = super::sensing::SenseSets {
+            fields: &mut self.fields,
+            screen: &self.screen,
+            poses: self.robots.physics.poses(),
+            slots: &mut self.robots.slots,
+            time: self.time,
+        };
+        super::sensing::sense_with(&mut self.sensing, sets, sums);
     }
 }

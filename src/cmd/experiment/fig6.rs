@@ -2,7 +2,7 @@
 //! half-transparent and shifted by up to 6 pixels (4 mm) (in the drawing only), so paths that share a trail
 //! show as a denser bundle rather than one line; the end points are numbered and a bar gives the scale.
 use super::case1::{Case1Result, freeze_steady_state};
-use super::plots::{boxed_label, label, save};
+use super::plots::{Label, save};
 use anyhow::Result;
 use colcos_sim::behaviour::WheelCommand;
 use colcos_sim::output::draw;
@@ -109,24 +109,14 @@ fn annotate_layout(img: &mut RgbImage, r: &Case1Result, size: f64) -> Result<()>
         } else {
             12
         };
-        boxed_label(
-            img,
-            &text,
-            x as i32 + dx,
-            y as i32 - (size as i32) / 2,
-            size,
-            colour,
-        )?;
+        Label::new(&text, size, colour).boxed(img, x as i32 + dx, y as i32 - (size as i32) / 2)?;
     }
     let (x, y) = draw::to_pixel(&s, w, h, lay.nest().pos);
     draw::disc(img, (x, y), (size * 0.35) as f32, Rgb([255, 255, 255]));
-    boxed_label(
+    Label::new("nest", size, WHITE).boxed(
         img,
-        "nest",
         x as i32 - (size as i32),
         y as i32 + (size as i32) / 2,
-        size,
-        WHITE,
     )?;
     Ok(())
 }
@@ -151,7 +141,7 @@ fn scale_bar(img: &mut RgbImage, r: &Case1Result, size: f64) -> Result<()> {
     }
     let text = "10 cm";
     let tx = x0 as i32 + len as i32 / 2 - super::plots::text_width(text, size) / 2;
-    label(img, text, tx, (y0 as f64 - 1.6 * size) as i32, size, WHITE)
+    Label::new(text, size, WHITE).draw(img, tx, (y0 as f64 - 1.6 * size) as i32)
 }
 
 /// The trajectories of group `g` over its dimmed screen, `width` pixels wide.
@@ -193,7 +183,7 @@ pub fn fig6_trajectories(r: &Case1Result, g: usize, path: &Path) -> Result<()> {
         r.config.layout.name,
         r.config.foods
     );
-    boxed_label(&mut img, &title, 10, 8, 22.0, WHITE)?;
+    Label::new(&title, 22.0, WHITE).boxed(&mut img, 10, 8)?;
     save(&img, path)
 }
 
@@ -212,19 +202,13 @@ pub fn trajectories_all_groups(r: &Case1Result, path: &Path) -> Result<()> {
     for (k, p) in panels.iter().enumerate() {
         image::imageops::replace(&mut img, p, 0, (k as u32 * (h + gap)) as i64);
         let g = &r.groups[k];
-        boxed_label(
-            &mut img,
-            &format!(
-                "{} ({}), {} trials",
-                g.name,
-                g.pheromones.join(" + "),
-                g.trials.len()
-            ),
-            8,
-            (k as u32 * (h + gap)) as i32 + 6,
-            20.0,
-            WHITE,
-        )?;
+        let title = format!(
+            "{} ({}), {} trials",
+            g.name,
+            g.pheromones.join(" + "),
+            g.trials.len()
+        );
+        Label::new(&title, 20.0, WHITE).boxed(&mut img, 8, (k as u32 * (h + gap)) as i32 + 6)?;
     }
     save(&img, path)
 }

@@ -3,7 +3,7 @@
 //! its moments come from [`super::moments`].
 use super::case2::{Case2Result, role_colour, snapshots_at};
 use super::moments::{featured_run, key_moments};
-use super::plots::{ensure_font, err, label, save, series_legend, text_width};
+use super::plots::{Label, ensure_font, err, save, series_legend, text_width};
 use anyhow::{Result, anyhow};
 use colcos_sim::metrics::PhaseKind;
 use colcos_sim::output::draw;
@@ -135,7 +135,7 @@ fn role_legend(img: &mut RgbImage, x: i32, y: i32, size: f64) -> Result<()> {
             Rgb([60, 60, 60]),
         );
         draw::disc(img, (x as f32 + 7.0, y as f32 + 0.6 * size as f32), 6.0, c);
-        label(img, role, x + 18, y, size, BLACK)?;
+        Label::new(role, size, BLACK).draw(img, x + 18, y)?;
         x += 18 + text_width(role, size) + 12;
     }
     Ok(())
@@ -161,17 +161,11 @@ pub fn fig7_snapshots(r: &Case2Result, path: &Path) -> Result<()> {
         title + rows * (h + caption + gap),
         Rgb([255, 255, 255]),
     );
-    label(
-        &mut img,
-        &format!(
-            "Case II, run {shown} (seed {}): AGP green around the leader, ALP red near the predator",
-            r.config.scenario.spec.seed
-        ),
-        gap as i32,
-        6,
-        20.0,
-        BLACK,
-    )?;
+    let heading = format!(
+        "Case II, run {shown} (seed {}): AGP green around the leader, ALP red near the predator",
+        r.config.scenario.spec.seed
+    );
+    Label::new(&heading, 20.0, BLACK).draw(&mut img, gap as i32, 6)?;
     role_legend(&mut img, gap as i32, 34, 17.0)?;
     for (k, (m, snap)) in moments.iter().zip(&snaps).enumerate() {
         let (c, rr) = (k as u32 % cols, k as u32 / cols);
@@ -188,14 +182,7 @@ pub fn fig7_snapshots(r: &Case2Result, path: &Path) -> Result<()> {
         } else {
             RGBColor(20, 120, 40)
         };
-        label(
-            &mut img,
-            &text,
-            x as i32 + 2,
-            (y + h + 4) as i32,
-            17.0,
-            colour,
-        )?;
+        Label::new(&text, 17.0, colour).draw(&mut img, x as i32 + 2, (y + h + 4) as i32)?;
     }
     save(&img, path)
 }
@@ -242,26 +229,14 @@ pub fn case2_trajectories(r: &Case2Result, path: &Path) -> Result<()> {
             c,
         ));
     }
-    label(
-        &mut img,
-        &format!(
-            "Case II trajectories, run {shown}, {:.0} s (small dot: start, ring: end)",
-            run.times.last().copied().unwrap_or(0.0)
-        ),
-        10,
-        8,
-        20.0,
-        WHITE,
-    )?;
+    let heading = format!(
+        "Case II trajectories, run {shown}, {:.0} s (small dot: start, ring: end)",
+        run.times.last().copied().unwrap_or(0.0)
+    );
+    Label::new(&heading, 20.0, WHITE).draw(&mut img, 10, 8)?;
     for (k, (name, c)) in legend.iter().enumerate() {
-        label(
-            &mut img,
-            name,
-            10,
-            36 + 22 * k as i32,
-            18.0,
-            RGBColor(c.0[0], c.0[1], c.0[2]),
-        )?;
+        let colour = RGBColor(c.0[0], c.0[1], c.0[2]);
+        Label::new(name, 18.0, colour).draw(&mut img, 10, 36 + 22 * k as i32)?;
     }
     save(&img, path)
 }

@@ -44,50 +44,49 @@ pub fn series_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
     Ok(())
 }
 
-/// Text on an image, top-left at `(x, y)` pixels.
-pub fn label(
-    img: &mut RgbImage,
-    text: &str,
-    x: i32,
-    y: i32,
-    size: f64,
-    colour: RGBColor,
-) -> Result<()> {
-    ensure_font();
-    let (w, h) = img.dimensions();
-    let buf: &mut [u8] = &mut *img;
-    let root = BitMapBackend::with_buffer(buf, (w, h)).into_drawing_area();
-    root.draw_text(
-        text,
-        &("sans-serif", size).into_font().color(&colour),
-        (x, y),
-    )
-    .map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
+/// Text to write on an image: `size` pixels, in `colour`.
+pub struct Label<'a> {
+    pub text: &'a str,
+    pub size: f64,
+    pub colour: RGBColor,
 }
 
-/// Text with a dark box behind it (readable over any screen colour).
-pub fn boxed_label(
-    img: &mut RgbImage,
-    text: &str,
-    x: i32,
-    y: i32,
-    size: f64,
-    colour: RGBColor,
-) -> Result<()> {
-    let wpx = text_width(text, size);
-    let hpx = (size * 1.25) as i32;
-    for yy in y.max(0)..(y + hpx).min(img.height() as i32) {
-        for xx in x.max(0)..(x + wpx).min(img.width() as i32) {
-            let p = img.get_pixel_mut(xx as u32, yy as u32);
-            p.0 = p.0.map(|c| c / 4);
-        }
+impl<'a> Label<'a> {
+    pub fn new(text: &'a str, size: f64, colour: RGBColor) -> Label<'a> {
+        Label { text, size, colour }
     }
-    label(img, text, x + 3, y + 1, size, colour)
+
+    /// Writes the text with its top-left at `(x, y)` pixels.
+    pub fn draw(&self, img: &mut RgbImage, x: i32, y: i32) -> Result<()> {
+        ensure_font();
+        let (w, h) = img.dimensions();
+        let buf: &mut [u8] = &mut *img;
+        let root = BitMapBackend::with_buffer(buf, (w, h)).into_drawing_area();
+        root.draw_text(
+            self.text,
+            &("sans-serif", self.size).into_font().color(&self.colour),
+            (x, y),
+        )
+        .map_err(err)?;
+        root.present().map_err(err)?;
+        Ok(())
+    }
+
+    /// [`Label::draw`] with a dark box behind the text (readable over any screen colour).
+    pub fn boxed(&self, img: &mut RgbImage, x: i32, y: i32) -> Result<()> {
+        let wpx = text_width(self.text, self.size);
+        let hpx = (self.size * 1.25) as i32;
+        for yy in y.max(0)..(y + hpx).min(img.height() as i32) {
+            for xx in x.max(0)..(x + wpx).min(img.width() as i32) {
+                let p = img.get_pixel_mut(xx as u32, yy as u32);
+                p.0 = p.0.map(|c| c / 4);
+            }
+        }
+        self.draw(img, x + 3, y + 1)
+    }
 }
 
-/// The width in pixels that [`label`] gives `text` at `size` (an upper bound for this font).
+/// The width in pixels that a [`Label`] gives `text` at `size` (an upper bound for this font).
 pub fn text_width(text: &str, size: f64) -> i32 {
     (text.chars().count() as f64 * size * 0.58) as i32 + 6
 }

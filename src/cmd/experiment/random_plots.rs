@@ -1,7 +1,7 @@
 //! Figures of case I on random maps: the maps where a G3 trial missed the food, each with the paths of
 //! those trials, and an overview of the first maps with every G3 trial.
 use super::fig6::trajectories_panel;
-use super::plots::{boxed_label, save};
+use super::plots::{Label, save};
 use super::random_run::{MapRun, RandomCase1, g3_failures};
 use anyhow::Result;
 use image::{Rgb, RgbImage};
@@ -32,7 +32,7 @@ fn panel(m: &MapRun, keep: &[usize], title: &str, width: u32) -> Result<RgbImage
     let trials = std::mem::take(&mut r.groups[2].trials);
     r.groups[2].trials = keep.iter().map(|&k| trials[k].clone()).collect();
     let mut img = trajectories_panel(&r, 2, width)?;
-    boxed_label(&mut img, title, 6, 6, 18.0, WHITE)?;
+    Label::new(title, 18.0, WHITE).boxed(&mut img, 6, 6)?;
     Ok(img)
 }
 

@@ -1,8 +1,8 @@
 //! `summary.json` (the numbers), `summary.md` (the table a person reads, beside the paper) and the
 //! console summary, plus the paper's claims as checks.
 use super::Report;
-use super::case1::Case1Result;
-use super::case2::Case2Result;
+use super::case1::{Case1Result, GroupResult};
+use super::case2::{Case2Result, Case2Run};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use serde_json::json;
@@ -93,22 +93,38 @@ fn r3(v: f32) -> f64 {
     (v as f64 * 1000.0).round() / 1000.0
 }
 
+/// One group of case I, with food at the end points `foods`.
+fn group_json(g: &GroupResult, foods: &[usize]) -> serde_json::Value {
+    json!({
+        "name": g.name,
+        "pheromones": g.pheromones,
+        "available_food": foods,
+        "arrivals": g.counts.per_point,
+        "timeouts": g.counts.timeouts,
+        "at_food": g.at_food(foods),
+        "trials": g.trials.len(),
+    })
+}
+
+/// One run of case II.
+fn run_json(run: &Case2Run) -> serde_json::Value {
+    json!({
+        "time": run.times.iter().map(|&t| r3(t)).collect::<Vec<_>>(),
+        "s": run.s.iter().map(|&s| r3(s)).collect::<Vec<_>>(),
+        "alarm": run.alarm,
+        "phases": run.phases,
+        "phase_boundaries": run.phases.iter().skip(1).map(|p| r3(p.start)).collect::<Vec<_>>(),
+        "aggregation_fall": run.aggregation_fall,
+        "alarm_rise": run.alarm_rise,
+    })
+}
+
 pub fn json(r1: Option<&Case1Result>, r2: Option<&Case2Result>, wall: f64) -> serde_json::Value {
     let case1 = r1.map(|r| {
         let groups: Vec<_> = r
             .groups
             .iter()
-            .map(|g| {
-                json!({
-                    "name": g.name,
-                    "pheromones": g.pheromones,
-                    "available_food": r.config.foods,
-                    "arrivals": g.counts.per_point,
-                    "timeouts": g.counts.timeouts,
-                    "at_food": g.at_food(&r.config.foods),
-                    "trials": g.trials.len(),
-                })
-            })
+            .map(|g| group_json(g, &r.config.foods))
             .collect();
         json!({
             "layout": r.config.layout.name,
@@ -124,21 +140,7 @@ pub fn json(r1: Option<&Case1Result>, r2: Option<&Case2Result>, wall: f64) -> se
         })
     });
     let case2 = r2.map(|r| {
-        let runs: Vec<_> = r
-            .runs
-            .iter()
-            .map(|run| {
-                json!({
-                    "time": run.times.iter().map(|&t| r3(t)).collect::<Vec<_>>(),
-                    "s": run.s.iter().map(|&s| r3(s)).collect::<Vec<_>>(),
-                    "alarm": run.alarm,
-                    "phases": run.phases,
-                    "phase_boundaries": run.phases.iter().skip(1).map(|p| r3(p.start)).collect::<Vec<_>>(),
-                    "aggregation_fall": run.aggregation_fall,
-                    "alarm_rise": run.alarm_rise,
-                })
-            })
-            .collect();
+        let runs: Vec<_> = r.runs.iter().map(run_json).collect();
         json!({
             "scenario": "scenarios/case2_alarm.toml",
             "seed": r.config.scenario.spec.seed,

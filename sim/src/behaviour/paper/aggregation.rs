@@ -253,20 +253,6 @@ impl Leader {
             }),
         }
     }
-    /// Which branch of Algorithm 2 applies to `obs`.
-    pub fn decide(&self, obs: &Observation) -> AggregationDecision {
-        self.core.decide(obs)
-    }
-}
-
-impl Behaviour for Leader {
-    fn name(&self) -> &str {
-        "aggregation_leader"
-    }
-    fn act(&mut self, obs: &Observation, rng: &mut SimRng) -> WheelCommand {
-        let d = self.core.decide(obs);
-        self.core.command(d, obs, rng)
-    }
 }
 
 /// Algorithm 3: a follower.
@@ -280,18 +266,30 @@ impl Follower {
             core: Core::new(params),
         }
     }
-    /// Which branch of Algorithm 3 applies to `obs`.
-    pub fn decide(&self, obs: &Observation) -> AggregationDecision {
-        self.core.decide(obs)
-    }
 }
 
-impl Behaviour for Follower {
-    fn name(&self) -> &str {
-        "aggregation_follower"
-    }
-    fn act(&mut self, obs: &Observation, rng: &mut SimRng) -> WheelCommand {
-        let d = self.core.decide(obs);
-        self.core.command(d, obs, rng)
-    }
+/// `decide` and [`Behaviour`] of an algorithm that runs [`Core`]: `$algorithm` names it in the docs,
+/// `$name` is the name it is registered under.
+macro_rules! runs_core {
+    ($role:ident, $name:literal, $algorithm:literal) => {
+        impl $role {
+            #[doc = concat!("Which branch of ", $algorithm, " applies to `obs`.")]
+            pub fn decide(&self, obs: &Observation) -> AggregationDecision {
+                self.core.decide(obs)
+            }
+        }
+
+        impl Behaviour for $role {
+            fn name(&self) -> &str {
+                $name
+            }
+            fn act(&mut self, obs: &Observation, rng: &mut SimRng) -> WheelCommand {
+                let d = self.core.decide(obs);
+                self.core.command(d, obs, rng)
+            }
+        }
+    };
 }
+
+runs_core!(Leader, "aggregation_leader", "Algorithm 2");
+runs_core!(Follower, "aggregation_follower", "Algorithm 3");
