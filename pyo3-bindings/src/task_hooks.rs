@@ -191,7 +191,7 @@ impl TaskInfo {
             roles: (0..sc.robot_count())
                 .map(|i| view.map_or(String::new(), |w| w.role(i).to_string()))
                 .collect(),
-            pheromones: sc.spec.pheromones.iter().map(|p| p.name.clone()).collect(),
+            pheromones: sc.pheromone_names().map(String::from).collect(),
             colours: sc.spec.pheromones.iter().map(|p| p.colour).collect(),
             max_wheel_speed: p.max_wheel_speed,
             wheel_base: p.wheel_base,

@@ -161,12 +161,7 @@ impl Plan {
         };
         // The pheromone names of field masses come from the first combination's scenario.
         let first = plan.build(0, false)?;
-        let pheromones = first
-            .spec
-            .pheromones
-            .iter()
-            .map(|p| p.name.clone())
-            .collect();
+        let pheromones = first.pheromone_names().map(String::from).collect();
         plan.metrics = MetricSet::new(&plan.spec.metrics, &plan.spec.metric_options, pheromones)?;
         plan.columns = ID_COLUMNS.iter().map(|s| s.to_string()).collect();
         plan.columns

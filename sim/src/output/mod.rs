@@ -7,3 +7,17 @@ pub mod trajectory;
 
 pub use gif::GifRecorder;
 pub use trajectory::{TickRows, TrajectoryLog};
+
+/// `name` made safe as part of a file name: ASCII letters, digits, `-` and the characters in `keep`
+/// stay, every other character becomes `_`.
+pub fn file_safe(name: &str, keep: &[char]) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || keep.contains(&c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}

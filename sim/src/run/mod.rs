@@ -266,7 +266,7 @@ fn write_fields(
         .map_err(|e| SimError::io(format!("creating {}", dir.display()), e))?;
     let mut files = Vec::new();
     for p in world.pheromones() {
-        let path = dir.join(format!("{}.npy", sanitize(&p.name)));
+        let path = dir.join(format!("{}.npy", crate::output::file_safe(&p.name, &[])));
         match &p.model {
             FieldModel::Grid(g) => {
                 npy::write_npy_f32(&path, &[g.spec().ny, g.spec().nx], g.values())?
@@ -288,19 +288,6 @@ fn write_fields(
         files.push(path);
     }
     Ok(files)
-}
-
-/// A pheromone name made safe as a file name.
-fn sanitize(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
 }
 
 /// Largest final screen image written, in pixels: an 8K panel. A virtual screen beyond it (the

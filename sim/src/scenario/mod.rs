@@ -113,6 +113,11 @@ impl Scenario {
             .fold(0usize, |n, g| n.saturating_add(g.count))
     }
 
+    /// The pheromones' names, in the scenario's order.
+    pub fn pheromone_names(&self) -> impl Iterator<Item = &str> {
+        self.spec.pheromones.iter().map(|p| p.name.as_str())
+    }
+
     /// Index of the pheromone called `name`.
     pub fn pheromone_index(&self, name: &str) -> Option<usize> {
         self.spec.pheromones.iter().position(|p| p.name == name)

@@ -534,7 +534,7 @@ fn validate_robots(sc: &Scenario) -> Result<()> {
 
 fn find_pheromone(sc: &Scenario, key: &str, name: &str) -> Result<usize> {
     sc.pheromone_index(name).ok_or_else(|| {
-        let known: Vec<_> = sc.spec.pheromones.iter().map(|p| p.name.as_str()).collect();
+        let known: Vec<_> = sc.pheromone_names().collect();
         SimError::invalid(
             key,
             format!("{name:?}"),

@@ -30,15 +30,7 @@ pub struct AxisInfo {
 
 /// A file name from a column name (`robots[1].count` -> `robots_1_.count`).
 fn file_part(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
+    colcos_sim::output::file_safe(name, &['.'])
 }
 
 /// Every picture of the sweep; returns the files written.

@@ -268,12 +268,7 @@ impl MetricSet {
                 self.options.leader_role
             ));
         }
-        let names: Vec<&str> = scenario
-            .spec
-            .pheromones
-            .iter()
-            .map(|p| p.name.as_str())
-            .collect();
+        let names: Vec<&str> = scenario.pheromone_names().collect();
         if (self.has(Metric::FieldMass) || !self.thresholds.is_empty()) && names != self.pheromones
         {
             return Err(format!(
