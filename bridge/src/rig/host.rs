@@ -290,18 +290,8 @@ impl ArenaView for HostWorld {
     fn robots(&self) -> &[RobotSlot] {
         &self.parts.slots
     }
-    fn pheromones(&self) -> &[colcos_sim::field::Pheromone] {
-        self.parts.fields.pheromones()
-    }
-    fn pheromone_value_and_gradient_observed(
-        &self,
-        index: usize,
-        p: Vec2,
-        step: f32,
-    ) -> (f32, Vec2) {
-        self.parts
-            .fields
-            .value_and_gradient_observed(index, p, step)
+    fn fields(&self) -> &colcos_sim::world::FieldSet {
+        &self.parts.fields
     }
     fn role(&self, i: usize) -> &str {
         &self.roles[i]

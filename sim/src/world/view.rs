@@ -1,7 +1,7 @@
 //! What a loop function (an RL task's rewards, a metric) sees of an arena: the robots' poses as the
 //! host knows them, their observations and drives, and the fields. A simulated [`World`] is one; so is
 //! a rig's host, whose poses come from a real tracker.
-use super::{RobotSlot, World};
+use super::{FieldSet, RobotSlot, World};
 use crate::behaviour::Observation;
 use crate::field::Pheromone;
 use crate::robot::{ColiasParams, Pose};
@@ -19,14 +19,20 @@ pub trait ArenaView {
     fn observations(&self) -> &[Observation];
     /// Per-robot group, drive state and last command.
     fn robots(&self) -> &[RobotSlot];
-    fn pheromones(&self) -> &[Pheromone];
+    /// The pheromone fields as the screen shows them.
+    fn fields(&self) -> &FieldSet;
+    fn pheromones(&self) -> &[Pheromone] {
+        self.fields().pheromones()
+    }
     /// Pheromone `index`'s value at `p` as of the current observations, and its gradient.
     fn pheromone_value_and_gradient_observed(
         &self,
         index: usize,
         p: Vec2,
         step: f32,
-    ) -> (f32, Vec2);
+    ) -> (f32, Vec2) {
+        self.fields().value_and_gradient_observed(index, p, step)
+    }
     /// Role of robot `i` (its group's `role`).
     fn role(&self, i: usize) -> &str;
     fn robot_count(&self) -> usize {
@@ -70,16 +76,8 @@ impl ArenaView for World {
     fn robots(&self) -> &[RobotSlot] {
         World::robots(self)
     }
-    fn pheromones(&self) -> &[Pheromone] {
-        World::pheromones(self)
-    }
-    fn pheromone_value_and_gradient_observed(
-        &self,
-        index: usize,
-        p: Vec2,
-        step: f32,
-    ) -> (f32, Vec2) {
-        World::pheromone_value_and_gradient_observed(self, index, p, step)
+    fn fields(&self) -> &FieldSet {
+        &self.fields
     }
     fn role(&self, i: usize) -> &str {
         World::role(self, i)
