@@ -21,11 +21,7 @@ const SCENARIO: &str = r#"
 name = "twin-truth"
 duration = 600.0
 seed = 7
-[[robots]]
-count = 3
-behaviour = "wander"
-placement = "explicit"
-poses = [[0.4, 0.4, 0.0], [1.0, 0.4, 90.0], [0.7, 0.6, 180.0]]
+robots = [{ count = 3, behaviour = "wander", placement = "explicit", poses = [[0.4, 0.4, 0.0], [1.0, 0.4, 90.0], [0.7, 0.6, 180.0]] }]
 "#;
 
 /// Printed stripes on the black screen, 12 cm apart: white along x, orange along y.

@@ -50,11 +50,7 @@ fn bandwidth(ctx: &GpuContext) -> Option<f64> {
 
 fn bench_4k(ctx: &std::sync::Arc<GpuContext>, d: f32, label: &str) {
     let screen = ScreenSpec::default();
-    let spec = GridSpec {
-        nx: 3840,
-        ny: 2160,
-        cell: screen.size[0] / 3840.0,
-    };
+    let spec = GridSpec::new(3840, 2160, screen.size[0] / 3840.0);
     let dt = 0.02;
     let params = GridParams {
         evaporation: 20.0,

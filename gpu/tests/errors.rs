@@ -17,11 +17,7 @@ fn params() -> GridParams {
 }
 
 fn spec() -> GridSpec {
-    GridSpec {
-        nx: 32,
-        ny: 24,
-        cell: 0.01,
-    }
+    GridSpec::new(32, 24, 0.01)
 }
 
 #[test]
@@ -84,11 +80,7 @@ fn shader_that_does_not_compile_is_an_error() {
 fn batch_above_the_binding_limit_is_an_error() {
     let Some(ctx) = common::ctx() else { return };
     let side = ((ctx.max_binding() / 8) as f64).sqrt() as usize + 2;
-    let big = GridSpec {
-        nx: side,
-        ny: side,
-        cell: 0.001,
-    };
+    let big = GridSpec::new(side, side, 0.001);
     match GpuGrids::new(ctx.clone(), big, &[params()]) {
         Err(GpuError::TooLarge { bytes, limit, .. }) => assert!(bytes > limit),
         Err(e) => panic!("expected TooLarge, got {e}"),

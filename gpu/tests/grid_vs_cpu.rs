@@ -114,11 +114,7 @@ fn run_cases(
 }
 
 fn spec() -> GridSpec {
-    GridSpec {
-        nx: 97,
-        ny: 61,
-        cell: 0.005,
-    }
+    GridSpec::new(97, 61, 0.005)
 }
 
 fn p(e: f32, d: f32, scheme: DiffusionScheme, wind: [f32; 2]) -> GridParams {
@@ -215,11 +211,7 @@ fn odd_shapes() {
     for (nx, ny) in [(1, 40), (40, 1), (2, 2), (3, 257), (300, 7)] {
         run_cases(
             &format!("{nx}x{ny}"),
-            GridSpec {
-                nx,
-                ny,
-                cell: 0.005,
-            },
+            GridSpec::new(nx, ny, 0.005),
             &all,
             0.02,
             100,
@@ -248,11 +240,7 @@ fn infinite_diffusion_is_uniform() {
 fn many_worlds_in_one_batch() {
     use DiffusionScheme::*;
     // 64 worlds x 3 pheromones of a 5 mm grid of a small arena, mixed parameters, in one batch.
-    let spec = GridSpec {
-        nx: 60,
-        ny: 40,
-        cell: 0.005,
-    };
+    let spec = GridSpec::new(60, 40, 0.005);
     let cases: Vec<(GridParams, bool)> = (0..192)
         .map(|k| match k % 3 {
             0 => (p(20.0, 2e-6, Auto, [0.0, 0.0]), false),
@@ -275,11 +263,7 @@ fn implicit_solves_in_tiles_are_the_cpus_bit_for_bit() {
         (p(f32::INFINITY, 2e-2, Implicit, [0.0, 0.0]), false),
     ];
     for (nx, ny) in [(97, 61), (64, 130), (33, 65), (200, 3), (1, 70), (70, 1)] {
-        let spec = GridSpec {
-            nx,
-            ny,
-            cell: 0.005,
-        };
+        let spec = GridSpec::new(nx, ny, 0.005);
         let (mut cpu, mut gpu) = batch(ctx.clone(), spec, &cases, 3);
         for _ in 0..30 {
             cpu.iter_mut().for_each(|f| f.step(0.02));

@@ -20,11 +20,7 @@ const D: f32 = 1e-6;
 const WIDTH: f32 = 1.439;
 
 fn fields(nx: usize, ny: usize, scheme: DiffusionScheme) -> Vec<GridField> {
-    let spec = GridSpec {
-        nx,
-        ny,
-        cell: WIDTH / nx as f32,
-    };
+    let spec = GridSpec::new(nx, ny, WIDTH / nx as f32);
     [8.0f32, 200.0, 300.0]
         .iter()
         .map(|&e| {

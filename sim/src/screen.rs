@@ -32,14 +32,16 @@ pub struct ScreenSpec {
 impl Default for ScreenSpec {
     /// The paper's 65-inch 4K panel.
     fn default() -> Self {
-        ScreenSpec {
-            resolution: [3840, 2160],
-            size: [1.439, 0.809],
-        }
+        ScreenSpec::new([3840, 2160], [1.439, 0.809])
     }
 }
 
 impl ScreenSpec {
+    /// A panel of `resolution` pixels and `size` metres.
+    pub const fn new(resolution: [u32; 2], size: [f32; 2]) -> Self {
+        ScreenSpec { resolution, size }
+    }
+
     /// Size of one pixel, m: `(size.x / resolution.x, size.y / resolution.y)`.
     pub fn pixel_size(&self) -> Vec2 {
         Vec2::new(

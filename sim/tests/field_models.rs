@@ -73,11 +73,7 @@ fn gaussian_source_matches_eq5() {
 
 #[test]
 fn polyline_map_has_the_given_width() {
-    let spec = GridSpec {
-        nx: 200,
-        ny: 100,
-        cell: 0.005,
-    };
+    let spec = GridSpec::new(200, 100, 0.005);
     let pts = [
         Vec2::new(0.1, 0.25),
         Vec2::new(0.9, 0.25),
@@ -116,11 +112,7 @@ fn image_map_reads_png_top_row_at_height() {
         };
     }
     img.save(&path).unwrap();
-    let spec = GridSpec {
-        nx: 8,
-        ny: 4,
-        cell: 0.1,
-    };
+    let spec = GridSpec::new(8, 4, 0.1);
     let red = image_map(&spec, &path, Some(Channel::R), 2.0).unwrap();
     // Top grid row (j = 3) is the image's top row: full red; bottom row none.
     assert!((0..8).all(|i| (red[3 * 8 + i] - 2.0).abs() < 1e-6));
@@ -154,19 +146,12 @@ fn grid_pheromone(
 
 #[test]
 fn pixel_at_rounds_and_clips() {
-    let spec = GridSpec {
-        nx: 4,
-        ny: 4,
-        cell: 0.25,
-    };
+    let spec = GridSpec::new(4, 4, 0.25);
     // r 100.4 -> 100; b negative -> 0
     let a = grid_pheromone([100.0, 0.0, -50.0], spec, |g| g.values_mut().fill(1.004));
     // g rounds half away from zero -> 255
     let b = grid_pheromone([0.0, 1.0, 0.0], spec, |g| g.values_mut().fill(254.5));
-    let screen = ScreenSpec {
-        resolution: [8, 8],
-        size: [1.0, 1.0],
-    };
+    let screen = ScreenSpec::new([8, 8], [1.0, 1.0]);
     assert_eq!(
         pixel_at(&[a, b], &screen, Vec2::new(0.3, 0.6)),
         [100, 255, 0]
@@ -187,11 +172,7 @@ fn pixel_at_rounds_and_clips() {
 
 #[test]
 fn render_puts_high_y_at_the_top() {
-    let spec = GridSpec {
-        nx: 144,
-        ny: 81,
-        cell: 0.01,
-    };
+    let spec = GridSpec::new(144, 81, 0.01);
     let p = grid_pheromone([0.0, 0.0, 255.0], spec, |g| {
         g.deposit_point(&Kernel::Disc { radius: 0.05 }, Vec2::new(0.3, 0.7), 1.0)
     });
@@ -211,10 +192,7 @@ fn render_puts_high_y_at_the_top() {
             time: 0.0,
         }),
     };
-    let screen = ScreenSpec {
-        resolution: [1440, 810],
-        size: [1.44, 0.81],
-    };
+    let screen = ScreenSpec::new([1440, 810], [1.44, 0.81]);
     let img = render(&[p, gauss], &screen, 144, 81);
     assert_eq!(img.dimensions(), (144, 81));
     // Blue blob at y = 0.7 m: image row (0.81 - 0.7) / 0.01 = 11 from the top, column 30.
@@ -237,20 +215,13 @@ fn render_puts_high_y_at_the_top() {
 
 #[test]
 fn render_matches_pixel_at() {
-    let spec = GridSpec {
-        nx: 50,
-        ny: 30,
-        cell: 0.02,
-    };
+    let spec = GridSpec::new(50, 30, 0.02);
     let p = grid_pheromone([40.0, 10.0, 0.0], spec, |g| {
         for (k, v) in g.values_mut().iter_mut().enumerate() {
             *v = (k % 13) as f32 * 0.37;
         }
     });
-    let screen = ScreenSpec {
-        resolution: [160, 90],
-        size: [1.0, 0.6],
-    };
+    let screen = ScreenSpec::new([160, 90], [1.0, 0.6]);
     let ps = [p];
     let img = render(&ps, &screen, 160, 90);
     for (x, row) in [(0u32, 0u32), (17, 33), (159, 89), (80, 45)] {
@@ -268,11 +239,7 @@ fn render_matches_pixel_at() {
 
 #[test]
 fn stepping_is_bit_identical_across_thread_counts() {
-    let spec = GridSpec {
-        nx: 3840,
-        ny: 2160,
-        cell: 1.439 / 3840.0,
-    };
+    let spec = GridSpec::new(3840, 2160, 1.439 / 3840.0);
     let h = spec.cell;
     let run = |threads: usize| -> Vec<Vec<f32>> {
         on_threads(threads, || {

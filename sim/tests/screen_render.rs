@@ -105,10 +105,7 @@ fn random_world(rng: &mut SmallRng) -> (Vec<Pheromone>, ScreenSpec, u32, u32) {
             })
         })
         .collect();
-    let screen = ScreenSpec {
-        resolution: [w, h],
-        size,
-    };
+    let screen = ScreenSpec::new([w, h], size);
     (pheromones, screen, w, h)
 }
 
@@ -250,15 +247,7 @@ fn empty_images_and_worlds() {
     assert_eq!(render(&[], &screen, 0, 5).dimensions(), (0, 5));
     let img = render(&[], &screen, 4, 3);
     assert!(img.as_raw().iter().all(|&b| b == 0));
-    let empty = grid(
-        GridSpec {
-            nx: 0,
-            ny: 0,
-            cell: 0.1,
-        },
-        [255.0; 3],
-        |_| 1.0,
-    );
+    let empty = grid(GridSpec::new(0, 0, 0.1), [255.0; 3], |_| 1.0);
     let img = render(&[empty], &screen, 8, 8);
     assert!(img.as_raw().iter().all(|&b| b == 0), "an empty grid is 0");
 }

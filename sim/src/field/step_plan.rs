@@ -170,11 +170,7 @@ mod tests {
     use super::*;
 
     fn plan(params: GridParams, dt: f32) -> StepPlan {
-        let spec = GridSpec {
-            nx: 10,
-            ny: 8,
-            cell: 0.01,
-        };
+        let spec = GridSpec::new(10, 8, 0.01);
         StepPlan::new(&spec, &params, dt, &mut 0.0).expect("a step")
     }
 
@@ -217,11 +213,7 @@ mod tests {
 
     #[test]
     fn nothing_to_plan() {
-        let spec = GridSpec {
-            nx: 4,
-            ny: 4,
-            cell: 0.01,
-        };
+        let spec = GridSpec::new(4, 4, 0.01);
         for dt in [0.0, -1.0, f32::NAN] {
             assert!(StepPlan::new(&spec, &GridParams::default(), dt, &mut 0.0).is_none());
         }

@@ -323,60 +323,91 @@ impl RobotGroupSpec {
 mod tests {
     use super::*;
 
-    /// The builder and a scenario file saying the same thing give the same scenario.
+    /// The builder and a scenario file saying the same thing give the same scenario, for every
+    /// builder method.
     #[test]
     fn builds_what_the_same_toml_parses_to() {
         let text = r#"
-duration = 0.6
-seed = 7
-physics = "discs"
-[screen]
-resolution = [3840, 2160]
-size = [2.4, 1.35]
-[field]
-cell = 0.003
-[output]
-gif_interval = 0
-[[pheromones]]
-name = "blue"
-colour = [0, 0, 255]
-evaporation = 5.0
-diffusion = 1e-6
-maps = [{ polyline = [[0.2, 0.2], [2.2, 1.1]], width = 0.05, rate = 0.2 }]
+name = "every-builder-method"
+screen = { resolution = [1920, 1080], size = [1.2, 0.675] }
+duration = 1.5
+dt = 0.01
+arena = { size = [1.0, 0.6] }
+seed = 11
+field = { cell = 0.005 }
+physics = "rapier"
+output = { gif_interval = 0.5 }
+pheromones = [
+    { name = "trail", colour = [0, 255, 0], evaporation = 8.0, diffusion = 2e-6, maps = [{ polyline = [[0.1, 0.3], [0.9, 0.3]], width = 0.04, rate = 0.3 }] },
+    { name = "alarm", colour = [255, 0, 0], model = "gaussian", evaporation = 4.0, sources = [{ k = 0.5, sigma = [0.1, 0.2], evaporation = 4.0, centre = [0.5, 0.3], start = 0.2 }] },
+]
 [[robots]]
-count = 20
-role = "walker"
+count = 6
+role = "scout"
 behaviour = "follow"
-params = { channel = "b", speed = 0.1 }
-deposits = [{ pheromone = "blue", kernel = { shape = "cone", radius = 0.01 }, rate = 5.0 }]
+params = { channel = "g", speed = 0.08 }
+placement = "grid"
+region = [0.1, 0.1, 0.5, 0.5]
+deposits = [{ pheromone = "trail", kernel = { shape = "disc", radius = 0.02 }, rate = 3.0 }]
+deposit_actions = [{ pheromone = "trail", kernel = { shape = "cone", radius = 0.03 }, max_rate = 6.0 }]
+emits = [{ pheromone = "alarm", k = 0.4, sigma = [0.05, 0.05], evaporation = 2.0, when = { near = { role = "nest", distance = 0.1 } } }]
 [[robots]]
-count = 1
+count = 2
+role = "nest"
 behaviour = "avoid"
 placement = "explicit"
-poses = [[0.15, 0.44, -20.0]]
+poses = [[0.8, 0.2, 90.0], [0.8, 0.4, -90.0]]
+emits = [{ pheromone = "alarm", k = 0.2, sigma = [0.03, 0.03], evaporation = 1.0, when = "action" }]
 "#;
         let parsed = Scenario::from_toml_str(text, ".").unwrap();
+        let alarm_source = SourceSpec {
+            k: 0.5,
+            sigma: [0.1, 0.2],
+            rho: 0.0,
+            evaporation: 4.0,
+            centre: [0.5, 0.3],
+            start: 0.2,
+        };
         let built = ScenarioBuilder::new()
-            .duration(0.6)
-            .seed(7)
-            .physics(PhysicsBackend::Discs)
-            .screen([3840, 2160], [2.4, 1.35])
-            .cell(0.003)
-            .gif_interval(0.0)
+            .name("every-builder-method")
+            .duration(1.5)
+            .dt(0.01)
+            .seed(11)
+            .physics(PhysicsBackend::Rapier)
+            .screen([1920, 1080], [1.2, 0.675])
+            .arena([1.0, 0.6])
+            .cell(0.005)
+            .gif_interval(0.5)
             .pheromone(
-                PheromoneSpec::grid("blue", [0.0, 0.0, 255.0])
-                    .with_evaporation(5.0)
-                    .with_diffusion(1e-6)
-                    .with_map(MapSpec::polyline(vec![[0.2, 0.2], [2.2, 1.1]], 0.05, 0.2)),
+                PheromoneSpec::grid("trail", [0.0, 255.0, 0.0])
+                    .with_evaporation(8.0)
+                    .with_diffusion(2e-6)
+                    .with_map(MapSpec::polyline(vec![[0.1, 0.3], [0.9, 0.3]], 0.04, 0.3)),
+            )
+            .pheromone(
+                PheromoneSpec::gaussian("alarm", [255.0, 0.0, 0.0])
+                    .with_evaporation(4.0)
+                    .with_source(alarm_source),
             )
             .robots(
-                RobotGroupSpec::new(20, "follow")
-                    .with_role("walker")
-                    .with_param("channel", "b")
-                    .with_param("speed", 0.1)
-                    .with_deposit("blue", Kernel::Cone { radius: 0.01 }, 5.0),
+                RobotGroupSpec::new(6, "follow")
+                    .with_role("scout")
+                    .with_param("channel", "g")
+                    .with_param("speed", 0.08)
+                    .with_placement(Placement::Grid)
+                    .in_region([0.1, 0.1, 0.5, 0.5])
+                    .with_deposit("trail", Kernel::Disc { radius: 0.02 }, 3.0)
+                    .with_deposit_action("trail", Kernel::Cone { radius: 0.03 }, 6.0)
+                    .with_emit(
+                        EmitSpec::follow("alarm", 0.4, [0.05, 0.05], 2.0).when_near("nest", 0.1),
+                    ),
             )
-            .robots(RobotGroupSpec::new(1, "avoid").at_poses(vec![[0.15, 0.44, -20.0]]))
+            .robots(
+                RobotGroupSpec::new(2, "avoid")
+                    .with_role("nest")
+                    .at_poses(vec![[0.8, 0.2, 90.0], [0.8, 0.4, -90.0]])
+                    .with_emit(EmitSpec::follow("alarm", 0.2, [0.03, 0.03], 1.0).when_action()),
+            )
             .build()
             .unwrap();
         assert_eq!(built.to_toml(), parsed.to_toml());

@@ -252,11 +252,7 @@ mod tests {
     fn footprint_levels_equal_levels_at() {
         use rand::{RngExt, SeedableRng};
         let mut rng = rand::rngs::SmallRng::seed_from_u64(9);
-        let spec = GridSpec {
-            nx: 60,
-            ny: 34,
-            cell: 0.024,
-        };
+        let spec = GridSpec::new(60, 34, 0.024);
         let mut g = GridField::new(spec, GridParams::default());
         // A few infinite and NaN cells: a channel no pheromone colours (blue) still reads 0 there.
         g.values_mut().iter_mut().for_each(|v| {

@@ -421,10 +421,7 @@ mod tests {
             colour: [255.0, 90.0, 20.0],
             model: FieldModel::Grid(g),
         }];
-        let screen = ScreenSpec {
-            resolution: [800, 400],
-            size: [1.0, 0.5],
-        };
+        let screen = ScreenSpec::new([800, 400], [1.0, 0.5]);
         let s = ColourSensor::new(ColourSensorParams {
             gamma: 1.8,
             ..Default::default()
@@ -474,10 +471,7 @@ mod tests {
         let ph = grid_and_gaussians(patterned_grid(60, 30, 0.02, |k| {
             (k as f32 * 0.61).cos().abs()
         }));
-        let screen = ScreenSpec {
-            resolution: [1200, 600],
-            size: [1.2, 0.6],
-        };
+        let screen = ScreenSpec::new([1200, 600], [1.2, 0.6]);
         let s = ColourSensor::new(ColourSensorParams {
             noise: 3.0,
             ..Default::default()

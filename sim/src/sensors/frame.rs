@@ -9,10 +9,7 @@ use image::RgbImage;
 /// The pixel of `frame` (an image of the whole panel of `size` m, row 0 at the top) that shows `p`;
 /// points off the panel map to the nearest edge pixel.
 pub fn frame_pixel(frame: &RgbImage, size: Vec2, p: Vec2) -> [u8; 3] {
-    let spec = ScreenSpec {
-        resolution: [frame.width(), frame.height()],
-        size: size.into(),
-    };
+    let spec = ScreenSpec::new([frame.width(), frame.height()], size.into());
     let c = spec.pixel_centre(p);
     let ps = spec.pixel_size();
     let col = (c.x / ps.x) as u32;

@@ -13,15 +13,15 @@ pub struct GridSpec {
 }
 
 impl GridSpec {
+    /// `nx * ny` cells of side `cell` m.
+    pub const fn new(nx: usize, ny: usize, cell: f32) -> Self {
+        GridSpec { nx, ny, cell }
+    }
     /// The coarsest grid with cells no larger than `cell` that covers `size` (m).
     pub fn covering(size: Vec2, cell: f32) -> Self {
         let nx = ((size.x / cell).round() as usize).max(1);
         let ny = ((size.y / cell).round() as usize).max(1);
-        GridSpec {
-            nx,
-            ny,
-            cell: size.x / nx as f32,
-        }
+        GridSpec::new(nx, ny, size.x / nx as f32)
     }
     pub fn len(&self) -> usize {
         self.nx * self.ny
