@@ -55,7 +55,10 @@ fn a_running_world_steps_without_allocating() {
         let per_step = allocations_per_step(file, PhysicsBackend::Rapier);
         let path = format!("{}/../scenarios/{file}", env!("CARGO_MANIFEST_DIR"));
         let robots = Scenario::from_file(&path).unwrap().robot_count();
-        let bound = 4.0 + robots as f64 / 10.0;
+        // A debug build's rapier allocates more (5.8 a step in three_trails against 3.4): twice
+        // the bound there.
+        let slack = if cfg!(debug_assertions) { 2.0 } else { 1.0 };
+        let bound = (4.0 + robots as f64 / 10.0) * slack;
         assert!(
             per_step <= bound,
             "{file}, rapier: {per_step} allocations a step (at most {bound})"
