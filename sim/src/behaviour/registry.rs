@@ -136,6 +136,11 @@ pub fn build_with(
 
 /// Deserialises a behaviour's `params` table, naming the key at fault and its value.
 pub fn parse_params<T: DeserializeOwned>(params: &toml::Table, key: &str) -> Result<T> {
+    // Every robot of every world built parses its table: the path-tracking deserializer (which
+    // allocates each key it passes) runs only for a table that fails, to name the key.
+    if let Ok(parsed) = T::deserialize(toml::Value::Table(params.clone())) {
+        return Ok(parsed);
+    }
     let value = toml::Value::Table(params.clone());
     serde_path_to_error::deserialize(value.clone()).map_err(|e| {
         let path = e.path().to_string();

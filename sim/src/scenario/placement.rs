@@ -14,7 +14,9 @@ use std::collections::HashMap;
 /// Buckets are a little wider than the largest distance asked for, so no closer robot is missed.
 struct Placed {
     side: f32,
-    buckets: HashMap<(i64, i64), Vec<(Vec2, usize)>>,
+    /// foldhash, not std's SipHash: a placement try looks up nine buckets, and SipHash made them
+    /// most of a small world's placement.
+    buckets: HashMap<(i64, i64), Vec<(Vec2, usize)>, foldhash::fast::FixedState>,
 }
 
 impl Placed {
@@ -73,7 +75,7 @@ pub(crate) fn place(sc: &Scenario, obstacles: &Obstacles, rng: &mut SimRng) -> R
     let diameter2 = (2.0 * radius).powi(2);
     let mut placed = Placed {
         side: (2.0 * radius + gap) * 1.01,
-        buckets: HashMap::new(),
+        buckets: HashMap::default(),
     };
     let mut poses = Vec::with_capacity(sc.robot_count());
     let heading =
