@@ -353,7 +353,7 @@ proptest::proptest! {
                 time: 1.5,
             }),
         });
-        let screen = ScreenSpec { resolution: [2667, 1600], size: [1.0, 0.6] };
+        let screen = ScreenSpec::new([2667, 1600], [1.0, 0.6]);
         let c = Vec2::new(centre.0, centre.1);
         let points: [Vec2; 9] = std::array::from_fn(|k| {
             if k == 0 { c } else { c + radius * Vec2::from_angle(k as f32 * std::f32::consts::FRAC_PI_4) }

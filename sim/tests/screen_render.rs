@@ -80,11 +80,11 @@ fn random_world(rng: &mut SmallRng) -> (Vec<Pheromone>, ScreenSpec, u32, u32) {
     let spec = |rng: &mut SmallRng| {
         let cell = rng.random_range(0.001..0.12f32);
         let cover = rng.random_range(0.7..1.3f32);
-        GridSpec {
-            nx: ((size[0] * cover / cell) as usize).clamp(1, 400),
-            ny: ((size[1] * cover / cell) as usize).clamp(1, 400),
+        GridSpec::new(
+            ((size[0] * cover / cell) as usize).clamp(1, 400),
+            ((size[1] * cover / cell) as usize).clamp(1, 400),
             cell,
-        }
+        )
     };
     let specs = [spec(rng), spec(rng)];
     let pheromones = (0..rng.random_range(1..5))

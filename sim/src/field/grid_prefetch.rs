@@ -65,7 +65,7 @@ mod tests {
             name: "g".into(),
             colour: [255.0, 0.0, 0.0],
             model: FieldModel::Grid(GridField::new(
-                GridSpec { nx, ny, cell: 0.01 },
+                GridSpec::new(nx, ny, 0.01),
                 GridParams::default(),
             )),
         }

@@ -195,7 +195,7 @@ mod tests {
         use rand::{RngExt, SeedableRng};
         let mut rng = rand::rngs::SmallRng::seed_from_u64(5);
         for (nx, ny) in [(1, 1), (2, 3), (37, 23), (200, 120)] {
-            let spec = GridSpec { nx, ny, cell: 0.01 };
+            let spec = GridSpec::new(nx, ny, 0.01);
             let mut g = GridField::new(spec, GridParams::default());
             g.values_mut()
                 .iter_mut()
